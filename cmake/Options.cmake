@@ -1,0 +1,20 @@
+# Compiler settings shared by every gilt target: call gilt_target_defaults(target).
+
+function(gilt_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic)
+  if(GILT_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  # Keep fused multiply-add contraction off: the ray offset and the sphere test rely on
+  # IEEE-exact products to stay watertight and scale-invariant.
+  target_compile_options(${target} PRIVATE -ffp-contract=off)
+  if(GILT_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+if(GILT_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()

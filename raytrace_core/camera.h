@@ -1,0 +1,31 @@
+#pragma once
+// Pinhole and thin-lens cameras.
+
+#include "raytrace_core/math.h"
+#include "raytrace_core/ray.h"
+
+namespace gilt::raytrace_core {
+
+/// A perspective camera. With aperture_radius = 0 it is a pinhole; otherwise a thin lens focused
+/// at focus_distance (0 means at the distance to look_at).
+struct Camera {
+  Vec3 look_from{0.0f, 0.0f, 1.0f};
+  Vec3 look_at{0.0f, 0.0f, 0.0f};
+  Vec3 up{0.0f, 1.0f, 0.0f};
+  float vfov_degrees = 40.0f;    ///< vertical field of view
+  float aperture_radius = 0.0f;  ///< lens radius in scene units
+  float focus_distance = 0.0f;   ///< distance of the plane in focus, scene units
+
+  /// Primary ray through film position `film` ∈ [0,1]² (x right, y down) for an image of the
+  /// given aspect ratio (width / height); `lens` ∈ [0,1)² picks the point on the lens.
+  Ray generate_ray(Vec2 film, Vec2 lens, float aspect) const;
+
+  /// Throws InputError when the camera cannot form an image (coincident points, up parallel to
+  /// the view direction, field of view outside (0, 180), negative aperture).
+  void validate() const;
+};
+
+/// A camera that frames the bounding box, looking down −z from in front of it.
+Camera default_camera(const Bounds3& bounds);
+
+}  // namespace gilt::raytrace_core

@@ -1,0 +1,60 @@
+#pragma once
+// Light sources: emissive triangles and spheres (area lights), point, spot, directional and a
+// constant environment, and sampling of each from a point to be lit.
+
+#include <cstdint>
+
+#include "raytrace_core/material.h"
+#include "raytrace_core/ray.h"
+#include "raytrace_core/rgb.h"
+
+namespace gilt::raytrace_core {
+
+class Scene;
+
+/// The kind of a light.
+enum class LightKind : uint8_t {
+  area_triangle,  ///< one emissive triangle: (geom_id, prim_id) of the scene's mesh
+  area_sphere,    ///< one emissive sphere: prim_id indexes Scene::spheres
+  point,          ///< isotropic point: `intensity` in W·sr⁻¹
+  spot,           ///< point with a cone: `intensity` on the axis, smooth falloff from inner to outer
+  directional,    ///< parallel light along `direction`: `irradiance` in W·m⁻² on a perpendicular plane
+  environment,    ///< constant radiance from every direction at infinity
+};
+
+/// One light. Area lights take their radiance from the material of their primitive.
+struct Light {
+  LightKind kind = LightKind::point;
+  uint32_t geom_id = 0, prim_id = 0;  ///< area lights: the emitting primitive
+  Vec3 position{0.0f};                ///< point, spot
+  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis, or direction of travel of directional light (unit)
+  Rgb intensity{0.0f};                ///< point, spot: W·sr⁻¹
+  Rgb irradiance{0.0f};               ///< directional: W·m⁻²
+  Rgb radiance{0.0f};                 ///< environment: W·sr⁻¹·m⁻²
+  float cos_inner = 1.0f, cos_outer = 0.0f;  ///< spot cone, cosines of the half angles
+};
+
+/// Light arriving at a point from one sampled position on a light.
+struct LightSample {
+  Rgb radiance{0.0f};  ///< incident radiance (delta lights: intensity / distance², or irradiance)
+  Vec3 wi{0.0f};       ///< unit direction from the lit point towards the light
+  float pdf = 0.0f;    ///< solid-angle density of wi (delta lights: 1); excludes light selection
+  bool delta = false;  ///< point, spot or directional: not reachable by BSDF sampling
+  Ray shadow_ray;      ///< visibility test between the lit point and the light sample
+};
+
+/// Samples light `light` from the reference surface point; empty radiance when nothing arrives.
+LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u);
+
+/// Solid-angle density with which sample_light picks direction wi reaching the light at `on_light`
+/// (area lights) from `ref`; environment ignores on_light. Zero for delta lights.
+float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref, const Vec3& wi,
+                const SurfacePoint& on_light);
+
+/// Emitted power of the light in W (per channel), used to choose lights in proportion to power.
+Rgb light_power(const Scene& scene, const Light& light);
+
+/// Radiance emitted by a surface of material m towards direction w leaving it (front = ng side).
+Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w);
+
+}  // namespace gilt::raytrace_core

@@ -1,0 +1,44 @@
+#pragma once
+// Surface materials: a closed set, so an enum and a switch rather than virtual classes.
+
+#include <cstdint>
+#include <string>
+
+#include "raytrace_core/rgb.h"
+
+namespace gilt::raytrace_core {
+
+/// The scattering model of a material.
+enum class MaterialKind : uint8_t {
+  diffuse,     ///< Lambertian: f = albedo / π, reflects on both sides
+  glossy,      ///< Lambertian `albedo` plus energy-normalised Phong lobe `specular`, `exponent`
+  mirror,      ///< perfect specular reflection tinted by `specular`
+  dielectric,  ///< smooth glass: Fresnel reflection and refraction with `ior`, Beer–Lambert `absorption`
+};
+
+/// A material. Emission is independent of the scattering kind: any surface may emit.
+struct Material {
+  std::string name;
+  MaterialKind kind = MaterialKind::diffuse;
+  Rgb albedo{0.8f};       ///< diffuse reflectance in [0, 1] (diffuse, glossy)
+  Rgb specular{0.0f};     ///< Phong specular reflectance (glossy) or mirror reflectance (mirror)
+  float exponent = 0.0f;  ///< Phong exponent n ≥ 0 (glossy)
+  float ior = 1.5f;       ///< index of refraction inside, relative to outside (dielectric)
+  Rgb absorption{0.0f};   ///< absorption coefficient σa per scene unit inside (dielectric)
+  Rgb emission{0.0f};     ///< emitted radiance, W·sr⁻¹·m⁻², from the front face
+  bool two_sided_emission = false;  ///< emit from both faces
+
+  /// True when the surface emits light.
+  bool is_emissive() const { return !emission.is_black(); }
+  /// True when every scattering direction is a delta (mirror, dielectric): no light sampling.
+  bool is_specular() const { return kind == MaterialKind::mirror || kind == MaterialKind::dielectric; }
+
+  /// Material of the given kind with default parameters, named.
+  static Material make_diffuse(std::string name, Rgb albedo);
+  static Material make_emitter(std::string name, Rgb radiance, Rgb albedo = Rgb(0.0f));
+  static Material make_mirror(std::string name, Rgb reflectance = Rgb(1.0f));
+  static Material make_dielectric(std::string name, float ior, Rgb absorption = Rgb(0.0f));
+  static Material make_glossy(std::string name, Rgb albedo, Rgb specular, float exponent);
+};
+
+}  // namespace gilt::raytrace_core

@@ -1,0 +1,50 @@
+#pragma once
+// The image loop shared by every method: tiles in parallel, per-sample random streams, a sample
+// or time budget, and progress. A method supplies only the radiance along one camera ray.
+
+#include <cstdint>
+#include <functional>
+
+#include "raytrace_core/camera.h"
+#include "raytrace_core/film.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/scene.h"
+
+namespace gilt::raytrace_core {
+
+/// How to render an image.
+struct RenderSettings {
+  int width = 512;
+  int height = 512;
+  int spp = 64;               ///< samples per pixel (the budget unless time_limit > 0)
+  double time_limit = 0.0;    ///< seconds; > 0 renders whole passes until the time is spent
+  uint64_t seed = 0;          ///< global seed; the image is a function of (scene, settings, seed)
+  int threads = 0;            ///< 0 = all hardware threads
+  Filter filter;              ///< pixel filter
+  bool progress = true;       ///< progress bar on stderr (only drawn on a terminal)
+  int tile_size = 16;         ///< tile edge in pixels
+};
+
+/// What a render did.
+struct RenderStats {
+  int spp = 0;              ///< samples per pixel completed
+  uint64_t samples = 0;     ///< camera samples taken
+  uint64_t rays = 0;        ///< rays traced, primary and shadow rays included
+  double seconds = 0.0;     ///< wall time
+};
+
+/// State of one camera sample: its random stream and a ray counter.
+struct SampleContext {
+  Rng rng;
+  uint64_t rays = 0;
+};
+
+/// Radiance arriving at the camera along a primary ray (W·sr⁻¹·m⁻²).
+using RadianceFunction = std::function<Rgb(const Ray& ray, SampleContext& ctx)>;
+
+/// Renders with the given radiance function. Sample s of pixel (x, y) draws from
+/// Rng::for_item(seed, y·width + x, s) only, so the result is independent of threads and tiles.
+Film render_image(const Scene& scene, const Camera& camera, const RenderSettings& settings,
+                  const RadianceFunction& radiance, RenderStats* stats = nullptr);
+
+}  // namespace gilt::raytrace_core

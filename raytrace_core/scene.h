@@ -1,0 +1,137 @@
+#pragma once
+// The scene: triangle meshes and analytic spheres with materials, lights and a camera, traversed
+// by Embree in robust mode.
+//
+// Fill the public data (a loader does this), then call commit(): it validates the geometry,
+// drops degenerate triangles, builds the Embree scene and the light list. Queries are const and
+// thread-safe after commit().
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "raytrace_core/camera.h"
+#include "raytrace_core/light.h"
+#include "raytrace_core/material.h"
+#include "raytrace_core/math.h"
+#include "raytrace_core/ray.h"
+#include "raytrace_core/sampling.h"
+
+namespace gilt::raytrace_core {
+
+/// An indexed triangle mesh of one material.
+struct TriangleMesh {
+  std::string name;
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;     ///< per-vertex shading normals, empty or one per position
+  std::vector<Vec2> uvs;         ///< per-vertex texture coordinates, empty or one per position
+  std::vector<uint32_t> indices; ///< three per triangle, counter-clockwise seen from the front
+  uint32_t material = 0;
+
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+/// An analytic sphere. Its front (outside) is the emitting side of an emissive sphere.
+struct Sphere {
+  Vec3 center{0.0f};
+  float radius = 1.0f;
+  uint32_t material = 0;
+};
+
+/// Render defaults a scene file may set; the command line overrides them.
+struct RenderDefaults {
+  int width = 512;
+  int height = 512;
+  int spp = 64;
+};
+
+/// Compact result of a closest-hit query; surface() expands it when shading needs it.
+struct Hit {
+  float t = kInfinity;
+  uint32_t geom_id = 0;  ///< mesh index, or Scene::sphere_geom_id() for spheres
+  uint32_t prim_id = 0;  ///< triangle index within the mesh, or sphere index
+  float u = 0.0f, v = 0.0f;  ///< barycentrics of the triangle's second and third vertex
+};
+
+/// Everything shading needs about a hit point.
+struct SurfaceInteraction : SurfacePoint {
+  Vec3 ns{0.0f, 0.0f, 1.0f};  ///< unit shading normal, on the same side as ng
+  Vec2 uv{0.0f};
+  uint32_t material = 0;
+  int32_t light = -1;          ///< index into Scene::lights() when the surface emits, else −1
+  bool front_face = true;      ///< the ray arrived on the ng side
+};
+
+/// A scene ready for ray queries after commit().
+class Scene {
+ public:
+  Scene();
+  ~Scene();
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // --- Scene description, filled by loaders before commit(). ---
+  std::string name;
+  std::vector<TriangleMesh> meshes;
+  std::vector<Sphere> spheres;
+  std::vector<Material> materials;
+  std::vector<Light> punctual_lights;  ///< point, spot, directional and environment lights
+  std::optional<Camera> camera;        ///< the scene's own camera, if it has one
+  RenderDefaults render;
+  std::vector<std::string> warnings;   ///< non-fatal problems found while loading or committing
+
+  /// Validates the description (throws InputError naming the mesh and field on NaN or infinite
+  /// coordinates, bad indices or material references), drops degenerate triangles with a
+  /// warning, and builds the acceleration structure and the light list. Call once.
+  void commit();
+  bool committed() const { return committed_; }
+
+  // --- Queries, valid after commit(). ---
+
+  /// Closest intersection along the ray within (0, tmax], if any.
+  std::optional<Hit> intersect(const Ray& ray) const;
+  /// True when anything blocks the ray within (0, tmax].
+  bool occluded(const Ray& ray) const;
+  /// Surface details of a hit found along `ray`.
+  SurfaceInteraction surface(const Ray& ray, const Hit& hit) const;
+
+  /// All lights: one per emissive triangle and sphere, then the punctual lights.
+  const std::vector<Light>& lights() const { return lights_; }
+  /// Light chosen with probability proportional to its power.
+  const Distribution1D& light_distribution() const { return light_distribution_; }
+  /// Bounds of all finite geometry.
+  const Bounds3& bounds() const { return bounds_; }
+  /// Geometry id Embree gives the spheres.
+  uint32_t sphere_geom_id() const { return static_cast<uint32_t>(meshes.size()); }
+  /// Total triangle count after commit().
+  size_t triangle_count() const;
+  /// The camera to render with: the scene's own, or a default view of its bounds.
+  Camera effective_camera() const;
+
+  /// Area of one triangle or sphere, in scene units².
+  float primitive_area(uint32_t geom_id, uint32_t prim_id) const;
+  /// Material of one primitive.
+  const Material& primitive_material(uint32_t geom_id, uint32_t prim_id) const;
+  /// Surface point on a triangle at barycentrics (b1, b2) of its second and third vertex.
+  SurfaceInteraction triangle_point(uint32_t geom_id, uint32_t prim_id, Vec2 barycentrics) const;
+  /// Point on sphere `prim_id` in the direction `dir` (unit) from its centre.
+  SurfaceInteraction sphere_point(uint32_t prim_id, const Vec3& dir) const;
+
+  /// The Embree scene handle, for benchmarks comparing against raw Embree calls.
+  void* embree_scene() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::vector<Light> lights_;
+  Distribution1D light_distribution_;
+  Bounds3 bounds_;
+  bool committed_ = false;
+  std::vector<int32_t> first_light_of_geom_;  // per mesh (+ spheres): light index of primitive 0, or −1
+};
+
+}  // namespace gilt::raytrace_core

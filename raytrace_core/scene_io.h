@@ -1,0 +1,32 @@
+#pragma once
+// Loading scenes from files and by built-in name.
+
+#include <string>
+#include <vector>
+
+#include "raytrace_core/scene.h"
+
+namespace gilt::raytrace_core {
+
+/// Loads a scene file by extension (.obj with its .mtl, .gltf, .glb, .ply, .json) or a built-in
+/// scene by name, and commits it. Throws InputError naming the file and, where known, the line
+/// or field.
+Scene load_scene(const std::string& path_or_name);
+
+/// Loads a scene file without committing it (so callers may still edit it).
+Scene load_scene_file(const std::string& path);
+
+/// Names of the built-in scenes: cornell, cornell-caustics, furnace, smallpt.
+std::vector<std::string> builtin_scene_names();
+/// True when `name` is a built-in scene.
+bool is_builtin_scene(const std::string& name);
+/// A built-in scene, not yet committed. Throws InputError for an unknown name.
+Scene builtin_scene(const std::string& name);
+
+/// Parameters of the built-in `furnace` scene: a closed box of emission le and albedo rho.
+Scene furnace_scene(float le, float rho);
+
+/// Applies p ↦ scale·p + offset to all geometry, lights and the camera (for scale tests).
+void transform_scene(Scene& scene, float scale, const Vec3& offset);
+
+}  // namespace gilt::raytrace_core
