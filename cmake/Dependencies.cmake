@@ -9,18 +9,13 @@ find_package(CLI11 CONFIG REQUIRED)
 find_package(tinyobjloader CONFIG REQUIRED)
 find_package(TinyGLTF CONFIG REQUIRED)
 
-# OpenImageIO's exported target names /usr/include/opencv4 as an include directory even when
-# OpenCV is not installed, which fails CMake's generate step. Drop that entry.
-find_package(OpenImageIO CONFIG REQUIRED)
-foreach(_oiio_target OpenImageIO::OpenImageIO OpenImageIO::OpenImageIO_Util)
-  if(TARGET ${_oiio_target})
-    get_target_property(_dirs ${_oiio_target} INTERFACE_INCLUDE_DIRECTORIES)
-    if(_dirs)
-      list(FILTER _dirs EXCLUDE REGEX "opencv")
-      set_target_properties(${_oiio_target} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_dirs}")
-    endif()
-  endif()
-endforeach()
+# OpenImageIO: Debian's exported CMake targets check for files the -dev package does not bring
+# (the command-line tools in openimageio-tools, which pull Qt, and Imath's Python bindings), and
+# they list /usr/include/opencv4 as an include directory. The package's pkg-config file has none
+# of these problems, so gilt links OpenImageIO through it.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET GLOBAL OpenImageIO)
+add_library(OpenImageIO::OpenImageIO ALIAS PkgConfig::OIIO)
 
 # OpenMesh: CGAL ships a FindOpenMesh.cmake that fails on Debian; ask for the package's own config.
 find_package(OpenMesh CONFIG REQUIRED)

@@ -8,7 +8,7 @@ namespace gilt::raytrace_core {
 
 /// Path tracer parameters.
 struct PathSettings {
-  int max_depth = 1024;  ///< hard cap on bounces; Russian roulette ends paths long before
+  int max_depth = 1 << 20;  ///< hang guard only: Russian roulette ends paths long before (ρ^(2^20) ≈ 0)
   int rr_depth = 3;      ///< bounces before Russian roulette starts
 };
 

@@ -31,6 +31,7 @@ struct RenderStats {
   uint64_t samples = 0;     ///< camera samples taken
   uint64_t rays = 0;        ///< rays traced, primary and shadow rays included
   double seconds = 0.0;     ///< wall time
+  uint64_t non_finite = 0;  ///< samples discarded because the method returned NaN or infinity
 };
 
 /// State of one camera sample: its random stream and a ray counter.

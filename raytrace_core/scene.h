@@ -47,6 +47,12 @@ struct RenderDefaults {
   int spp = 64;
 };
 
+/// Rounding-error bound factor γ(n) = nε / (1 − nε) with ε = 2⁻²⁴ (Higham; PBRT §3.9).
+constexpr float error_gamma(int n) {
+  constexpr float eps = 0x1p-24f;
+  return (n * eps) / (1.0f - n * eps);
+}
+
 /// Compact result of a closest-hit query; surface() expands it when shading needs it.
 struct Hit {
   float t = kInfinity;
@@ -131,7 +137,8 @@ class Scene {
   Distribution1D light_distribution_;
   Bounds3 bounds_;
   bool committed_ = false;
-  std::vector<int32_t> first_light_of_geom_;  // per mesh (+ spheres): light index of primitive 0, or −1
+  std::vector<int32_t> first_light_of_mesh_;  // light index of triangle 0 of an emissive mesh, or −1
+  std::vector<int32_t> light_of_sphere_;      // light index of each sphere, or −1
 };
 
 }  // namespace gilt::raytrace_core

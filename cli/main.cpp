@@ -1,0 +1,43 @@
+// gilt: command-line front end. Exit codes: 0 success, 2 bad input (flags, files, numbers),
+// 1 an internal failure.
+
+#include <exception>
+#include <functional>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/commands.h"
+#include "raytrace_core/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"gilt: global illumination toolkit (path tracing, radiosity, photon mapping)", "gilt"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "gilt 0.1.0");
+  std::function<void()> action;
+  const auto render = gilt::cli::add_render_command(app);
+  app.get_subcommand("render")->callback([&] { action = render; });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+  try {
+    action();
+  } catch (const gilt::raytrace_core::InputError& e) {
+    std::cerr << "gilt: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "gilt: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,57 @@
+// Pinhole and thin-lens perspective cameras.
+
+#include "raytrace_core/camera.h"
+
+#include <cmath>
+
+#include "raytrace_core/error.h"
+#include "raytrace_core/sampling.h"
+
+namespace gilt::raytrace_core {
+
+void Camera::validate() const {
+  if (!is_finite(look_from) || !is_finite(look_at) || !is_finite(up))
+    throw InputError("camera: look_from, look_at and up must be finite");
+  const Vec3 forward = look_at - look_from;
+  if (!(glm::dot(forward, forward) > 0.0f)) throw InputError("camera: look_from and look_at coincide");
+  const Vec3 side = glm::cross(forward, up);
+  if (!(glm::dot(side, side) > 1e-12f * glm::dot(forward, forward) * glm::dot(up, up)))
+    throw InputError("camera: up is zero or parallel to the view direction");
+  if (!(vfov_degrees > 0.0f && vfov_degrees < 180.0f))
+    throw InputError("camera: vertical field of view must lie in (0, 180) degrees");
+  if (!(aperture_radius >= 0.0f) || !std::isfinite(aperture_radius))
+    throw InputError("camera: aperture radius must be a finite number ≥ 0");
+  if (!(focus_distance >= 0.0f) || !std::isfinite(focus_distance))
+    throw InputError("camera: focus distance must be a finite number ≥ 0");
+}
+
+Ray Camera::generate_ray(Vec2 film, Vec2 lens, float aspect) const {
+  const Vec3 w = glm::normalize(look_at - look_from);  // forward
+  const Vec3 u = glm::normalize(glm::cross(w, up));     // right
+  const Vec3 v = glm::cross(u, w);                      // up on the image
+  const float half_h = std::tan(0.5f * vfov_degrees * kPi / 180.0f);
+  const float half_w = half_h * aspect;
+  // Direction through the film point at unit distance in front of the pinhole.
+  const Vec3 d = w + (2.0f * film.x - 1.0f) * half_w * u + (1.0f - 2.0f * film.y) * half_h * v;
+  if (aperture_radius <= 0.0f) return {look_from, glm::normalize(d), kInfinity};
+  const float focus = focus_distance > 0.0f ? focus_distance : glm::length(look_at - look_from);
+  const Vec3 target = look_from + focus * d;  // the point on the plane of focus
+  const Vec2 disk = aperture_radius * sample_uniform_disk(lens);
+  const Vec3 origin = look_from + disk.x * u + disk.y * v;
+  return {origin, glm::normalize(target - origin), kInfinity};
+}
+
+Camera default_camera(const Bounds3& bounds) {
+  Camera c;
+  if (bounds.empty()) return c;
+  const float radius = std::max(bounds.radius(), 1e-30f);
+  c.vfov_degrees = 40.0f;
+  // Far enough back along +z that the bounding sphere fills the vertical field of view.
+  const float distance = radius / std::sin(0.5f * c.vfov_degrees * kPi / 180.0f);
+  c.look_at = bounds.center();
+  c.look_from = c.look_at + Vec3(0.0f, 0.0f, distance);
+  c.up = Vec3(0.0f, 1.0f, 0.0f);
+  return c;
+}
+
+}  // namespace gilt::raytrace_core

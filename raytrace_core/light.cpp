@@ -1,0 +1,166 @@
+// Light sampling: area lights by uniform area (triangles) or by the cone they subtend (spheres),
+// delta lights directly, the environment uniformly over the sphere (PBRT 4th ed., ch. 12).
+
+#include "raytrace_core/light.h"
+
+#include <cmath>
+
+#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene.h"
+
+namespace gilt::raytrace_core {
+namespace {
+
+/// Area density converted to solid angle as seen from ref: pdf_A · d² / |cos θ_light|.
+float area_to_solid_angle(float pdf_area, const Vec3& ref, const SurfacePoint& on_light) {
+  const Vec3 d = on_light.p - ref;
+  const float dist2 = glm::dot(d, d);
+  const float cos_light = std::fabs(glm::dot(on_light.ng, d)) / std::sqrt(dist2);
+  if (!(cos_light > 0.0f) || !(dist2 > 0.0f)) return 0.0f;
+  return pdf_area * dist2 / cos_light;
+}
+
+/// sin²θ_max and 1 − cos θ_max of the cone a sphere subtends from a point outside it.
+struct SphereCone {
+  float cos_max, one_minus_cos;
+};
+SphereCone sphere_cone(const Sphere& s, const Vec3& p) {
+  const double d2 = glm::dot(DVec3(p) - DVec3(s.center), DVec3(p) - DVec3(s.center));
+  const double sin2 = double(s.radius) * s.radius / d2;
+  const double cos_max = std::sqrt(std::max(0.0, 1.0 - sin2));
+  return {static_cast<float>(cos_max), static_cast<float>(sin2 / (1.0 + cos_max))};  // 1 − cos without cancellation
+}
+
+bool inside_sphere(const Sphere& s, const Vec3& p) {
+  const DVec3 d = DVec3(p) - DVec3(s.center);
+  return glm::dot(d, d) <= double(s.radius) * s.radius;
+}
+
+/// Smooth spot falloff between the outer and inner cone.
+float spot_falloff(const Light& l, const Vec3& w_from_light) {
+  const float c = glm::dot(w_from_light, l.direction);
+  if (c >= l.cos_inner) return 1.0f;
+  if (c <= l.cos_outer) return 0.0f;
+  const float x = (c - l.cos_outer) / (l.cos_inner - l.cos_outer);
+  return x * x * (3.0f - 2.0f * x);
+}
+
+}  // namespace
+
+Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w) {
+  if (m.two_sided_emission || glm::dot(ng, w) > 0.0f) return m.emission;
+  return Rgb(0.0f);
+}
+
+LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u) {
+  LightSample ls;
+  switch (light.kind) {
+    case LightKind::area_triangle:
+    case LightKind::area_sphere: {
+      SurfaceInteraction q;
+      float pdf = 0.0f;
+      if (light.kind == LightKind::area_triangle) {
+        q = scene.triangle_point(light.geom_id, light.prim_id, sample_uniform_triangle(u));
+        pdf = area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, q);
+      } else {
+        const Sphere& s = scene.spheres[light.prim_id];
+        if (inside_sphere(s, ref.p)) {
+          q = scene.sphere_point(light.prim_id, sample_uniform_sphere(u));
+          pdf = area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, q);
+        } else {
+          // Uniform direction in the subtended cone, then the nearer intersection with the sphere.
+          const SphereCone cone = sphere_cone(s, ref.p);
+          const DVec3 to_center = DVec3(s.center) - DVec3(ref.p);
+          const double dc = glm::length(to_center);
+          const Frame frame = Frame::from_normal(Vec3(to_center / dc));
+          const float cos_theta = 1.0f - u.x * cone.one_minus_cos;
+          const float sin_theta = safe_sqrt(1.0f - cos_theta * cos_theta);
+          const float phi = 2.0f * kPi * u.y;
+          const Vec3 wi = frame.to_world(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta));
+          // Distance along wi to the sphere: dc cos θ − sqrt(r² − dc² sin² θ).
+          const double r = s.radius;
+          const double sin2 = double(sin_theta) * sin_theta;
+          const double ds = dc * cos_theta - std::sqrt(std::max(0.0, r * r - dc * dc * sin2));
+          const DVec3 hit = DVec3(ref.p) + ds * DVec3(wi);
+          q = scene.sphere_point(light.prim_id, Vec3(hit - DVec3(s.center)));
+          pdf = 1.0f / (2.0f * kPi * cone.one_minus_cos);
+        }
+      }
+      const Vec3 d = q.p - ref.p;
+      const float dist = glm::length(d);
+      if (!(pdf > 0.0f) || !(dist > 0.0f) || !std::isfinite(pdf)) return ls;
+      ls.wi = d / dist;
+      ls.pdf = pdf;
+      ls.radiance = emitted_radiance(scene.primitive_material(light.geom_id, light.prim_id), q.ng, -ls.wi);
+      ls.shadow_ray = spawn_shadow_ray(ref, q);
+      return ls;
+    }
+    case LightKind::point:
+    case LightKind::spot: {
+      const Vec3 d = light.position - ref.p;
+      const float dist2 = glm::dot(d, d);
+      if (!(dist2 > 0.0f)) return ls;
+      ls.wi = d / std::sqrt(dist2);
+      ls.pdf = 1.0f;
+      ls.delta = true;
+      ls.radiance = light.intensity / dist2;
+      if (light.kind == LightKind::spot) ls.radiance *= spot_falloff(light, -ls.wi);
+      ls.shadow_ray = spawn_shadow_ray(ref, light.position);
+      return ls;
+    }
+    case LightKind::directional:
+      ls.wi = -light.direction;
+      ls.pdf = 1.0f;
+      ls.delta = true;
+      ls.radiance = light.irradiance;
+      ls.shadow_ray = spawn_shadow_ray_to_infinity(ref, ls.wi);
+      return ls;
+    case LightKind::environment:
+      ls.wi = sample_uniform_sphere(u);
+      ls.pdf = uniform_sphere_pdf();
+      ls.radiance = light.radiance;
+      ls.shadow_ray = spawn_shadow_ray_to_infinity(ref, ls.wi);
+      return ls;
+  }
+  return ls;
+}
+
+float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref, const Vec3& /*wi*/,
+                const SurfacePoint& on_light) {
+  switch (light.kind) {
+    case LightKind::area_triangle:
+      return area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, on_light);
+    case LightKind::area_sphere: {
+      const Sphere& s = scene.spheres[light.prim_id];
+      if (inside_sphere(s, ref.p))
+        return area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, on_light);
+      return 1.0f / (2.0f * kPi * sphere_cone(s, ref.p).one_minus_cos);
+    }
+    case LightKind::environment: return uniform_sphere_pdf();
+    case LightKind::point:
+    case LightKind::spot:
+    case LightKind::directional: return 0.0f;
+  }
+  return 0.0f;
+}
+
+Rgb light_power(const Scene& scene, const Light& light) {
+  const float scene_radius = scene.bounds().radius();
+  switch (light.kind) {
+    case LightKind::area_triangle:
+    case LightKind::area_sphere: {
+      const Material& m = scene.primitive_material(light.geom_id, light.prim_id);
+      const float sides = m.two_sided_emission ? 2.0f : 1.0f;
+      return m.emission * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
+    }
+    case LightKind::point: return light.intensity * (4.0f * kPi);
+    case LightKind::spot:
+      // ∫ falloff over the sphere: full cone to cos_inner, then the smoothstep band (its mean is ½).
+      return light.intensity * (2.0f * kPi * (1.0f - 0.5f * (light.cos_inner + light.cos_outer)));
+    case LightKind::directional: return light.irradiance * (kPi * scene_radius * scene_radius);
+    case LightKind::environment: return light.radiance * (4.0f * kPi * kPi * scene_radius * scene_radius);
+  }
+  return Rgb(0.0f);
+}
+
+}  // namespace gilt::raytrace_core

@@ -1,0 +1,105 @@
+// Unidirectional path tracing with next-event estimation and MIS (Veach & Guibas 1995, power
+// heuristic), Russian roulette (Arvo & Kirk 1990), Beer–Lambert absorption inside dielectrics.
+
+#include "raytrace_core/path_tracer.h"
+
+#include "raytrace_core/bsdf.h"
+
+namespace gilt::raytrace_core {
+
+Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx, const PathSettings& settings) {
+  const auto& lights = scene.lights();
+  const Distribution1D& light_choice = scene.light_distribution();
+  Rgb radiance(0.0f), beta(1.0f);
+  Ray ray = camera_ray;
+  bool specular_bounce = true;  // the camera counts as a delta event: emission seen directly is not weighted
+  float bsdf_pdf_prev = 0.0f;
+  SurfacePoint prev;
+
+  for (int depth = 0;; ++depth) {
+    ++ctx.rays;
+    const std::optional<Hit> hit = scene.intersect(ray);
+    const Vec3 wo_world = -glm::normalize(ray.direction);
+    if (!hit) {
+      // Escaped: environment lights, MIS-weighted against light sampling.
+      for (size_t li = 0; li < lights.size(); ++li) {
+        if (lights[li].kind != LightKind::environment) continue;
+        float weight = 1.0f;
+        if (!specular_bounce) {
+          const float light_pdf_v = light_choice.pmf(uint32_t(li)) * light_pdf(scene, lights[li], prev, -wo_world, prev);
+          weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
+        }
+        radiance += beta * lights[li].radiance * weight;
+      }
+      break;
+    }
+    const SurfaceInteraction si = scene.surface(ray, *hit);
+    const Material& m = scene.materials[si.material];
+
+    // Leaving the inside of a dielectric: attenuate by its absorption over the segment.
+    if (m.kind == MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+      beta *= exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+
+    if (m.is_emissive()) {
+      const Rgb le = emitted_radiance(m, si.ng, wo_world);
+      if (!le.is_black()) {
+        float weight = 1.0f;
+        if (!specular_bounce && si.light >= 0) {
+          const float light_pdf_v =
+              light_choice.pmf(uint32_t(si.light)) * light_pdf(scene, lights[si.light], prev, -wo_world, si);
+          weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
+        }
+        radiance += beta * le * weight;
+      }
+    }
+    if (depth + 1 >= settings.max_depth) break;
+
+    const Frame frame = Frame::from_normal(si.ns);
+    const Vec3 wo = frame.to_local(wo_world);
+    const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
+
+    // Next-event estimation towards one light chosen by power.
+    if (!m.is_specular() && light_choice.size() > 0) {
+      float pmf = 0.0f;
+      const uint32_t li = light_choice.sample(ctx.rng.uniform());
+      pmf = light_choice.pmf(li);
+      const LightSample ls = sample_light(scene, lights[li], si, ctx.rng.uniform2());
+      // Reflection only: the light must be on wo's side of the geometric surface (no leaks).
+      if (ls.pdf > 0.0f && !ls.radiance.is_black() && (glm::dot(ls.wi, si.ng) > 0.0f) == wo_above) {
+        const Vec3 wi = frame.to_local(ls.wi);
+        const Rgb f = bsdf_eval(m, wo, wi) * std::fabs(wi.z);
+        if (!f.is_black()) {
+          ++ctx.rays;
+          if (!scene.occluded(ls.shadow_ray)) {
+            const float weight = ls.delta ? 1.0f : power_heuristic(1.0f, ls.pdf * pmf, 1.0f, bsdf_pdf(m, wo, wi));
+            radiance += beta * f * ls.radiance * (weight / (ls.pdf * pmf));
+          }
+        }
+      }
+    }
+
+    // Continue the path by sampling the BSDF.
+    const float u_lobe = ctx.rng.uniform();
+    const std::optional<BsdfSample> bs = bsdf_sample(m, wo, u_lobe, ctx.rng.uniform2());
+    if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
+    const Vec3 wi_world = frame.to_world(bs->wi);
+    // A shading normal may send a reflected ray through the geometric surface: end such paths.
+    const bool wi_above = glm::dot(wi_world, si.ng) > 0.0f;
+    if (wi_above != (bs->transmission ? !wo_above : wo_above)) break;
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+    specular_bounce = bs->delta;
+    bsdf_pdf_prev = bs->pdf;
+    prev = si;
+    ray = spawn_ray(si, wi_world);
+
+    // Russian roulette on the throughput.
+    if (depth + 1 >= settings.rr_depth) {
+      const float survive = std::min(1.0f, beta.max_component());
+      if (survive <= 0.0f || ctx.rng.uniform() >= survive) break;
+      beta /= survive;
+    }
+  }
+  return radiance;
+}
+
+}  // namespace gilt::raytrace_core

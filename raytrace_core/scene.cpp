@@ -1,0 +1,403 @@
+// Scene validation, Embree traversal (robust mode) and hit-point reconstruction.
+//
+// Triangles go to Embree's built-in triangle geometry. Spheres are an Embree user geometry
+// intersected in double precision with the numerically stable quadratic of Haines et al.,
+// "Precision Improvements for Ray/Sphere Intersection" (Ray Tracing Gems, 2019), so that the
+// 1e5-radius walls of the smallpt scene intersect as cleanly as a unit sphere.
+
+#include "raytrace_core/scene.h"
+
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <algorithm>
+#include <string>
+
+#include "raytrace_core/error.h"
+
+namespace gilt::raytrace_core {
+namespace {
+
+std::string embree_error_message(RTCError code) {
+  switch (code) {
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    default: return "error " + std::to_string(static_cast<int>(code));
+  }
+}
+
+// Embree reports errors through a C callback, which must not throw: keep the message and let
+// commit() throw after the call that failed.
+thread_local std::string embree_last_message;
+void on_embree_error(void*, RTCError, const char* message) { embree_last_message = message ? message : ""; }
+
+void check_embree(RTCDevice device, const char* what) {
+  const RTCError code = rtcGetDeviceError(device);
+  if (code != RTC_ERROR_NONE)
+    throw std::runtime_error(std::string("Embree: ") + what + ": " + embree_error_message(code) +
+                             (embree_last_message.empty() ? "" : ": " + embree_last_message));
+}
+
+/// The process-wide Embree device, created on first use.
+RTCDevice embree_device() {
+  static RTCDevice device = [] {
+    RTCDevice d = rtcNewDevice(nullptr);
+    if (!d) throw std::runtime_error("Embree: cannot create a device: " + embree_error_message(rtcGetDeviceError(nullptr)));
+    rtcSetDeviceErrorFunction(d, on_embree_error, nullptr);
+    return d;
+  }();
+  return device;
+}
+
+/// Nearest root of the ray–sphere quadratic within (tnear, tfar], or a negative value.
+double intersect_sphere(const Sphere& s, const DVec3& o, const DVec3& d, double tnear, double tfar) {
+  const DVec3 f = o - DVec3(s.center);
+  const double a = glm::dot(d, d);
+  const double b_half = glm::dot(f, d);
+  const DVec3 l = f - (b_half / a) * d;  // f minus its projection on d: avoids b² − 4ac cancellation
+  const double r = s.radius;
+  const double disc = r * r - glm::dot(l, l);
+  if (disc < 0.0) return -1.0;
+  const double c = glm::dot(f, f) - r * r;
+  const double q = -b_half - std::copysign(std::sqrt(a * disc), b_half);
+  double t0 = c / q, t1 = q / a;
+  if (t0 > t1) std::swap(t0, t1);
+  if (t0 > tnear && t0 <= tfar) return t0;
+  if (t1 > tnear && t1 <= tfar) return t1;
+  return -1.0;
+}
+
+void sphere_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& spheres = *static_cast<const std::vector<Sphere>*>(args->geometryUserPtr);
+  const Sphere& s = spheres[args->primID];
+  RTCBounds* b = args->bounds_o;
+  // Round outwards so the box contains the exact sphere.
+  b->lower_x = std::nextafter(s.center.x - s.radius, -kInfinity);
+  b->lower_y = std::nextafter(s.center.y - s.radius, -kInfinity);
+  b->lower_z = std::nextafter(s.center.z - s.radius, -kInfinity);
+  b->upper_x = std::nextafter(s.center.x + s.radius, kInfinity);
+  b->upper_y = std::nextafter(s.center.y + s.radius, kInfinity);
+  b->upper_z = std::nextafter(s.center.z + s.radius, kInfinity);
+}
+
+// Scene queries use rtcIntersect1 / rtcOccluded1 only, so callbacks always see N == 1.
+void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  const auto& spheres = *static_cast<const std::vector<Sphere>*>(args->geometryUserPtr);
+  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+  const DVec3 o(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z);
+  const DVec3 d(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
+  const double t = intersect_sphere(spheres[args->primID], o, d, rh->ray.tnear, rh->ray.tfar);
+  if (t < 0.0) return;
+  rh->ray.tfar = static_cast<float>(t);
+  const DVec3 n = o + t * d - DVec3(spheres[args->primID].center);
+  rh->hit.Ng_x = static_cast<float>(n.x);
+  rh->hit.Ng_y = static_cast<float>(n.y);
+  rh->hit.Ng_z = static_cast<float>(n.z);
+  rh->hit.u = rh->hit.v = 0.0f;
+  rh->hit.primID = args->primID;
+  rh->hit.geomID = args->geomID;
+  rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  const auto& spheres = *static_cast<const std::vector<Sphere>*>(args->geometryUserPtr);
+  auto* ray = reinterpret_cast<RTCRay*>(args->ray);
+  const DVec3 o(ray->org_x, ray->org_y, ray->org_z);
+  const DVec3 d(ray->dir_x, ray->dir_y, ray->dir_z);
+  if (intersect_sphere(spheres[args->primID], o, d, ray->tnear, ray->tfar) >= 0.0) ray->tfar = -kInfinity;
+}
+
+bool finite3(const Vec3& v) { return is_finite(v); }
+
+}  // namespace
+
+struct Scene::Impl {
+  RTCScene scene = nullptr;
+  std::vector<Sphere> spheres;  // Embree's user data: a stable copy that survives moves of Scene
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+  }
+};
+
+Scene::Scene() : impl_(std::make_unique<Impl>()) {}
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+void Scene::commit() {
+  if (committed_) throw std::logic_error("Scene::commit called twice");
+  const std::string where = name.empty() ? std::string("scene") : name;
+
+  // Validate the description before anything is built.
+  for (size_t mi = 0; mi < materials.size(); ++mi) {
+    const Material& m = materials[mi];
+    const std::string id = where + ": material '" + m.name + "'";
+    if (!m.albedo.is_finite() || !m.specular.is_finite() || !m.emission.is_finite() || !m.absorption.is_finite() ||
+        !std::isfinite(m.exponent) || !std::isfinite(m.ior))
+      throw InputError(id + ": parameters must be finite numbers");
+    if (m.albedo.r < 0 || m.albedo.g < 0 || m.albedo.b < 0 || m.specular.r < 0 || m.specular.g < 0 || m.specular.b < 0 ||
+        m.emission.r < 0 || m.emission.g < 0 || m.emission.b < 0 || m.absorption.r < 0 || m.absorption.g < 0 ||
+        m.absorption.b < 0 || m.exponent < 0)
+      throw InputError(id + ": reflectance, emission, absorption and exponent must not be negative");
+    if (m.kind == MaterialKind::dielectric && !(m.ior > 0.0f)) throw InputError(id + ": ior must be positive");
+  }
+  auto check_material = [&](uint32_t material, const std::string& what) {
+    if (material >= materials.size())
+      throw InputError(where + ": " + what + " refers to material " + std::to_string(material) + " but there are " +
+                       std::to_string(materials.size()));
+  };
+
+  size_t dropped = 0;
+  for (size_t gi = 0; gi < meshes.size(); ++gi) {
+    TriangleMesh& mesh = meshes[gi];
+    const std::string what = "mesh '" + (mesh.name.empty() ? std::to_string(gi) : mesh.name) + "'";
+    check_material(mesh.material, what);
+    if (mesh.indices.size() % 3 != 0) throw InputError(where + ": " + what + ": index count is not a multiple of 3");
+    if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+      throw InputError(where + ": " + what + ": has " + std::to_string(mesh.normals.size()) + " normals for " +
+                       std::to_string(mesh.positions.size()) + " positions");
+    if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
+      throw InputError(where + ": " + what + ": has " + std::to_string(mesh.uvs.size()) + " texture coordinates for " +
+                       std::to_string(mesh.positions.size()) + " positions");
+    for (size_t vi = 0; vi < mesh.positions.size(); ++vi)
+      if (!finite3(mesh.positions[vi]))
+        throw InputError(where + ": " + what + ": vertex " + std::to_string(vi) + " has a NaN or infinite coordinate");
+    for (Vec3& n : mesh.normals)
+      if (!finite3(n) || glm::dot(n, n) == 0.0f) n = Vec3(0.0f);  // unusable normal: fall back to ng
+    std::vector<uint32_t> kept;
+    kept.reserve(mesh.indices.size());
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+      const uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
+      if (i0 >= mesh.positions.size() || i1 >= mesh.positions.size() || i2 >= mesh.positions.size())
+        throw InputError(where + ": " + what + ": triangle " + std::to_string(t) + " refers to a vertex past the " +
+                         std::to_string(mesh.positions.size()) + " it has");
+      const Vec3 c = glm::cross(mesh.positions[i1] - mesh.positions[i0], mesh.positions[i2] - mesh.positions[i0]);
+      const float len2 = glm::dot(c, c);
+      if (!(len2 > 0.0f) || !std::isfinite(len2)) {
+        ++dropped;
+        continue;
+      }
+      kept.insert(kept.end(), {i0, i1, i2});
+    }
+    mesh.indices = std::move(kept);
+  }
+  if (dropped > 0) warnings.push_back(std::to_string(dropped) + " degenerate triangle(s) dropped");
+
+  for (size_t si = 0; si < spheres.size(); ++si) {
+    const Sphere& s = spheres[si];
+    check_material(s.material, "sphere " + std::to_string(si));
+    if (!finite3(s.center) || !std::isfinite(s.radius) || !(s.radius > 0.0f))
+      throw InputError(where + ": sphere " + std::to_string(si) + ": centre must be finite and radius positive");
+  }
+  for (size_t li = 0; li < punctual_lights.size(); ++li) {
+    const Light& l = punctual_lights[li];
+    const std::string id = where + ": light " + std::to_string(li);
+    if (l.kind == LightKind::area_triangle || l.kind == LightKind::area_sphere)
+      throw InputError(id + ": area lights come from emissive materials, not the light list");
+    if (!finite3(l.position) || !finite3(l.direction) || !l.intensity.is_finite() || !l.irradiance.is_finite() ||
+        !l.radiance.is_finite() || !std::isfinite(l.cos_inner) || !std::isfinite(l.cos_outer))
+      throw InputError(id + ": parameters must be finite numbers");
+    if ((l.kind == LightKind::spot || l.kind == LightKind::directional) && !(glm::dot(l.direction, l.direction) > 0.0f))
+      throw InputError(id + ": direction must not be zero");
+  }
+  for (Light& l : punctual_lights)
+    if (glm::dot(l.direction, l.direction) > 0.0f) l.direction = glm::normalize(l.direction);
+  if (camera) camera->validate();
+
+  // Build Embree's scene.
+  RTCDevice device = embree_device();
+  impl_->scene = rtcNewScene(device);
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  for (size_t gi = 0; gi < meshes.size(); ++gi) {
+    const TriangleMesh& mesh = meshes[gi];
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), mesh.positions.size()));
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      vb[3 * i] = mesh.positions[i].x;
+      vb[3 * i + 1] = mesh.positions[i].y;
+      vb[3 * i + 2] = mesh.positions[i].z;
+    }
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(uint32_t), mesh.triangle_count()));
+    std::copy(mesh.indices.begin(), mesh.indices.end(), ib);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, static_cast<unsigned>(gi));
+    rtcReleaseGeometry(geom);
+  }
+  if (!spheres.empty()) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(spheres.size()));
+    impl_->spheres = spheres;
+    rtcSetGeometryUserData(geom, &impl_->spheres);
+    rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
+    rtcSetGeometryIntersectFunction(geom, sphere_intersect);
+    rtcSetGeometryOccludedFunction(geom, sphere_occluded);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, sphere_geom_id());
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(impl_->scene);
+  check_embree(device, "building the scene");
+
+  bounds_ = Bounds3{};
+  for (const TriangleMesh& mesh : meshes)
+    for (uint32_t i : mesh.indices) bounds_.extend(mesh.positions[i]);
+  for (const Sphere& s : spheres) {
+    bounds_.extend(s.center - Vec3(s.radius));
+    bounds_.extend(s.center + Vec3(s.radius));
+  }
+
+  // Lights: every emissive triangle and sphere, then the punctual lights; chosen by power.
+  lights_.clear();
+  first_light_of_mesh_.assign(meshes.size(), -1);
+  light_of_sphere_.assign(spheres.size(), -1);
+  for (size_t gi = 0; gi < meshes.size(); ++gi) {
+    if (!materials[meshes[gi].material].is_emissive() || meshes[gi].triangle_count() == 0) continue;
+    first_light_of_mesh_[gi] = static_cast<int32_t>(lights_.size());
+    for (size_t t = 0; t < meshes[gi].triangle_count(); ++t) {
+      Light l;
+      l.kind = LightKind::area_triangle;
+      l.geom_id = static_cast<uint32_t>(gi);
+      l.prim_id = static_cast<uint32_t>(t);
+      lights_.push_back(l);
+    }
+  }
+  for (size_t si = 0; si < spheres.size(); ++si) {
+    if (!materials[spheres[si].material].is_emissive()) continue;
+    light_of_sphere_[si] = static_cast<int32_t>(lights_.size());
+    Light l;
+    l.kind = LightKind::area_sphere;
+    l.geom_id = sphere_geom_id();
+    l.prim_id = static_cast<uint32_t>(si);
+    lights_.push_back(l);
+  }
+  lights_.insert(lights_.end(), punctual_lights.begin(), punctual_lights.end());
+  committed_ = true;  // light_power needs bounds and geometry queries
+  std::vector<float> power(lights_.size());
+  for (size_t i = 0; i < lights_.size(); ++i) power[i] = light_power(*this, lights_[i]).average();
+  light_distribution_ = Distribution1D(power);
+}
+
+std::optional<Hit> Scene::intersect(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.tnear = 0.0f;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.time = 0.0f;
+  rh.ray.tfar = ray.tmax;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  return Hit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v};
+}
+
+bool Scene::occluded(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r;
+  r.org_x = ray.origin.x;
+  r.org_y = ray.origin.y;
+  r.org_z = ray.origin.z;
+  r.tnear = 0.0f;
+  r.dir_x = ray.direction.x;
+  r.dir_y = ray.direction.y;
+  r.dir_z = ray.direction.z;
+  r.time = 0.0f;
+  r.tfar = ray.tmax;
+  r.mask = 0xFFFFFFFFu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(impl_->scene, &context, &r);
+  return r.tfar < 0.0f;
+}
+
+SurfaceInteraction Scene::triangle_point(uint32_t geom_id, uint32_t prim_id, Vec2 b) const {
+  const TriangleMesh& mesh = meshes[geom_id];
+  const uint32_t i0 = mesh.indices[3 * prim_id], i1 = mesh.indices[3 * prim_id + 1], i2 = mesh.indices[3 * prim_id + 2];
+  const Vec3 &p0 = mesh.positions[i0], &p1 = mesh.positions[i1], &p2 = mesh.positions[i2];
+  const float b0 = 1.0f - b.x - b.y;
+  SurfaceInteraction si;
+  si.p = b0 * p0 + b.x * p1 + b.y * p2;
+  // Error of the barycentric combination (PBRT §3.9.4), with room for b0's own rounding.
+  si.p_error = error_gamma(7) * (abs(b0 * p0) + abs(b.x * p1) + abs(b.y * p2));
+  si.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+  si.ns = si.ng;
+  if (!mesh.normals.empty()) {
+    const Vec3 n = b0 * mesh.normals[i0] + b.x * mesh.normals[i1] + b.y * mesh.normals[i2];
+    const float len2 = glm::dot(n, n);
+    if (len2 > 0.0f && std::isfinite(len2)) si.ns = glm::dot(n, si.ng) < 0.0f ? -n / std::sqrt(len2) : n / std::sqrt(len2);
+  }
+  if (!mesh.uvs.empty()) si.uv = b0 * mesh.uvs[i0] + b.x * mesh.uvs[i1] + b.y * mesh.uvs[i2];
+  else si.uv = b;
+  si.material = mesh.material;
+  if (first_light_of_mesh_[geom_id] >= 0) si.light = first_light_of_mesh_[geom_id] + static_cast<int32_t>(prim_id);
+  return si;
+}
+
+SurfaceInteraction Scene::sphere_point(uint32_t prim_id, const Vec3& dir) const {
+  const Sphere& s = spheres[prim_id];
+  const DVec3 n = glm::normalize(DVec3(dir));
+  SurfaceInteraction si;
+  si.p = Vec3(DVec3(s.center) + double(s.radius) * n);  // exact on the sphere up to the final rounding
+  si.p_error = error_gamma(3) * abs(si.p);
+  si.ng = Vec3(n);
+  si.ns = si.ng;
+  si.uv = Vec2(std::atan2(si.ng.y, si.ng.x) * kInv2Pi + 0.5f, std::acos(std::clamp(si.ng.z, -1.0f, 1.0f)) * kInvPi);
+  si.material = s.material;
+  si.light = light_of_sphere_[prim_id];
+  return si;
+}
+
+SurfaceInteraction Scene::surface(const Ray& ray, const Hit& hit) const {
+  SurfaceInteraction si;
+  if (hit.geom_id == sphere_geom_id()) {
+    // Re-project the hit onto the sphere in double precision.
+    const DVec3 p = DVec3(ray.origin) + double(hit.t) * DVec3(ray.direction);
+    si = sphere_point(hit.prim_id, Vec3(p - DVec3(spheres[hit.prim_id].center)));
+  } else {
+    si = triangle_point(hit.geom_id, hit.prim_id, Vec2(hit.u, hit.v));
+  }
+  si.front_face = glm::dot(ray.direction, si.ng) < 0.0f;
+  return si;
+}
+
+float Scene::primitive_area(uint32_t geom_id, uint32_t prim_id) const {
+  if (geom_id == sphere_geom_id()) return 4.0f * kPi * sqr(spheres[prim_id].radius);
+  const TriangleMesh& mesh = meshes[geom_id];
+  const Vec3& p0 = mesh.positions[mesh.indices[3 * prim_id]];
+  const Vec3& p1 = mesh.positions[mesh.indices[3 * prim_id + 1]];
+  const Vec3& p2 = mesh.positions[mesh.indices[3 * prim_id + 2]];
+  return 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+}
+
+const Material& Scene::primitive_material(uint32_t geom_id, uint32_t prim_id) const {
+  if (geom_id == sphere_geom_id()) return materials[spheres[prim_id].material];
+  return materials[meshes[geom_id].material];
+}
+
+size_t Scene::triangle_count() const {
+  size_t n = 0;
+  for (const TriangleMesh& m : meshes) n += m.triangle_count();
+  return n;
+}
+
+Camera Scene::effective_camera() const { return camera ? *camera : default_camera(bounds_); }
+
+void* Scene::embree_scene() const { return impl_->scene; }
+
+}  // namespace gilt::raytrace_core

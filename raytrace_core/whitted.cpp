@@ -1,0 +1,84 @@
+// Whitted-style ray tracing (Whitted 1980, "An Improved Illumination Model for Shaded Display"):
+// direct light through shadow rays, recursive mirror reflection and Fresnel-weighted refraction.
+// Diffuse and glossy surfaces see only direct light; there is no indirect diffuse term.
+
+#include "raytrace_core/whitted.h"
+
+#include "raytrace_core/bsdf.h"
+
+namespace gilt::raytrace_core {
+namespace {
+
+Rgb environment_radiance(const Scene& scene) {
+  Rgb sum(0.0f);
+  for (const Light& l : scene.lights())
+    if (l.kind == LightKind::environment) sum += l.radiance;
+  return sum;
+}
+
+Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings, int depth) {
+  ++ctx.rays;
+  const std::optional<Hit> hit = scene.intersect(ray);
+  if (!hit) return environment_radiance(scene);
+  const SurfaceInteraction si = scene.surface(ray, *hit);
+  const Material& m = scene.materials[si.material];
+  const Vec3 wo_world = -glm::normalize(ray.direction);
+  Rgb radiance = m.is_emissive() ? emitted_radiance(m, si.ng, wo_world) : Rgb(0.0f);
+  const Frame frame = Frame::from_normal(si.ns);
+  const Vec3 wo = frame.to_local(wo_world);
+  const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
+
+  if (!m.is_specular()) {
+    // Local shading: the material's diffuse + Phong BSDF lit by shadow rays, lights chosen by power.
+    const Distribution1D& choice = scene.light_distribution();
+    const int n = std::max(1, settings.area_light_samples);
+    if (choice.size() == 0) return radiance;
+    for (int i = 0; i < n; ++i) {
+      const uint32_t li = choice.sample(ctx.rng.uniform());
+      const float pmf = choice.pmf(li);
+      const LightSample ls = sample_light(scene, scene.lights()[li], si, ctx.rng.uniform2());
+      if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) continue;
+      const Vec3 wi = frame.to_local(ls.wi);
+      const Rgb f = bsdf_eval(m, wo, wi) * std::fabs(wi.z);
+      if (f.is_black()) continue;
+      ++ctx.rays;
+      if (!scene.occluded(ls.shadow_ray)) radiance += f * ls.radiance / (ls.pdf * pmf * float(n));
+    }
+    return radiance;
+  }
+  if (depth + 1 >= settings.max_depth) return radiance;
+
+  auto follow = [&](const Vec3& wi_local, const Rgb& weight) {
+    const Vec3 wi_world = frame.to_world(wi_local);
+    Rgb l = trace(scene, spawn_ray(si, wi_world), ctx, settings, depth + 1);
+    return weight * l;
+  };
+  if (m.kind == MaterialKind::mirror) {
+    const Vec3 wi(-wo.x, -wo.y, wo.z);
+    return radiance + follow(wi, m.specular);
+  }
+  // Dielectric: both branches, weighted by Fresnel, as in Whitted's original.
+  Rgb absorb(1.0f);
+  if (!si.front_face && !m.absorption.is_black()) absorb = exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+  const float eta = m.ior;
+  const float cos_o = wo.z;
+  const float fr = fresnel_dielectric(cos_o, eta);
+  const Vec3 wr(-wo.x, -wo.y, wo.z);
+  radiance += follow(wr, Rgb(fr));
+  if (fr < 1.0f) {
+    const float e = cos_o > 0.0f ? eta : 1.0f / eta;  // IOR ratio of the side entered over the side left
+    const float sin2_t = (1.0f - cos_o * cos_o) / (e * e);
+    const float cos_t = std::sqrt(std::max(0.0f, 1.0f - sin2_t)) * (cos_o > 0.0f ? -1.0f : 1.0f);
+    const Vec3 wt = glm::normalize(Vec3(-wo.x / e, -wo.y / e, cos_t));
+    radiance += follow(wt, Rgb((1.0f - fr) / (e * e)));
+  }
+  return radiance * absorb;
+}
+
+}  // namespace
+
+Rgb whitted_radiance(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings) {
+  return trace(scene, ray, ctx, settings, 0);
+}
+
+}  // namespace gilt::raytrace_core
