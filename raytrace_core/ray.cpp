@@ -4,19 +4,31 @@
 #include "raytrace_core/ray.h"
 
 #include <cmath>
+#include <limits>
 
 namespace gilt::raytrace_core {
 
+namespace {
+
+/// Next float in direction `up`, skipping subnormals: Embree (and CPUs in flush-to-zero mode)
+/// read a subnormal origin as zero, which would put the origin back on the surface.
+float step_off(float x, bool up) {
+  const float next = std::nextafter(x, up ? kInfinity : -kInfinity);
+  if (std::fabs(next) < std::numeric_limits<float>::min()) return up ? std::numeric_limits<float>::min() : -std::numeric_limits<float>::min();
+  return next;
+}
+
+}  // namespace
+
 Vec3 offset_ray_origin(const SurfacePoint& sp, const Vec3& w) {
   const float d = glm::dot(abs(sp.ng), sp.p_error);
-  Vec3 offset = d * sp.ng;
-  if (glm::dot(w, sp.ng) < 0.0f) offset = -offset;
-  Vec3 po = sp.p + offset;
-  // The sum above was rounded; step one more float away so po is strictly past the error bound.
-  for (int i = 0; i < 3; ++i) {
-    if (offset[i] > 0.0f) po[i] = std::nextafter(po[i], kInfinity);
-    else if (offset[i] < 0.0f) po[i] = std::nextafter(po[i], -kInfinity);
-  }
+  const float side = glm::dot(w, sp.ng) < 0.0f ? -1.0f : 1.0f;
+  const Vec3 normal = side * sp.ng;
+  Vec3 po = sp.p + d * normal;
+  // The sum above was rounded, and d is zero where p is exact (a plane z = c has no error in z):
+  // step one more float along every component of the normal, so po is strictly off the surface.
+  for (int i = 0; i < 3; ++i)
+    if (normal[i] != 0.0f) po[i] = step_off(po[i], normal[i] > 0.0f);
   return po;
 }
 

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# gilt set-up on Debian 12: installs what is missing, builds, then runs one job.
+#   bash scripts/setup.sh demo   install, build, render the built-in Cornell box to out/cornell.png
+#   bash scripts/setup.sh test   install, build, run the whole test suite (what CI runs)
+#   bash scripts/setup.sh build  install and build only
+# Environment: BUILD_DIR (default build), JOBS (default: number of cores).
+set -euo pipefail
+
+job=${1:-demo}
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build_dir=${BUILD_DIR:-$root/build}
+jobs=${JOBS:-$(nproc)}
+
+packages=(
+  cmake g++ ninja-build pkg-config
+  libglm-dev libembree-dev libtbb-dev libopenimageio-dev
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev libopenmesh-dev libflann-dev liblz4-dev
+  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev
+  libgtest-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release ${CMAKE_ARGS:-}
+cmake --build "$build_dir" -j "$jobs"
+
+case "$job" in
+  demo)
+    mkdir -p "$root/out"
+    "$build_dir/cli/gilt" render cornell --spp 256 -o "$root/out/cornell.png"
+    ;;
+  test)
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
+    ;;
+  build) ;;
+  *)
+    echo "setup: unknown job '$job' (expected demo, test or build)" >&2
+    exit 2
+    ;;
+esac

@@ -1,0 +1,125 @@
+// The gilt command line on good and bad input: bad flags, files and numbers exit with code 2 and
+// a message naming the problem, and never leave an output file behind or clobber one.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("gilt-cli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("'") + GILT_BINARY_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
+                            err.string() + "' </dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+  fs::path write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  }
+  /// Files in the test folder (to prove nothing was left behind).
+  size_t file_count() const { return std::distance(fs::directory_iterator(dir_), fs::directory_iterator()); }
+
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(Cli, RendersBuiltInSceneAndReportsJson) {
+  const fs::path out = dir_ / "c.exr";
+  const Result r = run("render cornell --spp 2 --width 16 --height 12 --threads 1 --json -o '" + out.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(out));
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["width"], 16);
+  EXPECT_EQ(j["height"], 12);
+  EXPECT_EQ(j["spp"], 2);
+  EXPECT_EQ(j["samples"], 16 * 12 * 2);
+  EXPECT_GT(j["rays"].get<double>(), 16 * 12 * 2 - 1);
+  EXPECT_GT(j["triangles"].get<int>(), 0);
+}
+
+TEST_F(Cli, WhittedRendersPng) {
+  const fs::path out = dir_ / "w.png";
+  const Result r = run("render cornell-caustics --method whitted --spp 1 --width 16 --height 16 -o '" + out.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
+struct BadCase {
+  const char* name;
+  std::string args;     // after "render"
+  std::string message;  // expected in stderr
+};
+
+TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
+  const std::string out = (dir_ / "out.png").string();
+  const fs::path bad_obj = write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+  const fs::path nan_obj = write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  const fs::path bad_json = write("bad.json", "{\n  \"meshes\": [\n    oops\n  ]\n}\n");
+  const std::vector<BadCase> cases = {
+      {"missing file", "render " + (dir_ / "nope.obj").string() + " -o " + out, "nope.obj"},
+      {"unknown scene type", "render " + write("scene.xyz", "x").string() + " -o " + out, "scene.xyz"},
+      {"face index out of range", "render " + bad_obj.string() + " -o " + out, "bad_index.obj"},
+      {"NaN coordinate", "render " + nan_obj.string() + " -o " + out, "nan"},
+      {"malformed JSON", "render " + bad_json.string() + " -o " + out, "bad.json"},
+      {"zero spp", "render cornell --spp 0 -o " + out, "--spp"},
+      {"spp not a number", "render cornell --spp many -o " + out, "--spp"},
+      {"spp and time", "render cornell --spp 4 --time 1 -o " + out, "--time"},
+      {"two-number lookfrom", "render cornell --lookfrom 1,2 -o " + out, "--lookfrom"},
+      {"zero fov", "render cornell --fov 0 --spp 1 -o " + out, "field of view"},
+      {"camera up along view", "render cornell --lookfrom 0,0,0 --lookat 0,1,0 --up 0,1,0 -o " + out, "up"},
+      {"unknown method", "render cornell --method magic -o " + out, "--method"},
+      {"unsupported output", "render cornell -o " + (dir_ / "out.jpg").string(), "out.jpg"},
+      {"missing output folder", "render cornell -o " + (dir_ / "no/such/dir/out.png").string(), "does not exist"},
+      {"no output", "render cornell", "--output"},
+      {"no subcommand", "", "subcommand"},
+  };
+  const size_t files_before = file_count();
+  for (const BadCase& c : cases) {
+    const Result r = run(c.args);
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": stderr was: " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.name << " left an output file";
+    EXPECT_EQ(file_count(), files_before) << c.name << " left a file behind";
+  }
+}
+
+TEST_F(Cli, FailedRunDoesNotClobberExistingOutput) {
+  const fs::path out = write("keep.png", "previous contents");
+  const Result r = run("render " + (dir_ / "missing.obj").string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(slurp(out), "previous contents");
+}
