@@ -1,0 +1,112 @@
+// Film accumulation and filter importance sampling.
+//
+// Each filter is separable, so a 2D offset is two independent 1D draws, each by inverting the
+// filter's 1D CDF. Because a sample is placed where the filter is large rather than weighted by
+// it, every sample has unit weight and the pixel value is a plain mean.
+
+#include "raytrace_core/film.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "raytrace_core/error.h"
+
+namespace gilt::raytrace_core {
+
+namespace {
+
+/// Inverse of the error function on (-1, 1). Starts from Winitzki's closed-form approximation
+/// (relative error ~2e-3) and polishes it with Newton steps on std::erf in double precision.
+double erf_inverse(double x) {
+  constexpr double kA = 0.147;
+  constexpr double kTwoOverSqrtPi = 2.0 * std::numbers::inv_sqrtpi;
+  const double log_term = std::log((1.0 - x) * (1.0 + x));
+  const double c = 2.0 / (std::numbers::pi * kA) + 0.5 * log_term;
+  double y = std::copysign(std::sqrt(std::sqrt(c * c - log_term / kA) - c), x);
+  for (int i = 0; i < 3; ++i) {
+    const double slope = kTwoOverSqrtPi * std::exp(-y * y);
+    y -= (std::erf(y) - x) / slope;
+  }
+  return y;
+}
+
+/// Box filter on [-r, r]: uniform.
+float sample_box(float u, float r) { return r * (2.0f * u - 1.0f); }
+
+/// Tent filter on [-r, r] with density (r - |x|) / r². Each half of the triangle holds half the
+/// mass; inverting the CDF of one half gives a square root.
+float sample_tent(float u, float r) {
+  if (u < 0.5f) return r * (std::sqrt(2.0f * u) - 1.0f);
+  return r * (1.0f - std::sqrt(2.0f * (1.0f - u)));
+}
+
+/// Gaussian with σ = r/3 truncated to [-r, r]. The truncated CDF is
+///   F(x) = (erf(x / (σ√2)) + e) / (2e),  e = erf(r / (σ√2)),
+/// so x = σ√2 · erf⁻¹((2u − 1) e). Exact for the truncated distribution, not a rejection loop,
+/// so one u always gives the same offset.
+float sample_gaussian(float u, float r) {
+  const double sigma_sqrt2 = static_cast<double>(r) / 3.0 * std::sqrt(2.0);
+  const double e = std::erf(3.0 / std::sqrt(2.0));  // r / (σ√2) is 3/√2 for every radius
+  const double x = sigma_sqrt2 * erf_inverse((2.0 * static_cast<double>(u) - 1.0) * e);
+  return std::clamp(static_cast<float>(x), -r, r);
+}
+
+float sample_1d(FilterKind kind, float u, float r) {
+  switch (kind) {
+    case FilterKind::box:
+      return sample_box(u, r);
+    case FilterKind::tent:
+      return sample_tent(u, r);
+    case FilterKind::gaussian:
+      return sample_gaussian(u, r);
+  }
+  return 0.0f;
+}
+
+}  // namespace
+
+Vec2 Filter::sample(Vec2 u) const {
+  if (!(radius > 0.0f)) return Vec2(0.0f);
+  return {sample_1d(kind, u.x, radius), sample_1d(kind, u.y, radius)};
+}
+
+FilterKind Filter::parse(const std::string& name) {
+  if (name == "box") return FilterKind::box;
+  if (name == "tent") return FilterKind::tent;
+  if (name == "gaussian") return FilterKind::gaussian;
+  throw InputError("unknown filter '" + name + "' (expected box, tent or gaussian)");
+}
+
+Film::Film(int width, int height) : width_(width), height_(height) {
+  if (width < 0 || height < 0) {
+    throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) + " is negative");
+  }
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  sum_.assign(n, Rgb());
+  count_.assign(n, 0);
+}
+
+Rgb Film::pixel(int x, int y) const {
+  const size_t i = static_cast<size_t>(y) * width_ + x;
+  return count_[i] == 0 ? Rgb() : sum_[i] / static_cast<float>(count_[i]);
+}
+
+std::vector<Rgb> Film::pixels() const {
+  std::vector<Rgb> image;
+  image.reserve(sum_.size());
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) image.push_back(pixel(x, y));
+  }
+  return image;
+}
+
+size_t Film::non_finite_count() const {
+  size_t n = 0;
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) n += pixel(x, y).is_finite() ? 0 : 1;
+  }
+  return n;
+}
+
+}  // namespace gilt::raytrace_core
