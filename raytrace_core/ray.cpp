@@ -3,6 +3,7 @@
 
 #include "raytrace_core/ray.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -21,12 +22,17 @@ float step_off(float x, bool up) {
 }  // namespace
 
 Vec3 offset_ray_origin(const SurfacePoint& sp, const Vec3& w) {
-  const float d = glm::dot(abs(sp.ng), sp.p_error);
+  // Distance along the normal: the point's error bound projected on the normal, but at least its
+  // largest per-axis bound. On a plane x = 0 the x coordinate is exact and the projected bound is
+  // zero, yet Embree's ray–triangle test mixes all three axes (shear and edge functions), and
+  // with flush-to-zero arithmetic an origin a few ulps off such a plane reports a hit at t = −0.
+  const float d = std::max(glm::dot(abs(sp.ng), sp.p_error),
+                           std::max(sp.p_error.x, std::max(sp.p_error.y, sp.p_error.z)));
   const float side = glm::dot(w, sp.ng) < 0.0f ? -1.0f : 1.0f;
   const Vec3 normal = side * sp.ng;
   Vec3 po = sp.p + d * normal;
-  // The sum above was rounded, and d is zero where p is exact (a plane z = c has no error in z):
-  // step one more float along every component of the normal, so po is strictly off the surface.
+  // The sum above was rounded: step one more float along every component of the normal, so po
+  // is strictly past the bound.
   for (int i = 0; i < 3; ++i)
     if (normal[i] != 0.0f) po[i] = step_off(po[i], normal[i] > 0.0f);
   return po;
