@@ -167,6 +167,9 @@ void write_image(const std::string& path, const Image& image, float exposure) {
     if (format == Format::exr) spec.attribute("compression", "zip");
     data = linear.data();
   }
+  // OpenImageIO stamps EXR files with the current time (capDate) unless told a DateTime; a fixed
+  // one keeps files bit-identical across runs, so equal images give equal files.
+  spec.attribute("DateTime", "1970:01:01 00:00:00");
 
   const fs::path temporary = temporary_path_for(destination);
   std::vector<unsigned char> bytes;

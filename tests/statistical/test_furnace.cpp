@@ -72,7 +72,7 @@ void expect_furnace(rc::Scene& scene, float le, float rho, const char* what) {
                     << ", expected " << expected << " +- " << tol;
   }
   EXPECT_EQ(bad, 0) << what << " rho=" << rho;
-  RecordProperty("worst_error_over_tolerance", std::to_string(worst));
+  ::testing::Test::RecordProperty("worst_error_over_tolerance", std::to_string(worst));
 }
 
 }  // namespace

@@ -81,7 +81,7 @@ void expect_same_image(float scale, const rc::Vec3& offset) {
   const double rms = rms_difference(img, ref.image);
   EXPECT_LT(rms, 0.5 * ref.noise_rms) << "scale " << scale << ", offset " << offset.x;
   EXPECT_LT(std::abs(mean(img) - mean(ref.image)), 4.0 * ref.mean_stderr) << "scale " << scale << ", offset " << offset.x;
-  RecordProperty("rms_over_noise", std::to_string(rms / ref.noise_rms));
+  ::testing::Test::RecordProperty("rms_over_noise", std::to_string(rms / ref.noise_rms));
 }
 
 }  // namespace
