@@ -1,6 +1,6 @@
 #pragma once
 // Warping functions from the unit square to directions and points, with their densities.
-// Each one has a chi-square test in tests/test_sampling.cpp.
+// Each one has a chi-square test in tests/statistical/test_sampling.cpp.
 
 #include <span>
 #include <vector>

@@ -1,0 +1,53 @@
+// Material factories. Parameters a kind does not use are zeroed so that no module reads a
+// meaningless default (e.g. the 0.8 diffuse albedo of a mirror).
+
+#include "raytrace_core/material.h"
+
+#include <utility>
+
+namespace gilt::raytrace_core {
+
+Material Material::make_diffuse(std::string name, Rgb albedo) {
+  Material m;
+  m.name = std::move(name);
+  m.kind = MaterialKind::diffuse;
+  m.albedo = albedo;
+  return m;
+}
+
+Material Material::make_emitter(std::string name, Rgb radiance, Rgb albedo) {
+  Material m = make_diffuse(std::move(name), albedo);
+  m.emission = radiance;
+  return m;
+}
+
+Material Material::make_mirror(std::string name, Rgb reflectance) {
+  Material m;
+  m.name = std::move(name);
+  m.kind = MaterialKind::mirror;
+  m.albedo = Rgb(0.0f);
+  m.specular = reflectance;
+  return m;
+}
+
+Material Material::make_dielectric(std::string name, float ior, Rgb absorption) {
+  Material m;
+  m.name = std::move(name);
+  m.kind = MaterialKind::dielectric;
+  m.albedo = Rgb(0.0f);
+  m.ior = ior;
+  m.absorption = absorption;
+  return m;
+}
+
+Material Material::make_glossy(std::string name, Rgb albedo, Rgb specular, float exponent) {
+  Material m;
+  m.name = std::move(name);
+  m.kind = MaterialKind::glossy;
+  m.albedo = albedo;
+  m.specular = specular;
+  m.exponent = exponent;
+  return m;
+}
+
+}  // namespace gilt::raytrace_core
