@@ -73,8 +73,11 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
           const DVec3 to_center = DVec3(s.center) - DVec3(ref.p);
           const double dc = glm::length(to_center);
           const Frame frame = Frame::from_normal(Vec3(to_center / dc));
-          const float cos_theta = 1.0f - u.x * cone.one_minus_cos;
-          const float sin_theta = safe_sqrt(1.0f - cos_theta * cos_theta);
+          // Work from 1 − cos θ: for a small or distant sphere cos θ is within a few floats of 1,
+          // and 1 − cos² θ would snap the directions onto a few rings.
+          const float one_minus_cos = u.x * cone.one_minus_cos;
+          const float cos_theta = 1.0f - one_minus_cos;
+          const float sin_theta = safe_sqrt(one_minus_cos * (2.0f - one_minus_cos));
           const float phi = 2.0f * kPi * u.y;
           const Vec3 wi = frame.to_world(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta));
           // Distance along wi to the sphere: dc cos θ − sqrt(r² − dc² sin² θ).
