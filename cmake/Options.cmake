@@ -8,12 +8,9 @@ function(gilt_target_defaults target)
   # Keep fused multiply-add contraction off: the ray offset and the sphere test rely on
   # IEEE-exact products to stay watertight and scale-invariant.
   target_compile_options(${target} PRIVATE -ffp-contract=off)
-  if(GILT_SANITIZE)
-    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer)
-    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
-  endif()
 endfunction()
 
+# Sanitizers apply to every target, so the libraries are instrumented along with the tests.
 if(GILT_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer)
   add_link_options(-fsanitize=address,undefined)

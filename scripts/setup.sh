@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # gilt set-up on Debian 12: installs what is missing, builds, then runs one job.
 #   bash scripts/setup.sh demo   install, build, render the built-in Cornell box to out/cornell.png
-#   bash scripts/setup.sh test   install, build, run the whole test suite (what CI runs)
+#   bash scripts/setup.sh test   install, build with warnings as errors, run the whole test suite,
+#                                then build the unit tests with AddressSanitizer + UBSan and run them
+#                                (what CI runs; SANITIZE=0 skips the sanitizer stage)
 #   bash scripts/setup.sh build  install and build only
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -euo pipefail
@@ -31,7 +33,9 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release ${CMAKE_ARGS:-}
+extra=()
+[ "$job" = test ] && extra+=(-DGILT_WERROR=ON)
+cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${extra[@]}" ${CMAKE_ARGS:-}
 cmake --build "$build_dir" -j "$jobs"
 
 case "$job" in
@@ -41,6 +45,15 @@ case "$job" in
     ;;
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
+    if [ "${SANITIZE:-1}" != 0 ]; then
+      # The fast label again, under AddressSanitizer and UndefinedBehaviorSanitizer.
+      asan_dir=${build_dir}-asan
+      cmake -S "$root" -B "$asan_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGILT_SANITIZE=ON \
+        -DGILT_BUILD_BENCH=OFF ${CMAKE_ARGS:-}
+      cmake --build "$asan_dir" -j "$jobs"
+      UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
+        ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -L unit
+    fi
     ;;
   build) ;;
   *)

@@ -1,0 +1,324 @@
+// PLY meshes (ascii and binary) through OpenMesh, with one default diffuse material.
+//
+// OpenMesh skips faces whose indices are out of range and reads "nan" in ascii files as garbage,
+// saying so only on its own error stream. So the header and body are walked here first, checking
+// that coordinates are finite and face indices name a vertex, with messages that give the line
+// (ascii) or the element (binary); then OpenMesh reads the mesh, its error stream captured.
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+
+#include "raytrace_core/error.h"
+#include "raytrace_core/loaders.h"
+
+namespace gilt::raytrace_core {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using PlyMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
+
+struct PlyProperty {
+  std::string name;
+  std::string type;        // value type (of the items, for a list)
+  std::string count_type;  // list length type; empty for a scalar
+};
+
+struct PlyElement {
+  std::string name;
+  size_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  std::string format;  // ascii, binary_little_endian or binary_big_endian
+  std::vector<PlyElement> elements;
+  size_t lines = 0;  // header lines, so body line numbers follow on
+};
+
+/// Bytes of a PLY scalar type, or 0 for an unknown type.
+size_t type_size(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+std::vector<std::string> tokens_of(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> tokens;
+  for (std::string t; in >> t;) tokens.push_back(t);
+  return tokens;
+}
+
+bool is_identifier(const std::string& s) {
+  return !s.empty() &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; });
+}
+
+/// Reads the header, strictly: OpenMesh's own header parser loops forever on some malformed ones.
+PlyHeader read_header(std::istream& in, const std::string& file) {
+  PlyHeader header;
+  const auto fail = [&](const std::string& what) {
+    throw InputError(file + ":" + std::to_string(header.lines) + ": " + what);
+  };
+  for (std::string line; std::getline(in, line);) {
+    ++header.lines;
+    const std::vector<std::string> t = tokens_of(line);
+    if (header.lines == 1) {
+      if (t.size() != 1 || t[0] != "ply") fail("not a PLY file (no 'ply' magic line)");
+      continue;
+    }
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (!std::all_of(line.begin(), line.end(),
+                     [](unsigned char c) { return (c >= 0x20 && c < 0x7f) || std::isspace(c); }))
+      fail("the header holds a character that is not printable ASCII");
+    if (t[0] == "end_header") break;
+    if (t[0] == "format") {
+      if (t.size() != 3 || t[2] != "1.0" ||
+          (t[1] != "ascii" && t[1] != "binary_little_endian" && t[1] != "binary_big_endian"))
+        fail("unknown PLY format (expected ascii, binary_little_endian or binary_big_endian 1.0)");
+      header.format = t[1];
+    } else if (t[0] == "element") {
+      size_t count = 0;
+      if (t.size() != 3 || !is_identifier(t[1]) ||
+          std::from_chars(t[2].data(), t[2].data() + t[2].size(), count).ptr != t[2].data() + t[2].size())
+        fail("malformed 'element' line");
+      header.elements.push_back({t[1], count, {}});
+    } else if (t[0] == "property") {
+      if (header.elements.empty()) fail("'property' before any 'element'");
+      const bool list = t.size() == 5 && t[1] == "list";
+      const bool integer_count =
+          list && type_size(t[2]) != 0 && t[2].find("float") == std::string::npos && t[2] != "double";
+      if ((t.size() != 3 && !list) || (list && !integer_count) || type_size(t[t.size() - 2]) == 0 ||
+          !is_identifier(t.back()))
+        fail("malformed 'property' line");
+      header.elements.back().properties.push_back({t.back(), t[t.size() - 2], list ? t[2] : ""});
+    } else {
+      fail("unknown header keyword '" + t[0] + "'");
+    }
+  }
+  if (in.eof()) throw InputError(file + ": the header has no 'end_header'");
+  if (header.format.empty()) fail("no 'format' line in the header");
+  // OpenMesh needs vertices with x, y, z, and faces (if any) with a list of vertex indices.
+  const auto has = [](const PlyElement& e, std::initializer_list<const char*> names, bool list) {
+    return std::any_of(e.properties.begin(), e.properties.end(), [&](const PlyProperty& p) {
+      return (p.count_type.empty() != list) && std::find(names.begin(), names.end(), p.name) != names.end();
+    });
+  };
+  bool vertices = false;
+  for (const PlyElement& e : header.elements) {
+    if (e.name == "vertex") vertices = has(e, {"x"}, false) && has(e, {"y"}, false) && has(e, {"z"}, false);
+    if (e.name == "face" && !has(e, {"vertex_indices", "vertex_index"}, true))
+      fail("the face element has no 'vertex_indices' list");
+  }
+  if (!vertices) fail("no vertex element with x, y and z");
+  return header;
+}
+
+/// The values of a PLY body one by one, ascii or binary, with where() naming the position.
+class PlyValues {
+ public:
+  PlyValues(std::istream& in, const PlyHeader& header, std::string file)
+      : in_(in), file_(std::move(file)), format_(header.format), line_(header.lines) {
+    if (format_ != "ascii")
+      bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+
+  /// Moves to the next element item (the next non-blank line of an ascii file).
+  void begin_item(const std::string& element, size_t item) {
+    element_ = element;
+    item_ = item;
+    if (format_ != "ascii") return;
+    std::string line;
+    do {
+      if (!std::getline(in_, line)) fail("the file ends early");
+      ++line_;
+    } while (line.find_first_not_of(" \t\r") == std::string::npos);
+    tokens_ = tokens_of(line);
+    next_token_ = 0;
+  }
+
+  double next(const std::string& type) {
+    double value = 0.0;
+    if (format_ == "ascii") {
+      if (next_token_ >= tokens_.size()) fail("too few values on the line");
+      const std::string& t = tokens_[next_token_++];
+      const char* first = t.data() + (t.front() == '+' ? 1 : 0);
+      const auto [end, err] = std::from_chars(first, t.data() + t.size(), value);
+      if (err != std::errc() || end != t.data() + t.size())
+        value = std::nan("");  // not a number: the caller reports it where it matters
+      return value;
+    }
+    const size_t size = type_size(type);
+    if (offset_ + size > bytes_.size()) fail("the file ends early");
+    unsigned char raw[8];
+    std::memcpy(raw, bytes_.data() + offset_, size);
+    offset_ += size;
+    if (format_ == "binary_big_endian") std::reverse(raw, raw + size);
+    const auto as = [&](auto v) {
+      std::memcpy(&v, raw, sizeof v);
+      return double(v);
+    };
+    if (type == "char" || type == "int8") return as(int8_t());
+    if (type == "uchar" || type == "uint8") return as(uint8_t());
+    if (type == "short" || type == "int16") return as(int16_t());
+    if (type == "ushort" || type == "uint16") return as(uint16_t());
+    if (type == "int" || type == "int32") return as(int32_t());
+    if (type == "uint" || type == "uint32") return as(uint32_t());
+    if (type == "float" || type == "float32") return as(float());
+    return as(double());
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    const std::string where = format_ == "ascii" ? file_ + ":" + std::to_string(line_) : file_;
+    throw InputError(where + ": " + element_ + " " + std::to_string(item_) + ": " + what);
+  }
+
+ private:
+  std::istream& in_;
+  std::string file_, format_, element_;
+  size_t line_ = 0, item_ = 0;
+  std::vector<std::string> tokens_;
+  size_t next_token_ = 0;
+  std::vector<unsigned char> bytes_;
+  size_t offset_ = 0;
+};
+
+/// Checks every vertex coordinate is finite and every face index names a vertex.
+void check_body(std::istream& in, const PlyHeader& header, const std::string& file) {
+  size_t vertex_count = 0;
+  for (const PlyElement& e : header.elements)
+    if (e.name == "vertex") vertex_count = e.count;
+  PlyValues values(in, header, file);
+  for (const PlyElement& element : header.elements) {
+    for (size_t item = 0; item < element.count; ++item) {
+      values.begin_item(element.name, item);
+      for (const PlyProperty& p : element.properties) {
+        const bool is_list = !p.count_type.empty();
+        const double length = is_list ? values.next(p.count_type) : 1.0;
+        if (!(length >= 0.0 && length <= 1e6 && length == std::floor(length))) values.fail("bad list length");
+        const bool coordinate = element.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z");
+        const bool indices =
+            element.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (indices && length < 3) values.fail("a face needs at least 3 vertices");
+        for (size_t j = 0; j < size_t(length); ++j) {
+          const double v = values.next(p.type);
+          if (coordinate && !std::isfinite(float(v)))
+            values.fail("coordinate " + p.name + " is not a finite number");
+          if (indices && !(v >= 0.0 && v < double(vertex_count) && v == std::floor(v)))
+            values.fail("face refers to vertex " +
+                        std::to_string(std::isfinite(v) ? static_cast<long long>(v) : -1) + " of " +
+                        std::to_string(vertex_count));
+        }
+      }
+    }
+  }
+}
+
+/// Routes OpenMesh's global error stream into a string while alive (one reader at a time).
+class CaptureOpenMeshErrors {
+ public:
+  CaptureOpenMeshErrors() : lock_(mutex()) {
+    ::omerr().connect(captured_);
+    to_cerr_ = ::omerr().disconnect(std::cerr);
+  }
+  ~CaptureOpenMeshErrors() {
+    ::omerr().flush();
+    ::omerr().disconnect(captured_);
+    if (to_cerr_) ::omerr().connect(std::cerr);
+  }
+  std::string text() {
+    ::omerr().flush();
+    return captured_.str();
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::ostringstream captured_;
+  bool to_cerr_ = false;
+};
+
+}  // namespace
+
+void load_ply(const fs::path& path, Scene& scene) {
+  const std::string file = path.string();
+  size_t declared_faces = 0;
+  bool has_colours = false;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(file + ": cannot open file");
+    const PlyHeader header = read_header(in, file);
+    check_body(in, header, file);
+    for (const PlyElement& e : header.elements) {
+      if (e.name == "face") declared_faces = e.count;
+      for (const PlyProperty& p : e.properties)
+        has_colours = has_colours || (e.name == "vertex" && (p.name == "red" || p.name == "diffuse_red"));
+    }
+  }
+
+  PlyMesh om;
+  om.request_vertex_normals();
+  OpenMesh::IO::Options options = OpenMesh::IO::Options::VertexNormal;
+  {
+    CaptureOpenMeshErrors capture;
+    if (!OpenMesh::IO::read_mesh(om, file, options)) {
+      const std::string errors = capture.text();
+      const std::string first = errors.substr(0, errors.find('\n'));
+      throw InputError(file + ": cannot read PLY file" + (first.empty() ? "" : " (" + first + ")"));
+    }
+  }
+  // Indices were checked above, so the faces OpenMesh could not add repeat a vertex. (It keeps
+  // non-manifold faces, giving them copies of their vertices.)
+  if (om.n_faces() < declared_faces)
+    scene.warnings.push_back(file + ": " + std::to_string(declared_faces - om.n_faces()) +
+                             " face(s) with a repeated vertex dropped");
+
+  TriangleMesh mesh;
+  mesh.name = path.stem().string();
+  mesh.positions.reserve(om.n_vertices());
+  for (const auto& v : om.vertices()) {
+    const auto& p = om.point(v);
+    mesh.positions.emplace_back(p[0], p[1], p[2]);
+  }
+  if (options.check(OpenMesh::IO::Options::VertexNormal))
+    for (const auto& v : om.vertices()) {
+      const auto& n = om.normal(v);
+      mesh.normals.emplace_back(n[0], n[1], n[2]);  // copies of non-manifold vertices read 0: ng is used
+    }
+  for (const auto& f : om.faces()) {
+    std::vector<uint32_t> loop;
+    for (const auto& v : om.fv_range(f)) loop.push_back(static_cast<uint32_t>(v.idx()));
+    for (size_t i = 1; i + 1 < loop.size(); ++i)
+      mesh.indices.insert(mesh.indices.end(), {loop[0], loop[i], loop[i + 1]});
+  }
+
+  mesh.material = static_cast<uint32_t>(scene.materials.size());
+  scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
+  std::string note = file + ": a PLY holds geometry only: diffuse albedo 0.8, no lights";
+  if (has_colours) note += "; vertex colours ignored";
+  scene.warnings.push_back(note);
+  if (mesh.indices.empty()) scene.warnings.push_back(file + ": no faces");
+  scene.meshes.push_back(std::move(mesh));
+}
+
+}  // namespace gilt::raytrace_core

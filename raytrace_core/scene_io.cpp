@@ -1,0 +1,114 @@
+// Scene loading entry points: a built-in name or a file dispatched by its extension, then commit.
+// The format loaders live in load_*.cpp, the built-in scenes in builtin_scenes.cpp.
+
+#include "raytrace_core/scene_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+#include <utility>
+
+#include <glm/glm.hpp>
+
+#include "raytrace_core/error.h"
+#include "raytrace_core/loaders.h"
+
+namespace gilt::raytrace_core {
+
+namespace fs = std::filesystem;
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+void transform_mesh(TriangleMesh& mesh, const glm::mat4& transform) {
+  const glm::mat3 linear(transform);
+  const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
+  for (Vec3& p : mesh.positions) p = Vec3(transform * glm::vec4(p, 1.0f));
+  for (Vec3& n : mesh.normals) {
+    const Vec3 m = normal_matrix * n;
+    const float length = glm::length(m);
+    n = length > 0.0f ? m / length : Vec3(0.0f);  // commit() falls back to ng for zero normals
+  }
+  // A mirroring transform turns counter-clockwise into clockwise: swap two corners so the same
+  // physical side stays the front (glTF 2.0 §3.7.4 asks the same of mirrored nodes).
+  if (glm::determinant(linear) < 0.0f)
+    for (size_t t = 0; t < mesh.triangle_count(); ++t)
+      std::swap(mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]);
+}
+
+Scene load_scene_file(const std::string& path) {
+  const fs::path file(path);
+  std::error_code ec;
+  if (!fs::exists(file, ec)) {
+    std::string names;
+    for (const std::string& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
+    throw InputError(path + ": no such file (built-in scenes are " + names + ")");
+  }
+  if (fs::is_directory(file, ec)) throw InputError(path + ": is a directory, not a scene file");
+
+  Scene scene;
+  scene.name = path;  // commit() prefixes its messages with the name, so they name the file too
+  const std::string ext = lower_extension(file);
+  if (ext == ".obj") {
+    load_obj(file, scene);
+  } else if (ext == ".gltf" || ext == ".glb") {
+    load_gltf(file, scene);
+  } else if (ext == ".ply") {
+    load_ply(file, scene);
+  } else if (ext == ".json") {
+    load_json(file, scene);
+  } else {
+    throw InputError(path + ": unknown scene format '" + ext +
+                     "' (expected .obj, .gltf, .glb, .ply or .json)");
+  }
+  return scene;
+}
+
+Scene load_scene(const std::string& path_or_name) {
+  Scene scene = is_builtin_scene(path_or_name) ? builtin_scene(path_or_name) : load_scene_file(path_or_name);
+  try {
+    scene.commit();
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    if (message.rfind(path_or_name, 0) == 0) throw;
+    throw InputError(path_or_name + ": " + message);
+  }
+  return scene;
+}
+
+void transform_scene(Scene& scene, float scale, const Vec3& offset) {
+  if (scene.committed()) throw std::logic_error("transform_scene: the scene is already committed");
+  if (!(scale > 0.0f) || !std::isfinite(scale) || !is_finite(offset))
+    throw InputError("transform_scene: scale must be positive and finite, offset finite");
+  const auto map = [&](const Vec3& p) { return scale * p + offset; };
+
+  for (TriangleMesh& mesh : scene.meshes)
+    for (Vec3& p : mesh.positions) p = map(p);  // normals keep their direction under p ↦ s·p + o
+  for (Sphere& sphere : scene.spheres) {
+    sphere.center = map(sphere.center);
+    sphere.radius *= scale;
+  }
+  for (Light& light : scene.punctual_lights) {
+    if (light.kind != LightKind::point && light.kind != LightKind::spot) continue;
+    light.position = map(light.position);
+    // Irradiance from a point light falls as intensity / distance²: scaling the intensity by s²
+    // keeps every image unchanged, like the radiance of area lights.
+    light.intensity *= scale * scale;
+  }
+  // σa is per scene unit: the same optical depth through a body s times larger needs σa / s.
+  for (Material& material : scene.materials) material.absorption /= scale;
+  if (scene.camera) {
+    Camera& camera = *scene.camera;
+    camera.look_from = map(camera.look_from);
+    camera.look_at = map(camera.look_at);
+    camera.aperture_radius *= scale;
+    camera.focus_distance *= scale;
+  }
+}
+
+}  // namespace gilt::raytrace_core

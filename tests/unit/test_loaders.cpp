@@ -1,0 +1,587 @@
+// Scene loaders: OBJ/MTL, glTF (.gltf and .glb), PLY, gilt's JSON, the built-in scenes, and bad
+// input, which must raise InputError naming the file and the line or field. Fixtures are written
+// to a fresh temporary directory at run time.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "raytrace_core/error.h"
+#include "raytrace_core/scene_io.h"
+
+namespace gilt::raytrace_core {
+namespace {
+
+namespace fs = std::filesystem;
+
+class Loaders : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    static std::atomic<int> counter{0};
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("gilt_loaders_" + std::to_string(::getpid()) + "_" +
+                                        std::to_string(counter++) + "_" + info->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  /// Writes `content` to `name` inside the test's directory and returns the full path.
+  std::string write(const std::string& name, const std::string& content) {
+    const fs::path path = dir_ / name;
+    fs::create_directories(path.parent_path());
+    std::ofstream(path, std::ios::binary) << content;
+    return path.string();
+  }
+  fs::path dir_;
+};
+
+/// The InputError message `f` throws; a test failure when it throws nothing or something else.
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return {};
+}
+
+#define EXPECT_CONTAINS(text, part) EXPECT_NE((text).find(part), std::string::npos) << "in: " << (text)
+
+bool has_warning(const Scene& scene, const std::string& part) {
+  for (const std::string& w : scene.warnings)
+    if (w.find(part) != std::string::npos) return true;
+  return false;
+}
+
+Vec3 triangle_normal(const TriangleMesh& mesh, size_t t) {
+  const Vec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
+             c = mesh.positions[mesh.indices[3 * t + 2]];
+  return glm::cross(b - a, c - a);
+}
+
+const TriangleMesh& mesh_named(const Scene& scene, const std::string& name) {
+  for (const TriangleMesh& m : scene.meshes)
+    if (m.name == name) return m;
+  throw std::runtime_error("no mesh " + name);
+}
+
+// ---------------------------------------------------------------- OBJ + MTL
+
+const char* kMtl = R"(newmtl lamp
+Kd 0 0 0
+Ke 17 12 4
+newmtl glass
+illum 7
+Ni 1.33
+Tf 0.9 0.9 1
+newmtl chrome
+illum 3
+Kd 0 0 0
+Ks 0.9 0.9 0.9
+newmtl plastic
+Kd 0.5 0.5 0.5
+Ks 0.3 0.3 0.3
+Ns 50
+newmtl hot
+Kd 0.8 0.8 0.8
+Ks 0.5 0.5 0.5
+Ns 10
+)";
+
+TEST_F(Loaders, ObjMaterialsSplitPerMaterial) {
+  write("box.mtl", kMtl);
+  const std::string obj = write("box.obj", R"(mtllib box.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vn 0 0 1
+vt 0 0
+usemtl lamp
+f 1/1/1 2/1/1 3/1/1 4/1/1
+usemtl glass
+f 1 2 3
+usemtl lamp
+f 1/1/1 3/1/1 4/1/1
+usemtl chrome
+f 1 2 3
+usemtl plastic
+f 1 2 3
+usemtl hot
+f -4 -3 -2
+)");
+  Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.materials.size(), 5u);
+  ASSERT_EQ(scene.meshes.size(), 5u);  // one mesh per material, the two lamp groups merged
+  for (const TriangleMesh& mesh : scene.meshes) {
+    const Material& m = scene.materials[mesh.material];
+    if (m.name == "lamp") {
+      EXPECT_EQ(mesh.triangle_count(), 3u);  // the quad triangulated, plus the later lamp face
+      EXPECT_EQ(mesh.normals.size(), mesh.positions.size());
+      EXPECT_EQ(mesh.uvs.size(), mesh.positions.size());
+      EXPECT_EQ(m.emission, Rgb(17, 12, 4));
+    } else {
+      EXPECT_EQ(mesh.triangle_count(), 1u);
+      EXPECT_TRUE(mesh.normals.empty());
+    }
+  }
+  const auto material = [&](const std::string& name) -> const Material& {
+    for (const Material& m : scene.materials)
+      if (m.name == name) return m;
+    throw std::runtime_error("no material " + name);
+  };
+  EXPECT_EQ(material("glass").kind, MaterialKind::dielectric);
+  EXPECT_FLOAT_EQ(material("glass").ior, 1.33f);
+  EXPECT_NEAR(material("glass").absorption.r, -std::log(0.9f), 1e-5f);
+  EXPECT_EQ(material("glass").absorption.b, 0.0f);
+  EXPECT_EQ(material("chrome").kind, MaterialKind::mirror);
+  EXPECT_FLOAT_EQ(material("chrome").specular.g, 0.9f);
+  EXPECT_EQ(material("plastic").kind, MaterialKind::glossy);
+  EXPECT_FLOAT_EQ(material("plastic").exponent, 50.0f);
+  const Material& hot = material("hot");  // Kd + Ks = 1.3 > 1: scaled to sum 1
+  EXPECT_NEAR(hot.albedo.r + hot.specular.r, 1.0f, 1e-6f);
+  EXPECT_TRUE(has_warning(scene, "Kd + Ks exceeds 1"));
+
+  const Scene committed = load_scene(obj);
+  EXPECT_EQ(committed.lights().size(), 3u);  // the three lamp triangles
+}
+
+TEST_F(Loaders, ObjWithoutMtlGetsDefaultMaterial) {
+  const std::string obj = write("plain.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.materials[scene.meshes[0].material].kind, MaterialKind::diffuse);
+  EXPECT_TRUE(has_warning(scene, "missing.mtl"));
+}
+
+TEST_F(Loaders, ObjFaceIndexOutOfRange) {
+  const std::string obj = write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+  const std::string message = error_of([&] { load_scene(obj); });
+  EXPECT_CONTAINS(message, "bad_index.obj:4:");
+  EXPECT_CONTAINS(message, "vertex 9 of 3");
+  const std::string zero = write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(zero); }), "zero.obj:4:");
+}
+
+TEST_F(Loaders, ObjNonFiniteCoordinate) {
+  const std::string nan = write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(nan); }), "nan.obj:2:");
+  const std::string inf = write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1e999 0\nf 1 2 3\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(inf); }), "inf.obj:3:");
+}
+
+TEST_F(Loaders, DegenerateTrianglesDroppedWithWarning) {
+  const std::string obj = write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+  const Scene scene = load_scene(obj);
+  EXPECT_EQ(scene.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(scene, "1 degenerate"));
+}
+
+// ---------------------------------------------------------------- glTF
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const uint32_t n = (uint32_t(bytes[i]) << 16) | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
+                       (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
+    out += table[(n >> 18) & 63];
+    out += table[(n >> 12) & 63];
+    out += i + 1 < bytes.size() ? table[(n >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? table[n & 63] : '=';
+  }
+  return out;
+}
+
+/// A unit quad in the z = 0 plane (4 float positions, then 6 u16 indices): 60 bytes.
+std::vector<unsigned char> quad_buffer(float first_x = 0.0f, uint16_t last_index = 3) {
+  const float positions[12] = {first_x, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  const uint16_t indices[6] = {0, 1, 2, 0, 2, last_index};
+  std::vector<unsigned char> bytes(sizeof positions + sizeof indices);
+  std::memcpy(bytes.data(), positions, sizeof positions);
+  std::memcpy(bytes.data() + sizeof positions, indices, sizeof indices);
+  return bytes;
+}
+
+/// A glTF document around a 60-byte buffer given by `buffer` (the JSON of buffers[0]).
+std::string gltf_json(const std::string& buffer, int position_type = 5126) {
+  return R"({"asset": {"version": "2.0"}, "scene": 0,
+  "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
+                     "KHR_materials_ior"],
+  "scenes": [{"nodes": [0, 3, 4, 5, 6]}],
+  "nodes": [{"name": "root", "translation": [10, 0, 0], "children": [1, 2]},
+            {"mesh": 0, "translation": [0, 1, 0]},
+            {"mesh": 1, "scale": [2, 2, 2]},
+            {"camera": 0, "translation": [0, 0, 5]},
+            {"translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"extensions": {"KHR_lights_punctual": {"light": 1}}},
+            {"rotation": [-0.70710678, 0, 0, 0.70710678], "extensions": {"KHR_lights_punctual": {"light": 2}}}],
+  "meshes": [{"name": "lamp", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]},
+             {"name": "pane", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 1}]}],
+  "materials": [{"name": "lamp", "emissiveFactor": [1, 1, 1], "doubleSided": true,
+                 "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+                 "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}},
+                {"name": "glass", "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                                                 "KHR_materials_ior": {"ior": 1.4}}},
+                {"name": "chrome", "pbrMetallicRoughness": {"metallicFactor": 1, "roughnessFactor": 0}},
+                {"name": "satin", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0.5}}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "aspectRatio": 1.5}}],
+  "extensions": {"KHR_lights_punctual": {"lights": [
+      {"type": "point", "color": [1, 0.5, 0.25], "intensity": 10},
+      {"type": "spot", "intensity": 20, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
+      {"type": "directional", "intensity": 3}]}},
+  "buffers": [)" +
+         buffer + R"(],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+  "accessors": [{"bufferView": 0, "componentType": )" +
+         std::to_string(position_type) + R"(, "count": 4, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+}
+
+std::string embedded_buffer(const std::vector<unsigned char>& bytes) {
+  return R"({"byteLength": )" + std::to_string(bytes.size()) +
+         R"(, "uri": "data:application/octet-stream;base64,)" + base64(bytes) + "\"}";
+}
+
+void expect_gltf_contents(const Scene& scene) {
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  EXPECT_EQ(scene.meshes[0].positions[0], Vec3(10, 1, 0));  // root then child translation
+  EXPECT_EQ(scene.meshes[1].positions[2], Vec3(12, 2, 0));  // scaled by 2, then moved by the root
+  ASSERT_EQ(scene.materials.size(), 4u);
+  const Material& lamp = scene.materials[scene.meshes[0].material];
+  EXPECT_EQ(lamp.emission, Rgb(5.0f));
+  EXPECT_TRUE(lamp.two_sided_emission);
+  const Material& glass = scene.materials[scene.meshes[1].material];
+  EXPECT_EQ(glass.kind, MaterialKind::dielectric);
+  EXPECT_FLOAT_EQ(glass.ior, 1.4f);
+  EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
+  EXPECT_EQ(scene.materials[3].kind, MaterialKind::glossy);
+  EXPECT_NEAR(scene.materials[3].exponent, 30.0f, 1e-3f);  // 2/α² − 2 with α = 0.5²
+
+  ASSERT_TRUE(scene.camera.has_value());
+  EXPECT_EQ(scene.camera->look_from, Vec3(0, 0, 5));
+  EXPECT_EQ(scene.camera->look_at, Vec3(0, 0, 4));
+  EXPECT_NEAR(scene.camera->vfov_degrees, 0.8f * 180.0f / kPi, 1e-4f);
+  EXPECT_EQ(scene.render.width, 768);
+
+  ASSERT_EQ(scene.punctual_lights.size(), 3u);
+  const Light& point = scene.punctual_lights[0];
+  EXPECT_EQ(point.kind, LightKind::point);
+  EXPECT_EQ(point.position, Vec3(0, 3, 0));
+  EXPECT_EQ(point.intensity, Rgb(10.0f, 5.0f, 2.5f));
+  const Light& spot = scene.punctual_lights[1];
+  EXPECT_EQ(spot.kind, LightKind::spot);
+  EXPECT_FLOAT_EQ(spot.cos_inner, std::cos(0.2f));
+  EXPECT_FLOAT_EQ(spot.cos_outer, std::cos(0.5f));
+  EXPECT_EQ(spot.direction, Vec3(0, 0, -1));
+  const Light& sun = scene.punctual_lights[2];
+  EXPECT_EQ(sun.kind, LightKind::directional);
+  EXPECT_EQ(sun.irradiance, Rgb(3.0f));
+  EXPECT_NEAR(sun.direction.y, -1.0f, 1e-6f);  // node −z turned by −90° about x
+}
+
+TEST_F(Loaders, GltfEmbeddedBuffer) {
+  const std::string path = write("scene.gltf", gltf_json(embedded_buffer(quad_buffer())));
+  expect_gltf_contents(load_scene_file(path));
+  EXPECT_EQ(load_scene(path).lights().size(), 2u + 3u);  // two lamp triangles, three punctual lights
+}
+
+TEST_F(Loaders, GlbBinaryContainer) {
+  std::string json = gltf_json(R"({"byteLength": 60})");
+  while (json.size() % 4 != 0) json += ' ';
+  const std::vector<unsigned char> bin = quad_buffer();  // 60 bytes: already a multiple of 4
+  const auto u32 = [](std::string& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out += char((v >> (8 * i)) & 0xff);
+  };
+  std::string glb;
+  u32(glb, 0x46546C67);  // "glTF"
+  u32(glb, 2);
+  u32(glb, uint32_t(12 + 8 + json.size() + 8 + bin.size()));
+  u32(glb, uint32_t(json.size()));
+  u32(glb, 0x4E4F534A);  // "JSON"
+  glb += json;
+  u32(glb, uint32_t(bin.size()));
+  u32(glb, 0x004E4942);  // "BIN"
+  glb.append(bin.begin(), bin.end());
+  expect_gltf_contents(load_scene_file(write("scene.glb", glb)));
+}
+
+TEST_F(Loaders, GltfBadInput) {
+  const std::string index = write("bad_index.gltf", gltf_json(embedded_buffer(quad_buffer(0.0f, 7))));
+  std::string message = error_of([&] { load_scene(index); });
+  EXPECT_CONTAINS(message, "bad_index.gltf");
+  EXPECT_CONTAINS(message, "index 7");
+
+  const std::string type = write("bad_type.gltf", gltf_json(embedded_buffer(quad_buffer()), 5123));
+  message = error_of([&] { load_scene(type); });
+  EXPECT_CONTAINS(message, "bad_type.gltf");
+  EXPECT_CONTAINS(message, "expected float VEC3");
+
+  const std::string nan = write("nan.gltf", gltf_json(embedded_buffer(quad_buffer(std::nanf("")))));
+  EXPECT_CONTAINS(error_of([&] { load_scene(nan); }), "nan.gltf");
+
+  const std::string junk = write("junk.gltf", "{ not json");
+  EXPECT_CONTAINS(error_of([&] { load_scene(junk); }), "junk.gltf");
+}
+
+// ---------------------------------------------------------------- PLY
+
+const char* kPlyHeader =
+    "ply\nformat ascii 1.0\ncomment test\nelement vertex 5\nproperty float x\nproperty float y\n"
+    "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+    "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+
+TEST_F(Loaders, PlyAscii) {
+  const std::string ply =
+      write("mesh.ply", std::string(kPlyHeader) +
+                            "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n0.5 2 0 0 0 1\n"
+                            "4 0 1 2 3\n3 3 2 4\n");
+  const Scene scene = load_scene(ply);
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.triangle_count(), 3u);  // the quad fanned into two
+  EXPECT_EQ(scene.meshes[0].normals.size(), 5u);
+  EXPECT_EQ(scene.meshes[0].normals[4], Vec3(0, 0, 1));
+  EXPECT_FLOAT_EQ(scene.materials[0].albedo.g, 0.8f);
+  EXPECT_TRUE(has_warning(scene, "no lights"));
+}
+
+TEST_F(Loaders, PlyBadInput) {
+  const std::string body = "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n";
+  const std::string index = write("bad_index.ply", kPlyHeader + body + "0.5 2 0 0 0 1\n4 0 1 2 3\n3 3 2 9\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(index); }), "bad_index.ply:20:");
+  const std::string nan = write("nan.ply", kPlyHeader + body + "nan 2 0 0 0 1\n4 0 1 2 3\n3 3 2 4\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(nan); }), "nan.ply:18:");
+  const std::string truncated = write("short.ply", kPlyHeader + body);
+  EXPECT_CONTAINS(error_of([&] { load_scene(truncated); }), "short.ply");
+  const std::string junk = write("junk.ply", "hello\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(junk); }), "junk.ply:1:");
+
+  // Binary: a face naming vertex 7 of 3.
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const int32_t face[3] = {0, 1, 7};
+  binary.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  binary += char(3);
+  binary.append(reinterpret_cast<const char*>(face), sizeof face);
+  const std::string binary_path = write("bad_binary.ply", binary);
+  EXPECT_CONTAINS(error_of([&] { load_scene(binary_path); }), "bad_binary.ply");
+}
+
+// ---------------------------------------------------------------- JSON
+
+TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
+  write("meshes/tri.mtl", "newmtl red\nKd 0.7 0.1 0.1\n");
+  write("meshes/tri.obj", "mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+  const std::string path = write("scene.json", R"({
+    // comments are allowed
+    "materials": {"white": {"albedo": 0.7}, "lamp": {"albedo": 0, "emission": [4, 4, 4]},
+                  "glass": {"kind": "dielectric", "ior": 1.5}, "gloss": {"kind": "glossy", "specular": 0.2}},
+    "meshes": [{"file": "meshes/tri.obj", "material": "white",
+                "transform": {"scale": 2, "rotate_deg_axis": [90, 0, 0, 1], "translate": [1, 0, 0]}},
+               {"file": "meshes/tri.obj", "transform": {"scale": [-1, 1, 1]}}],
+    "shapes": [{"type": "sphere", "center": [0, 1, 0], "radius": 0.5, "material": "glass"},
+               {"type": "quad", "vertices": [[0, 2, 0], [1, 2, 0], [1, 2, 1], [0, 2, 1]], "material": "lamp"}],
+    "lights": [{"type": "point", "position": [0, 1, 2], "intensity": [1, 2, 3]},
+               {"type": "spot", "position": [0, 3, 0], "direction": [0, -2, 0], "intensity": 5,
+                "inner_angle_deg": 20, "outer_angle_deg": 30},
+               {"type": "directional", "direction": [0, -1, 0], "irradiance": 2},
+               {"type": "environment", "radiance": 0.1}],
+    "camera": {"look_from": [0, 1, 5], "look_at": [0, 1, 0], "vfov": 45, "aperture_radius": 0.1},
+    "render": {"width": 320, "height": 240, "spp": 16}
+  })");
+  const Scene scene = load_scene_file(path);
+  ASSERT_EQ(scene.materials.size(), 5u);  // four of its own, plus the OBJ's red for the second mesh
+  ASSERT_EQ(scene.meshes.size(), 3u);
+  const TriangleMesh& turned = scene.meshes[0];
+  EXPECT_EQ(scene.materials[turned.material].name, "white");
+  EXPECT_NEAR(turned.positions[1].x, 1.0f, 1e-6f);  // (1,0,0) scaled, turned 90° about z, moved
+  EXPECT_NEAR(turned.positions[1].y, 2.0f, 1e-6f);
+  EXPECT_GT(triangle_normal(turned, 0).z, 0.0f);
+  const TriangleMesh& mirrored = scene.meshes[1];
+  EXPECT_EQ(scene.materials[mirrored.material].name, "red");
+  EXPECT_EQ(mirrored.positions[1], Vec3(-1, 0, 0));
+  EXPECT_GT(triangle_normal(mirrored, 0).z, 0.0f);  // the winding follows the mirror: front stays +z
+  EXPECT_LT(triangle_normal(mesh_named(scene, "shapes:lamp"), 0).y, 0.0f);  // faces down
+  ASSERT_EQ(scene.spheres.size(), 1u);
+  EXPECT_EQ(scene.materials[scene.spheres[0].material].kind, MaterialKind::dielectric);
+  ASSERT_EQ(scene.punctual_lights.size(), 4u);
+  EXPECT_EQ(scene.punctual_lights[1].direction, Vec3(0, -1, 0));
+  EXPECT_FLOAT_EQ(scene.punctual_lights[1].cos_outer, std::cos(glm::radians(30.0f)));
+  EXPECT_EQ(scene.punctual_lights[3].kind, LightKind::environment);
+  ASSERT_TRUE(scene.camera.has_value());
+  EXPECT_FLOAT_EQ(scene.camera->aperture_radius, 0.1f);
+  EXPECT_EQ(scene.render.width, 320);
+  EXPECT_EQ(scene.render.spp, 16);
+  EXPECT_EQ(load_scene(path).lights().size(), 2u + 4u);
+}
+
+TEST_F(Loaders, JsonBadInputNamesTheField) {
+  const std::string malformed =
+      write("malformed.json", "{\n  \"materials\": {\n    \"a\": {\"albedo\": 0.5,,}\n  }\n}\n");
+  std::string message = error_of([&] { load_scene(malformed); });
+  EXPECT_CONTAINS(message, "malformed.json:3:");
+
+  const std::string unknown = write("unknown.json", R"({"materials": {"white": {}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "nope"}]})");
+  message = error_of([&] { load_scene(unknown); });
+  EXPECT_CONTAINS(message, "unknown.json: /shapes/0/material: unknown material 'nope'");
+
+  const std::string type =
+      write("type.json", R"({"materials": {"glass": {"kind": "dielectric", "ior": "x"}}})");
+  EXPECT_CONTAINS(error_of([&] { load_scene(type); }), "type.json: /materials/glass/ior: expected a number");
+
+  const std::string missing = write("missing.json", R"({"meshes": [{"file": "nowhere.obj"}]})");
+  EXPECT_CONTAINS(error_of([&] { load_scene(missing); }), "missing.json: /meshes/0/file: no such file");
+
+  write("broken.obj", "v 0 0 0\nf 1 2 3\n");
+  const std::string nested = write("nested.json", R"({"meshes": [{"file": "broken.obj"}]})");
+  message = error_of([&] { load_scene(nested); });
+  EXPECT_CONTAINS(message, "nested.json: /meshes/0/file:");
+  EXPECT_CONTAINS(message, "broken.obj:2:");
+
+  const std::string bright = write("bright.json", R"({"materials": {"w": {"albedo": [0.5, 1.5, 0.5]}}})");
+  EXPECT_CONTAINS(error_of([&] { load_scene(bright); }), "bright.json: /materials/w/albedo:");
+}
+
+// ---------------------------------------------------------------- dispatch
+
+TEST_F(Loaders, MissingFileAndUnknownExtension) {
+  const std::string nowhere = (dir_ / "nowhere.obj").string();
+  EXPECT_CONTAINS(error_of([&] { load_scene(nowhere); }), "nowhere.obj: no such file");
+  const std::string odd = write("scene.xyz", "whatever");
+  std::string message = error_of([&] { load_scene(odd); });
+  EXPECT_CONTAINS(message, "scene.xyz");
+  EXPECT_CONTAINS(message, "'.xyz'");
+  EXPECT_CONTAINS(error_of([&] { builtin_scene("cornel"); }), "cornel");
+}
+
+// ---------------------------------------------------------------- built-in scenes
+
+TEST(BuiltinScenes, AllLoadAndCommit) {
+  ASSERT_EQ(builtin_scene_names().size(), 4u);
+  for (const std::string& name : builtin_scene_names()) {
+    EXPECT_TRUE(is_builtin_scene(name));
+    const Scene scene = load_scene(name);
+    EXPECT_TRUE(scene.committed()) << name;
+    EXPECT_TRUE(scene.camera.has_value()) << name;
+  }
+  EXPECT_FALSE(is_builtin_scene("cornell.obj"));
+}
+
+TEST(BuiltinScenes, CornellBox) {
+  const Scene scene = load_scene("cornell");
+  EXPECT_EQ(scene.meshes.size(), 8u);
+  EXPECT_EQ(scene.triangle_count(), 38u);
+  EXPECT_EQ(scene.materials.size(), 4u);
+  EXPECT_EQ(scene.lights().size(), 2u);  // the light quad's two triangles
+  EXPECT_EQ(scene.render.width, 512);
+  EXPECT_FLOAT_EQ(scene.camera->vfov_degrees, 39.3f);
+  EXPECT_EQ(scene.camera->look_from, Vec3(278, 273, -800));
+
+  const Vec3 inside(278.0f, 274.4f, 279.6f);
+  for (const char* wall : {"floor", "ceiling", "back_wall", "left_wall", "right_wall"}) {
+    const TriangleMesh& mesh = mesh_named(scene, wall);
+    for (size_t t = 0; t < mesh.triangle_count(); ++t)
+      EXPECT_GT(glm::dot(triangle_normal(mesh, t), inside - mesh.positions[mesh.indices[3 * t]]), 0.0f)
+          << wall;
+  }
+  for (const char* block : {"short_block", "tall_block"}) {
+    const TriangleMesh& mesh = mesh_named(scene, block);
+    EXPECT_EQ(mesh.triangle_count(), 10u);
+    Vec3 center(0.0f);
+    for (const Vec3& p : mesh.positions) center += p / float(mesh.positions.size());
+    for (size_t t = 0; t < mesh.triangle_count(); ++t)
+      EXPECT_GT(glm::dot(triangle_normal(mesh, t), mesh.positions[mesh.indices[3 * t]] - center), 0.0f)
+          << block;
+  }
+  // The light fills a hole in the ceiling: both at y = 548.8, areas adding up to the full ceiling.
+  const TriangleMesh& light = mesh_named(scene, "light");
+  const TriangleMesh& ceiling = mesh_named(scene, "ceiling");
+  float light_area = 0.0f, ceiling_area = 0.0f;
+  for (size_t t = 0; t < light.triangle_count(); ++t) {
+    EXPECT_LT(triangle_normal(light, t).y, 0.0f);  // emits downwards
+    light_area += 0.5f * glm::length(triangle_normal(light, t));
+  }
+  for (size_t t = 0; t < ceiling.triangle_count(); ++t)
+    ceiling_area += 0.5f * glm::length(triangle_normal(ceiling, t));
+  for (const Vec3& p : light.positions) EXPECT_EQ(p.y, 548.8f);
+  EXPECT_NEAR(light_area, 130.0f * 105.0f, 0.5f);
+  EXPECT_NEAR(ceiling_area + light_area, 556.0f * 559.2f, 2.0f);
+  EXPECT_EQ(scene.materials[light.material].emission, Rgb(17, 12, 4));
+}
+
+TEST(BuiltinScenes, CausticsFurnaceSmallpt) {
+  const Scene caustics = load_scene("cornell-caustics");
+  EXPECT_EQ(caustics.meshes.size(), 6u);
+  EXPECT_EQ(caustics.triangle_count(), 18u);
+  ASSERT_EQ(caustics.spheres.size(), 2u);
+  for (const Sphere& s : caustics.spheres) EXPECT_FLOAT_EQ(s.center.y, s.radius);  // resting on the floor
+  EXPECT_EQ(caustics.materials[caustics.spheres[1].material].kind, MaterialKind::dielectric);
+  EXPECT_EQ(caustics.materials[caustics.spheres[0].material].kind, MaterialKind::mirror);
+
+  const Scene furnace = load_scene("furnace");
+  EXPECT_EQ(furnace.triangle_count(), 12u);
+  EXPECT_EQ(furnace.lights().size(), 12u);
+  const Material& wall = furnace.materials[0];
+  EXPECT_EQ(wall.emission, Rgb(0.5f));
+  EXPECT_EQ(wall.albedo, Rgb(0.8f));  // every pixel: 0.5 / (1 − 0.8) = 2.5
+  const TriangleMesh& box = furnace.meshes[0];
+  for (size_t t = 0; t < box.triangle_count(); ++t)
+    EXPECT_LT(glm::dot(triangle_normal(box, t), box.positions[box.indices[3 * t]]), 0.0f);  // faces inwards
+  EXPECT_EQ(furnace_scene(1.0f, 0.5f).materials[0].emission, Rgb(1.0f));
+  EXPECT_CONTAINS(error_of([] { furnace_scene(1.0f, 1.0f); }), "furnace");
+
+  const Scene smallpt = load_scene("smallpt");
+  EXPECT_EQ(smallpt.spheres.size(), 8u);  // smallpt's nine less the black front wall
+  EXPECT_EQ(smallpt.meshes.size(), 0u);
+  EXPECT_EQ(smallpt.lights().size(), 1u);
+  EXPECT_EQ(smallpt.render.width, 1024);
+  EXPECT_EQ(smallpt.render.height, 768);
+  EXPECT_NEAR(smallpt.camera->vfov_degrees, 28.80f, 0.01f);  // 2·atan(0.5135 / 2)
+}
+
+TEST(BuiltinScenes, TransformScene) {
+  Scene cornell = builtin_scene("cornell");
+  const Vec3 offset(1000.0f, -20.0f, 3.0f);
+  const Vec3 p = cornell.meshes[0].positions[0];
+  transform_scene(cornell, 2.0f, offset);
+  EXPECT_EQ(cornell.meshes[0].positions[0], 2.0f * p + offset);
+  EXPECT_EQ(cornell.camera->look_from, 2.0f * Vec3(278, 273, -800) + offset);
+
+  Scene caustics = builtin_scene("cornell-caustics");
+  Material& glass = caustics.materials[caustics.spheres[1].material];
+  glass.absorption = Rgb(0.5f);
+  caustics.punctual_lights.push_back(
+      Light{.kind = LightKind::point, .position = Vec3(1.0f), .intensity = Rgb(1.0f)});
+  transform_scene(caustics, 4.0f, offset);
+  EXPECT_EQ(caustics.spheres[0].radius, 400.0f);
+  EXPECT_EQ(caustics.spheres[0].center, 4.0f * Vec3(400, 100, 370) + offset);
+  EXPECT_EQ(glass.absorption, Rgb(0.125f));
+  EXPECT_EQ(caustics.punctual_lights[0].position, Vec3(4.0f) + offset);
+  EXPECT_EQ(caustics.punctual_lights[0].intensity, Rgb(16.0f));  // same irradiance at 4× the distance
+  caustics.commit();
+  EXPECT_CONTAINS(error_of([&] {
+                    Scene s = builtin_scene("furnace");
+                    transform_scene(s, 0.0f, offset);
+                  }),
+                  "scale");
+}
+
+}  // namespace
+}  // namespace gilt::raytrace_core
