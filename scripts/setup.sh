@@ -52,6 +52,7 @@ case "$job" in
         -DGILT_BUILD_BENCH=OFF ${CMAKE_ARGS:-}
       cmake --build "$asan_dir" -j "$jobs"
       UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
+        LSAN_OPTIONS=suppressions=$root/tests/lsan.supp \
         ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -L unit
     fi
     ;;
