@@ -1,0 +1,61 @@
+#pragma once
+// The radiosity mesh: the scene's diffuse surfaces as a conforming triangle mesh of elements.
+// Vertices are shared within a smooth surface of one material and split where the material or
+// the surface normal changes sharply; light is received at vertices, shot from elements.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "raytrace_core/scene.h"
+
+namespace gilt::radiosity {
+
+namespace rc = gilt::raytrace_core;
+using rc::Vec3;
+
+/// How to mesh. With both sizes zero the default is used.
+struct MeshSettings {
+  float max_edge = 0.0f;        ///< target edge length in scene units (0: derive from `elements` or the default)
+  int elements = 0;             ///< approximate total element count (0: use max_edge or the default)
+  float sharp_angle_degrees = 30.0f;  ///< dihedral angle above which an edge is sharp (vertices split)
+  int remesh_iterations = 3;    ///< isotropic remeshing passes
+};
+
+/// Default element count when neither size is given: accurate on the built-in scenes.
+inline constexpr int kDefaultElements = 6000;
+
+/// One mesh of elements. Element e has vertices elements[e], material element_material[e].
+struct RadiosityMesh {
+  std::vector<Vec3> positions;                   ///< per vertex
+  std::vector<Vec3> normals;                     ///< per vertex: unit normal of its surface side
+  std::vector<uint32_t> vertex_material;         ///< per vertex (vertices never span materials)
+  std::vector<std::array<uint32_t, 3>> elements; ///< counter-clockwise seen from the front
+  std::vector<uint32_t> element_material;        ///< index into the scene's materials
+  std::vector<uint32_t> element_surface;         ///< which input mesh (or sphere) it came from
+  std::vector<Vec3> element_normal;              ///< unit geometric normal (front)
+  std::vector<float> element_area;               ///< scene units²
+
+  size_t vertex_count() const { return positions.size(); }
+  size_t element_count() const { return elements.size(); }
+};
+
+/// What meshing did: counts of repairs and the edge length used.
+struct MeshReport {
+  float max_edge = 0.0f;
+  size_t merged_vertices = 0, removed_degenerate = 0, reoriented = 0, self_intersecting = 0;
+  std::vector<std::string> warnings;
+};
+
+/// Meshes every diffuse or glossy surface of the committed scene (mirrors and dielectrics are
+/// left to ray tracing). Input meshes are checked and mended first (duplicate vertices merged,
+/// degenerate faces removed, orientation made consistent where possible, self-intersections
+/// reported), then remeshed isotropically with boundaries and sharp edges protected. Spheres
+/// are tessellated to the same edge length.
+RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report = nullptr);
+
+/// The edge length `settings` asks for on this scene (resolving `elements` and the default).
+float target_edge_length(const rc::Scene& scene, const MeshSettings& settings);
+
+}  // namespace gilt::radiosity

@@ -1,0 +1,66 @@
+#pragma once
+// Private to the radiosity mesher: the passes build_mesh() chains, declared here so that the
+// CGAL pass lives in its own translation unit (mesh_repair.cpp) and the rest (mesh.cpp) compiles
+// without CGAL's headers.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "radiosity/mesh.h"
+#include "raytrace_core/math.h"
+
+namespace gilt::radiosity::detail {
+
+using rc::DVec3;
+
+/// An indexed triangle surface in double precision, counter-clockwise seen from its front.
+struct TriangleSoup {
+  std::vector<DVec3> points;
+  std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+/// What repairing one input mesh found; each count names one kind of repair.
+struct RepairCounts {
+  size_t merged_vertices = 0;      ///< points equal to an earlier point, merged into it
+  size_t removed_degenerate = 0;   ///< faces with a repeated vertex or collinear vertices, removed
+  size_t removed_duplicates = 0;   ///< faces repeating another face's vertices, removed
+  size_t reoriented = 0;           ///< faces whose winding was reversed to agree with their neighbours
+  size_t duplicated_vertices = 0;  ///< vertices copied to make the surface manifold
+  size_t self_intersecting = 0;    ///< pairs of faces that intersect away from a shared vertex or edge
+};
+
+/// Remeshing parameters for one surface.
+struct RemeshParams {
+  double edge_length = 1.0;           ///< the remesher's target edge length, scene units (see build_mesh)
+  double sharp_angle_degrees = 30.0;  ///< dihedral angle above which an edge is kept as a crease
+  int iterations = 3;                 ///< isotropic remeshing passes
+};
+
+/// Mends one input mesh with CGAL Polygon Mesh Processing (merge duplicate points and faces,
+/// drop degenerate faces, orient consistently while keeping the input's front where the input
+/// agreed, count self-intersections) and remeshes it isotropically to `params.edge_length` with
+/// its border and sharp edges protected. Returns the remeshed surface (empty when nothing is
+/// left) and fills `counts`.
+TriangleSoup repair_and_remesh(const rc::TriangleMesh& mesh, const RemeshParams& params,
+                               RepairCounts* counts);
+
+/// Geodesic sphere: an icosahedron whose edges are cut into `frequency` parts, projected onto the
+/// sphere; 20·frequency² triangles, counter-clockwise seen from outside.
+TriangleSoup tessellate_sphere(const DVec3& center, double radius, int frequency);
+
+/// A surface whose vertices are split along creases: `corners[t]` are the output vertices of
+/// triangle t of the input soup, `normals[v]` the area-weighted normal of vertex v's smooth fan.
+struct SplitSurface {
+  std::vector<DVec3> positions;
+  std::vector<DVec3> normals;
+  std::vector<std::array<uint32_t, 3>> corners;
+};
+
+/// Splits the soup's vertices where the dihedral angle between neighbouring triangles exceeds
+/// `sharp_angle_degrees` (with OpenMesh): each smooth fan of triangles around a vertex gets its
+/// own copy of the vertex, with the fan's area-weighted normal.
+SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_degrees);
+
+}  // namespace gilt::radiosity::detail

@@ -1,0 +1,244 @@
+// Mesh repair and isotropic remeshing with CGAL Polygon Mesh Processing. Orientation of polygon
+// soups: Guéziec, Taubin, Lazarus & Horn 2001, "Cutting and Stitching"; remeshing: Botsch &
+// Kobbelt 2004, "A Remeshing Approach to Multiresolution Modeling". This is the only file of
+// gilt that includes CGAL, so its slow compile is paid once.
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <iterator>
+#include <numeric>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/detect_features.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
+#include <CGAL/Surface_mesh.h>
+
+#include "radiosity/mesh_detail.h"
+
+namespace gilt::radiosity::detail {
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using Polygon = std::vector<std::size_t>;
+using face_descriptor = SurfaceMesh::Face_index;
+using edge_descriptor = SurfaceMesh::Edge_index;
+
+/// Records which polygons orient_polygon_soup() reversed and how many points it copied. The
+/// orienter takes the visitor by value, so the records live outside it.
+struct OrientationRecorder : PMP::Default_orientation_visitor {
+  std::vector<char>* reversed = nullptr;
+  size_t* duplicated = nullptr;
+
+  void polygon_orientation_reversed(std::size_t polygon) { (*reversed)[polygon] ^= 1; }
+  void duplicated_vertex(std::size_t, std::size_t) { ++*duplicated; }
+};
+
+/// Union–find over polygon indices.
+class Components {
+ public:
+  explicit Components(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), size_t{0}); }
+  size_t find(size_t i) {
+    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+    return i;
+  }
+  void join(size_t a, size_t b) { parent_[find(a)] = find(b); }
+
+ private:
+  std::vector<size_t> parent_;
+};
+
+double polygon_area(const std::vector<Point>& points, const Polygon& polygon) {
+  // Fan from the first vertex; the soup holds triangles, but this costs nothing extra.
+  Kernel::Vector_3 sum(0.0, 0.0, 0.0);
+  for (size_t i = 1; i + 1 < polygon.size(); ++i)
+    sum = sum + CGAL::cross_product(points[polygon[i]] - points[polygon[0]],
+                                    points[polygon[i + 1]] - points[polygon[0]]);
+  return 0.5 * std::sqrt(sum.squared_length());
+}
+
+/// orient_polygon_soup() makes every connected component consistent but picks each component's
+/// side from whichever polygon it starts at. Where most of a component (by area) was reversed,
+/// reverse the whole component back, so the input's front survives wherever the input mostly
+/// agreed with itself. `reversed` marks polygons whose winding differs from the input.
+void restore_input_fronts(const std::vector<Point>& points, std::vector<Polygon>& polygons,
+                          std::vector<char>& reversed) {
+  Components components(polygons.size());
+  std::unordered_map<uint64_t, size_t> edge_owner;
+  edge_owner.reserve(3 * polygons.size());
+  for (size_t p = 0; p < polygons.size(); ++p) {
+    const Polygon& polygon = polygons[p];
+    for (size_t i = 0; i < polygon.size(); ++i) {
+      const uint64_t a = polygon[i], b = polygon[(i + 1) % polygon.size()];
+      const uint64_t key = (std::min(a, b) << 32) | std::max(a, b);
+      const auto [it, inserted] = edge_owner.emplace(key, p);
+      if (!inserted) components.join(p, it->second);
+    }
+  }
+  std::unordered_map<size_t, std::pair<double, double>> kept_and_flipped;  // area per component
+  for (size_t p = 0; p < polygons.size(); ++p) {
+    auto& areas = kept_and_flipped[components.find(p)];
+    (reversed[p] ? areas.second : areas.first) += polygon_area(points, polygons[p]);
+  }
+  for (size_t p = 0; p < polygons.size(); ++p) {
+    const auto& areas = kept_and_flipped[components.find(p)];
+    if (areas.second > areas.first) {
+      std::reverse(polygons[p].begin(), polygons[p].end());
+      reversed[p] ^= 1;
+    }
+  }
+}
+
+/// Builds a consistently oriented, manifold triangle mesh from the input, counting repairs.
+SurfaceMesh repair(const rc::TriangleMesh& input, RepairCounts& counts) {
+  std::vector<Point> points;
+  points.reserve(input.positions.size());
+  for (const rc::Vec3& p : input.positions) points.emplace_back(p.x, p.y, p.z);
+  std::vector<Polygon> polygons;
+  polygons.reserve(input.triangle_count());
+  for (size_t t = 0; t < input.triangle_count(); ++t)
+    polygons.push_back({input.indices[3 * t], input.indices[3 * t + 1], input.indices[3 * t + 2]});
+
+  counts.merged_vertices = PMP::merge_duplicate_points_in_polygon_soup(points, polygons);
+  // With equal points merged, a face that names one point twice has no area.
+  const auto repeats_a_point = [](const Polygon& polygon) {
+    for (size_t i = 0; i < polygon.size(); ++i)
+      for (size_t j = i + 1; j < polygon.size(); ++j)
+        if (polygon[i] == polygon[j]) return true;
+    return false;
+  };
+  counts.removed_degenerate = std::erase_if(polygons, repeats_a_point);
+  counts.removed_duplicates = PMP::merge_duplicate_polygons_in_polygon_soup(points, polygons);
+  PMP::remove_isolated_points_in_polygon_soup(points, polygons);
+
+  std::vector<char> reversed(polygons.size(), 0);
+  OrientationRecorder recorder;
+  recorder.reversed = &reversed;
+  recorder.duplicated = &counts.duplicated_vertices;
+  PMP::orient_polygon_soup(points, polygons, CGAL::parameters::visitor(recorder));
+  restore_input_fronts(points, polygons, reversed);
+  counts.reoriented = static_cast<size_t>(std::count(reversed.begin(), reversed.end(), char{1}));
+
+  SurfaceMesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+
+  // Faces whose three distinct points are collinear: remove_degenerate_faces() collapses or flips
+  // them into their neighbours; any it cannot handle (e.g. an isolated sliver) are cut out.
+  std::vector<face_descriptor> degenerate;
+  PMP::degenerate_faces(mesh, std::back_inserter(degenerate));
+  if (!degenerate.empty()) {
+    counts.removed_degenerate += degenerate.size();
+    PMP::remove_degenerate_faces(mesh);
+    degenerate.clear();
+    PMP::degenerate_faces(mesh, std::back_inserter(degenerate));
+    for (face_descriptor f : degenerate) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+    mesh.collect_garbage();
+  }
+
+  std::vector<std::pair<face_descriptor, face_descriptor>> intersecting;
+  PMP::self_intersections(mesh, std::back_inserter(intersecting));
+  counts.self_intersecting = intersecting.size();
+  return mesh;
+}
+
+/// Cuts every protected edge longer than `max_length` into the fewest equal pieces no longer than
+/// it, and fans the faces on either side from their opposite vertex so they stay triangles (the
+/// remesher then flips and smooths the fans away). Points are placed by their rank counted from
+/// the lexicographically smaller endpoint, so an edge that two input meshes share (a light set into
+/// a ceiling) is cut at bit-identical points in both.
+void split_protected_edges(SurfaceMesh& mesh, const std::vector<edge_descriptor>& edges, double max_length,
+                           SurfaceMesh::Property_map<edge_descriptor, bool>& constrained) {
+  using halfedge_descriptor = SurfaceMesh::Halfedge_index;
+  for (edge_descriptor e : edges) {
+    halfedge_descriptor h = mesh.halfedge(e);
+    const Point a = mesh.point(mesh.source(h)), b = mesh.point(mesh.target(h));
+    const int pieces = static_cast<int>(std::ceil(std::sqrt(CGAL::squared_distance(a, b)) / max_length));
+    if (pieces <= 1) continue;
+    const bool a_first = CGAL::compare_xyz(a, b) == CGAL::SMALLER;
+    const Point& low = a_first ? a : b;
+    const Kernel::Vector_3 span = (a_first ? b : a) - low;
+
+    // Halfedges leading to the vertex opposite the edge, on each side that has a face.
+    std::vector<halfedge_descriptor> to_opposite;
+    for (halfedge_descriptor side : {h, mesh.opposite(h)})
+      if (!mesh.is_border(side)) to_opposite.push_back(mesh.next(side));
+
+    for (int i = 1; i < pieces; ++i) {
+      // split_edge(h) inserts a vertex between h's source and target and returns the halfedge
+      // into it; h keeps running from the new vertex to the target.
+      const halfedge_descriptor into_new = CGAL::Euler::split_edge(h, mesh);
+      constrained[mesh.edge(into_new)] = true;
+      const int rank = a_first ? i : pieces - i;
+      mesh.point(mesh.target(into_new)) = low + span * (double(rank) / double(pieces));
+    }
+    for (halfedge_descriptor to_apex : to_opposite)
+      while (mesh.degree(mesh.face(to_apex)) > 3)
+        to_apex = CGAL::Euler::split_face(mesh.prev(mesh.prev(to_apex)), to_apex, mesh);
+  }
+}
+
+/// Isotropic remeshing to `params.edge_length` with border and sharp edges kept in place: they
+/// are cut to at most the target length first, then protected, so the remesher neither moves
+/// nor collapses them. Three tangential relaxation steps per pass instead of CGAL's one: on the
+/// Cornell box they raise the 5th percentile of the elements' smallest angle from 33.7° to 37.3°
+/// for no measurable time.
+void remesh(SurfaceMesh& mesh, const RemeshParams& params) {
+  auto constrained = mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
+  PMP::detect_sharp_edges(mesh, params.sharp_angle_degrees, constrained);
+  std::vector<edge_descriptor> protected_edges;
+  for (edge_descriptor e : mesh.edges()) {
+    if (mesh.is_border(e)) constrained[e] = true;
+    if (constrained[e]) protected_edges.push_back(e);
+  }
+  split_protected_edges(mesh, protected_edges, params.edge_length, constrained);
+  PMP::isotropic_remeshing(faces(mesh), params.edge_length, mesh,
+                           CGAL::parameters::number_of_iterations(static_cast<unsigned>(params.iterations))
+                               .edge_is_constrained_map(constrained)
+                               .protect_constraints(true)
+                               .number_of_relaxation_steps(3));
+  mesh.collect_garbage();
+}
+
+TriangleSoup to_soup(const SurfaceMesh& mesh) {
+  TriangleSoup soup;
+  soup.points.reserve(mesh.number_of_vertices());
+  for (auto v : mesh.vertices()) {
+    const Point& p = mesh.point(v);
+    soup.points.emplace_back(p.x(), p.y(), p.z());
+  }
+  soup.triangles.reserve(mesh.number_of_faces());
+  for (face_descriptor f : mesh.faces()) {
+    const auto h = mesh.halfedge(f);
+    soup.triangles.push_back({static_cast<uint32_t>(mesh.target(h).idx()),
+                              static_cast<uint32_t>(mesh.target(mesh.next(h)).idx()),
+                              static_cast<uint32_t>(mesh.target(mesh.next(mesh.next(h))).idx())});
+  }
+  return soup;
+}
+
+}  // namespace
+
+TriangleSoup repair_and_remesh(const rc::TriangleMesh& input, const RemeshParams& params,
+                               RepairCounts* counts) {
+  RepairCounts local;
+  RepairCounts& c = counts ? *counts : local;
+  c = RepairCounts{};
+  SurfaceMesh mesh = repair(input, c);
+  if (mesh.number_of_faces() == 0) return {};
+  remesh(mesh, params);
+  return to_soup(mesh);
+}
+
+}  // namespace gilt::radiosity::detail
