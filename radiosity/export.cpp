@@ -1,0 +1,614 @@
+// Writing a radiosity solution as a mesh with one colour per vertex.
+//
+// PLY goes through OpenMesh's writer; OBJ + MTL are written as text, since no OBJ writer among
+// gilt's libraries emits `v x y z r g b` vertex colours; glTF and GLB go through tinygltf. Every
+// file is encoded in memory first, then written to a hidden temporary beside its destination,
+// flushed to disk and renamed into place (the scheme of raytrace_core/image_io.cpp): a failure
+// leaves the destination as it was and no temporary behind.
+//
+// Materials are written so that gilt's own loaders read them back as the same kind:
+//   MTL   Kd albedo, Ks specular, Ns exponent (1000, the sharpest, for a mirror), Ni ior, d 1,
+//         Tf = exp(−σa) for a dielectric, Ke emission; illum 1 diffuse, 2 glossy, 3 mirror,
+//         7 dielectric. Two-sided emission has no MTL equivalent.
+//   glTF  baseColorFactor albedo, metallicFactor 0, roughnessFactor 1, emissiveFactor emission
+//         scaled into [0, 1] with KHR_materials_emissive_strength carrying the scale when the
+//         emission exceeds 1, doubleSided for two-sided emission.
+// Only materials that some element uses are written.
+
+#include "radiosity/export.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <tiny_gltf.h>
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include "raytrace_core/error.h"
+
+namespace gilt::radiosity {
+
+namespace fs = std::filesystem;
+using rc::InputError;
+using rc::Material;
+
+// glTF buffers and OpenMesh's LSB option are little-endian; the buffers below are copied raw.
+static_assert(std::endian::native == std::endian::little, "mesh export assumes a little-endian host");
+
+namespace {
+
+enum class Format { ply, obj, gltf, glb, unsupported };
+
+Format format_of(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".ply") return Format::ply;
+  if (ext == ".obj") return Format::obj;
+  if (ext == ".gltf") return Format::gltf;
+  if (ext == ".glb") return Format::glb;
+  return Format::unsupported;
+}
+
+// --- Atomic files ---------------------------------------------------------------------------
+
+/// Hidden sibling of `destination` that keeps its extension, unique within this machine.
+fs::path temporary_path_for(const fs::path& destination) {
+  static std::atomic<uint64_t> counter{0};
+  const std::string tag = ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  return destination.parent_path() /
+         ("." + destination.filename().string() + tag + destination.extension().string());
+}
+
+/// Bytes staged in a hidden temporary beside `destination`, flushed to disk; commit() renames
+/// them into place. The destination is untouched until then, and an uncommitted temporary is
+/// removed when the object goes away.
+class StagedFile {
+ public:
+  StagedFile(const fs::path& destination, std::string_view bytes)
+      : destination_(destination), temporary_(temporary_path_for(destination)) {
+    const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) fail(errno, false);
+    size_t written = 0;
+    int error = 0;
+    while (written < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error = n < 0 ? errno : EIO;
+        break;
+      }
+      written += static_cast<size_t>(n);
+    }
+    if (error == 0 && ::fsync(fd) != 0) error = errno;
+    if (::close(fd) != 0 && error == 0) error = errno;
+    if (error != 0) fail(error, true);
+  }
+  StagedFile(const StagedFile&) = delete;
+  StagedFile& operator=(const StagedFile&) = delete;
+  ~StagedFile() {
+    std::error_code ec;
+    if (!temporary_.empty()) fs::remove(temporary_, ec);
+  }
+
+  /// Renames the temporary over the destination; throws InputError (and removes it) on failure.
+  void commit() {
+    std::error_code ec;
+    fs::rename(temporary_, destination_, ec);
+    if (ec) fail(ec.value(), true);
+    temporary_.clear();
+  }
+
+ private:
+  [[noreturn]] void fail(int error, bool remove_temporary) {
+    if (remove_temporary) ::unlink(temporary_.c_str());
+    temporary_.clear();
+    throw InputError("cannot write '" + destination_.string() +
+                     "': " + std::generic_category().message(error));
+  }
+
+  fs::path destination_, temporary_;
+};
+
+/// Throws InputError unless the folder `destination` goes into exists.
+void require_folder(const fs::path& destination) {
+  const fs::path folder = destination.parent_path().empty() ? fs::path(".") : destination.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) {
+    throw InputError("cannot write '" + destination.string() + "': '" + folder.string() +
+                     "' is not an existing directory");
+  }
+}
+
+// --- What gets written ----------------------------------------------------------------------
+
+const char* quantity_name(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::radiance:
+      return "radiance";
+    case Quantity::irradiance:
+      return "irradiance";
+    case Quantity::radiosity:
+      return "radiosity";
+  }
+  return "?";
+}
+
+const char* quantity_units(Quantity quantity) {
+  return quantity == Quantity::radiance ? "W/(sr m^2)" : "W/m^2";
+}
+
+/// Checks that the mesh is consistent and finite: anything else is a bug upstream.
+void check_mesh(const RadiosityMesh& mesh, size_t material_count) {
+  const size_t n = mesh.vertex_count();
+  if (mesh.normals.size() != n || mesh.element_material.size() != mesh.element_count()) {
+    throw std::logic_error("write_solution: mesh arrays disagree in size");
+  }
+  for (size_t v = 0; v < n; ++v) {
+    if (!rc::is_finite(mesh.positions[v]) || !rc::is_finite(mesh.normals[v])) {
+      throw std::logic_error("write_solution: vertex " + std::to_string(v) + " is not finite");
+    }
+  }
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const auto& tri = mesh.elements[e];
+    if (tri[0] >= n || tri[1] >= n || tri[2] >= n || mesh.element_material[e] >= material_count) {
+      throw std::logic_error("write_solution: element " + std::to_string(e) +
+                             " refers to a missing vertex or material");
+    }
+  }
+}
+
+/// The colour of every vertex: the chosen quantity. The solver guarantees finite values, so a
+/// non-finite one is a bug, never written.
+std::vector<Rgb> vertex_colours(const Solution& solution, Quantity quantity) {
+  const size_t n = solution.mesh.vertex_count();
+  const std::vector<Rgb>& source =
+      quantity == Quantity::irradiance ? solution.vertex_irradiance : solution.vertex_radiosity;
+  if (source.size() != n) {
+    throw std::logic_error(std::string("write_solution: ") + quantity_name(quantity) + " is not per vertex");
+  }
+  std::vector<Rgb> colours(n);
+  for (size_t v = 0; v < n; ++v) {
+    switch (quantity) {
+      case Quantity::radiance:
+        colours[v] = solution.vertex_radiance(v);
+        break;
+      case Quantity::irradiance:
+        colours[v] = solution.vertex_irradiance[v];
+        break;
+      case Quantity::radiosity:
+        colours[v] = solution.vertex_radiosity[v];
+        break;
+    }
+    if (!colours[v].is_finite()) {
+      throw std::logic_error("write_solution: " + std::string(quantity_name(quantity)) + " of vertex " +
+                             std::to_string(v) + " is not finite");
+    }
+  }
+  return colours;
+}
+
+/// The elements of each material, in mesh order.
+std::vector<std::vector<uint32_t>> elements_by_material(const RadiosityMesh& mesh, size_t material_count) {
+  std::vector<std::vector<uint32_t>> groups(material_count);
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    groups[mesh.element_material[e]].push_back(static_cast<uint32_t>(e));
+  }
+  return groups;
+}
+
+/// One name per scene material, unique and without white space or '#' (an MTL name is one token).
+std::vector<std::string> material_names(const std::vector<Material>& materials) {
+  std::vector<std::string> names;
+  std::set<std::string> taken;
+  for (size_t i = 0; i < materials.size(); ++i) {
+    std::string name = materials[i].name;
+    for (char& c : name) {
+      if (std::isspace(static_cast<unsigned char>(c)) || std::iscntrl(static_cast<unsigned char>(c)) ||
+          c == '#')
+        c = '_';
+    }
+    if (name.empty()) name = "material_" + std::to_string(i);
+    while (!taken.insert(name).second) name.append("_").append(std::to_string(i));
+    names.push_back(name);
+  }
+  return names;
+}
+
+// --- sRGB -----------------------------------------------------------------------------------
+
+/// The sRGB transfer function (IEC 61966-2-1), linear [0, 1] to encoded [0, 1].
+float srgb_encode(float linear) {
+  return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+/// Linear value to an 8-bit sRGB code: exposure scale, transfer function, clamp, round.
+uint8_t to_srgb8(float linear, float scale) {
+  const float encoded = std::clamp(srgb_encode(linear * scale), 0.0f, 1.0f);
+  return static_cast<uint8_t>(std::lround(encoded * 255.0f));
+}
+
+// --- PLY ------------------------------------------------------------------------------------
+
+// OpenMesh's exporter converts colours to four-component vectors and does not compile with
+// three-component colour types; the alpha channel is not written (no Options::ColorAlpha).
+struct PlyTraits : OpenMesh::DefaultTraits {
+  using Point = OpenMesh::Vec3f;
+  using Normal = OpenMesh::Vec3f;
+  using Color = OpenMesh::Vec4f;
+  VertexAttributes(OpenMesh::Attributes::Normal | OpenMesh::Attributes::Color);
+};
+using PlyMesh = OpenMesh::TriMesh_ArrayKernelT<PlyTraits>;
+
+/// Mutes OpenMesh's error stream while alive: add_face reports each face it refuses there, and
+/// encode_ply handles those faces itself.
+class QuietOpenMeshErrors {
+ public:
+  QuietOpenMeshErrors() : was_enabled_(omerr().is_enabled()) { omerr().disable(); }
+  ~QuietOpenMeshErrors() {
+    if (was_enabled_) omerr().enable();
+  }
+  QuietOpenMeshErrors(const QuietOpenMeshErrors&) = delete;
+  QuietOpenMeshErrors& operator=(const QuietOpenMeshErrors&) = delete;
+
+ private:
+  bool was_enabled_;
+};
+
+/// Binary little-endian PLY of the mesh with `colours` written as floats, or as bytes
+/// ⌊255·c + 0.5⌋ (OpenMesh's conversion) when `float_colours` is false.
+std::string encode_ply(const RadiosityMesh& mesh, const std::vector<OpenMesh::Vec4f>& colours,
+                       bool float_colours) {
+  PlyMesh out;
+  out.reserve(mesh.vertex_count(), 3 * mesh.element_count(), mesh.element_count());
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    const Vec3& p = mesh.positions[v];
+    const Vec3& n = mesh.normals[v];
+    const auto handle = out.add_vertex(PlyMesh::Point(p.x, p.y, p.z));
+    out.set_normal(handle, PlyMesh::Normal(n.x, n.y, n.z));
+    out.set_color(handle, colours[v]);
+  }
+  // Vertex v keeps index v in the file. The half-edge structure refuses faces that would make the
+  // mesh non-manifold or flip its orientation (an edge shared by three elements, say); such a face
+  // gets its own copies of its vertices, appended at the end, so every element is written.
+  const QuietOpenMeshErrors quiet;
+  for (const auto& element : mesh.elements) {
+    std::array<OpenMesh::VertexHandle, 3> handles;
+    for (int k = 0; k < 3; ++k) handles[k] = OpenMesh::VertexHandle(static_cast<int>(element[k]));
+    if (out.add_face(handles[0], handles[1], handles[2]).is_valid()) continue;
+    for (auto& handle : handles) {
+      const PlyMesh::Point point = out.point(handle);  // a copy: add_vertex may reallocate
+      const auto copy = out.add_vertex(point);
+      out.set_normal(copy, out.normal(handle));
+      out.set_color(copy, out.color(handle));
+      handle = copy;
+    }
+    if (!out.add_face(handles[0], handles[1], handles[2]).is_valid()) {
+      throw std::logic_error("write_solution: OpenMesh refused a triangle of fresh vertices");
+    }
+  }
+
+  OpenMesh::IO::Options options = OpenMesh::IO::Options::Binary | OpenMesh::IO::Options::LSB |
+                                  OpenMesh::IO::Options::VertexNormal | OpenMesh::IO::Options::VertexColor;
+  if (float_colours) options += OpenMesh::IO::Options::ColorFloat;
+  std::ostringstream stream(std::ios::out | std::ios::binary);
+  if (!OpenMesh::IO::write_mesh(out, stream, ".ply", options)) {
+    throw std::runtime_error("write_solution: OpenMesh could not encode the mesh as PLY");
+  }
+  return std::move(stream).str();
+}
+
+std::string encode_ply(const RadiosityMesh& mesh, const std::vector<Rgb>& colours,
+                       const ExportSettings& settings) {
+  std::vector<OpenMesh::Vec4f> values(colours.size());
+  if (settings.srgb8) {
+    // Code k is handed over as k/255, which OpenMesh's rounding turns back into k exactly.
+    const float scale = std::exp2(settings.exposure);
+    const auto code = [scale](float linear) { return float(to_srgb8(linear, scale)) / 255.0f; };
+    for (size_t v = 0; v < colours.size(); ++v) {
+      values[v] = {code(colours[v].r), code(colours[v].g), code(colours[v].b), 1.0f};
+    }
+  } else {
+    for (size_t v = 0; v < colours.size(); ++v) values[v] = {colours[v].r, colours[v].g, colours[v].b, 1.0f};
+  }
+  return encode_ply(mesh, values, !settings.srgb8);
+}
+
+// --- OBJ + MTL ------------------------------------------------------------------------------
+
+/// Appends " x" with nine significant digits, which bring every float back exactly even through
+/// a parser that rounds slightly off; std::to_chars ignores the locale, unlike printf.
+void append_float(std::string& out, float x) {
+  char buffer[40];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x, std::chars_format::general, 9);
+  out += ' ';
+  out.append(buffer, result.ptr);
+}
+
+void append_line(std::string& out, const char* key, const Rgb& c) {
+  out += key;
+  for (int i = 0; i < 3; ++i) append_float(out, c[i]);
+  out += '\n';
+}
+
+std::string encode_mtl(const std::vector<Material>& materials, const std::vector<std::string>& names,
+                       const std::vector<std::vector<uint32_t>>& groups) {
+  std::string out = "# gilt radiosity export: materials\n";
+  for (size_t m = 0; m < materials.size(); ++m) {
+    if (groups[m].empty()) continue;
+    const Material& mat = materials[m];
+    int illum = 1;
+    float ns = 0.0f;
+    switch (mat.kind) {
+      case rc::MaterialKind::diffuse:
+        break;
+      case rc::MaterialKind::glossy:
+        illum = 2;
+        ns = mat.exponent;
+        break;
+      case rc::MaterialKind::mirror:
+        illum = 3;
+        ns = 1000.0f;
+        break;
+      case rc::MaterialKind::dielectric:
+        illum = 7;
+        break;
+    }
+    out += "\nnewmtl " + names[m] + "\n";
+    append_line(out, "Kd", mat.albedo);
+    append_line(out, "Ks", mat.specular);
+    out += "Ns";
+    append_float(out, ns);
+    out += "\nNi";
+    append_float(out, mat.ior);
+    out += "\nd 1\n";
+    if (mat.kind == rc::MaterialKind::dielectric) append_line(out, "Tf", rc::exp(mat.absorption * -1.0f));
+    append_line(out, "Ke", mat.emission);
+    out += "illum " + std::to_string(illum) + "\n";
+  }
+  return out;
+}
+
+std::string encode_obj(const RadiosityMesh& mesh, const std::vector<Rgb>& colours, Quantity quantity,
+                       const std::string& mtl_name, const std::vector<std::string>& names,
+                       const std::vector<std::vector<uint32_t>>& groups) {
+  std::string out;
+  out.reserve(96 * mesh.vertex_count() + 40 * mesh.element_count());
+  out += "# gilt radiosity export: vertex colours are linear ";
+  out += quantity_name(quantity);
+  out += " in ";
+  out += quantity_units(quantity);
+  out += "\nmtllib " + mtl_name + "\n";
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    out += 'v';
+    for (int i = 0; i < 3; ++i) append_float(out, mesh.positions[v][i]);
+    for (int i = 0; i < 3; ++i) append_float(out, colours[v][i]);
+    out += '\n';
+  }
+  for (const Vec3& n : mesh.normals) {
+    out += "vn";
+    for (int i = 0; i < 3; ++i) append_float(out, n[i]);
+    out += '\n';
+  }
+  for (size_t m = 0; m < groups.size(); ++m) {
+    if (groups[m].empty()) continue;
+    out += "usemtl " + names[m] + "\n";
+    for (const uint32_t e : groups[m]) {
+      out += 'f';
+      for (const uint32_t v : mesh.elements[e]) {
+        const std::string index = std::to_string(v + 1);
+        out += ' ' + index + "//" + index;
+      }
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+// --- glTF / GLB -----------------------------------------------------------------------------
+
+/// Appends `count` items of `bytes_per_item` bytes to the buffer as a new buffer view with one
+/// accessor over it; returns the accessor's index.
+int add_accessor(tinygltf::Model& model, std::vector<unsigned char>& buffer, const void* data, size_t count,
+                 size_t bytes_per_item, int component_type, int type, int target) {
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = buffer.size();
+  view.byteLength = count * bytes_per_item;
+  view.target = target;
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  buffer.insert(buffer.end(), bytes, bytes + view.byteLength);
+  model.bufferViews.push_back(std::move(view));
+
+  tinygltf::Accessor accessor;
+  accessor.bufferView = static_cast<int>(model.bufferViews.size()) - 1;
+  accessor.componentType = component_type;
+  accessor.type = type;
+  accessor.count = count;
+  model.accessors.push_back(std::move(accessor));
+  return static_cast<int>(model.accessors.size()) - 1;
+}
+
+tinygltf::Material gltf_material(const Material& m, const std::string& name, tinygltf::Model& model) {
+  tinygltf::Material out;
+  out.name = name;
+  out.pbrMetallicRoughness.baseColorFactor = {m.albedo.r, m.albedo.g, m.albedo.b, 1.0};
+  out.pbrMetallicRoughness.metallicFactor = 0.0;
+  out.pbrMetallicRoughness.roughnessFactor = 1.0;
+  out.doubleSided = m.two_sided_emission;
+  const float strength = m.emission.max_component();
+  if (strength > 1.0f) {
+    out.emissiveFactor = {m.emission.r / double(strength), m.emission.g / double(strength),
+                          m.emission.b / double(strength)};
+    tinygltf::Value::Object extension;
+    extension["emissiveStrength"] = tinygltf::Value(double(strength));
+    out.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(std::move(extension));
+    const std::string used = "KHR_materials_emissive_strength";
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), used) ==
+        model.extensionsUsed.end())
+      model.extensionsUsed.push_back(used);
+  } else if (strength > 0.0f) {
+    out.emissiveFactor = {m.emission.r, m.emission.g, m.emission.b};
+  }
+  return out;
+}
+
+/// One mesh with one primitive per material; each primitive holds the vertices its elements use.
+std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const std::vector<Rgb>& colours,
+                        const std::vector<std::string>& names,
+                        const std::vector<std::vector<uint32_t>>& groups, bool binary) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "gilt radiosity export";
+  std::vector<unsigned char> buffer;
+  tinygltf::Mesh gltf_mesh;
+  gltf_mesh.name = scene.name.empty() ? "radiosity" : scene.name;
+
+  for (size_t m = 0; m < groups.size(); ++m) {
+    if (groups[m].empty()) continue;
+    std::vector<uint32_t> vertices;  // mesh vertex of each primitive vertex, ascending
+    for (const uint32_t e : groups[m])
+      vertices.insert(vertices.end(), mesh.elements[e].begin(), mesh.elements[e].end());
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+
+    std::vector<float> positions, normals, rgb;
+    positions.reserve(3 * vertices.size());
+    normals.reserve(3 * vertices.size());
+    rgb.reserve(3 * vertices.size());
+    Vec3 lo(rc::kInfinity), hi(-rc::kInfinity);
+    for (const uint32_t v : vertices) {
+      const Vec3& p = mesh.positions[v];
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+      for (int i = 0; i < 3; ++i) {
+        positions.push_back(p[i]);
+        normals.push_back(mesh.normals[v][i]);
+        rgb.push_back(colours[v][i]);
+      }
+    }
+    std::vector<uint32_t> indices;
+    indices.reserve(3 * groups[m].size());
+    for (const uint32_t e : groups[m]) {
+      for (const uint32_t v : mesh.elements[e]) {
+        indices.push_back(
+            static_cast<uint32_t>(std::lower_bound(vertices.begin(), vertices.end(), v) - vertices.begin()));
+      }
+    }
+
+    tinygltf::Primitive primitive;
+    primitive.mode = TINYGLTF_MODE_TRIANGLES;
+    const size_t n = vertices.size();
+    const int position = add_accessor(model, buffer, positions.data(), n, 12, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                      TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    model.accessors[position].minValues = {lo.x, lo.y, lo.z};
+    model.accessors[position].maxValues = {hi.x, hi.y, hi.z};
+    primitive.attributes["POSITION"] = position;
+    primitive.attributes["NORMAL"] =
+        add_accessor(model, buffer, normals.data(), n, 12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                     TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.attributes["COLOR_0"] =
+        add_accessor(model, buffer, rgb.data(), n, 12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                     TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.indices =
+        add_accessor(model, buffer, indices.data(), indices.size(), 4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                     TINYGLTF_TYPE_SCALAR, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    primitive.material = static_cast<int>(model.materials.size());
+    model.materials.push_back(gltf_material(scene.materials[m], names[m], model));
+    gltf_mesh.primitives.push_back(std::move(primitive));
+  }
+
+  tinygltf::Scene gltf_scene;
+  if (!gltf_mesh.primitives.empty()) {
+    // A .gltf embeds the buffer as a base64 data: URI, so it stays a single file.
+    tinygltf::Buffer gltf_buffer;
+    gltf_buffer.data = std::move(buffer);
+    model.buffers.push_back(std::move(gltf_buffer));
+    model.meshes.push_back(std::move(gltf_mesh));
+    tinygltf::Node node;
+    node.name = model.meshes[0].name;
+    node.mesh = 0;
+    model.nodes.push_back(std::move(node));
+    gltf_scene.nodes.push_back(0);
+  }
+  model.scenes.push_back(std::move(gltf_scene));
+  model.defaultScene = 0;
+
+  tinygltf::TinyGLTF writer;
+  std::ostringstream stream(std::ios::out | std::ios::binary);
+  if (!writer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/!binary, /*writeBinary=*/binary)) {
+    throw std::runtime_error("write_solution: tinygltf could not encode the mesh");
+  }
+  return std::move(stream).str();
+}
+
+}  // namespace
+
+Quantity parse_quantity(const std::string& name) {
+  if (name == "radiance") return Quantity::radiance;
+  if (name == "irradiance") return Quantity::irradiance;
+  if (name == "radiosity") return Quantity::radiosity;
+  throw InputError("unknown quantity '" + name + "' (expected radiance, irradiance or radiosity)");
+}
+
+void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,
+                    const ExportSettings& settings) {
+  const fs::path destination(path);
+  const Format format = format_of(destination);
+  if (format == Format::unsupported) {
+    throw InputError("cannot write '" + path + "': unsupported mesh format '" +
+                     destination.extension().string() + "' (expected .ply, .obj, .gltf or .glb)");
+  }
+  require_folder(destination);
+  const RadiosityMesh& mesh = solution.mesh;
+  check_mesh(mesh, scene.materials.size());
+  const std::vector<Rgb> colours = vertex_colours(solution, settings.quantity);
+  const auto groups = elements_by_material(mesh, scene.materials.size());
+  const auto names = material_names(scene.materials);
+
+  // settings.srgb8 and settings.exposure apply to PLY only: OBJ and glTF keep linear floats.
+  switch (format) {
+    case Format::ply:
+      StagedFile(destination, encode_ply(mesh, colours, settings)).commit();
+      break;
+    case Format::obj: {
+      // Both files are staged before either is renamed, so a failure while encoding or writing
+      // leaves both as they were; each rename is atomic on its own. The MTL goes first, so the OBJ
+      // never names a material its MTL lacks.
+      fs::path mtl_path = destination;
+      mtl_path.replace_extension(".mtl");
+      StagedFile mtl(mtl_path, encode_mtl(scene.materials, names, groups));
+      StagedFile obj(destination, encode_obj(mesh, colours, settings.quantity, mtl_path.filename().string(),
+                                             names, groups));
+      mtl.commit();
+      obj.commit();
+      break;
+    }
+    case Format::gltf:
+    case Format::glb:
+      StagedFile(destination, encode_gltf(scene, mesh, colours, names, groups, format == Format::glb))
+          .commit();
+      break;
+    case Format::unsupported:
+      break;
+  }
+}
+
+}  // namespace gilt::radiosity
