@@ -6,9 +6,18 @@
 
 #include <CLI/CLI.hpp>
 
+#include "radiosity/solver.h"
+
 namespace gilt::cli {
 
 /// `gilt render`: renders an image with a chosen method.
 std::function<void()> add_render_command(CLI::App& app);
+
+/// `gilt radiosity`: solves radiosity and exports the mesh with vertex colours.
+std::function<void()> add_radiosity_command(CLI::App& app);
+
+/// Registers the radiosity meshing and solver options (--max-edge, --elements, --tolerance) on
+/// a subcommand; both `render --method radiosity` and `radiosity` use them.
+void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& settings);
 
 }  // namespace gilt::cli

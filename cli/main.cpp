@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   std::function<void()> action;
   const auto render = gilt::cli::add_render_command(app);
   app.get_subcommand("render")->callback([&] { action = render; });
+  const auto radiosity = gilt::cli::add_radiosity_command(app);
+  app.get_subcommand("radiosity")->callback([&] { action = radiosity; });
 
   try {
     app.parse(argc, argv);

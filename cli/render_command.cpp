@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "radiosity/solver.h"
+#include "radiosity/view.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/image_io.h"
 #include "raytrace_core/parallel.h"
@@ -38,6 +40,7 @@ struct RenderOptions {
   int max_depth = 0;
   bool json = false;
   bool quiet = false;
+  radiosity::SolverSettings solver;
 };
 
 /// Parses "x,y,z" into a vector; `flag` names the option in the error.
@@ -75,8 +78,8 @@ void check_output(const std::string& path) {
 }
 
 void run_render(const RenderOptions& o) {
-  if (o.method != "path" && o.method != "whitted")
-    throw rc::InputError("--method " + o.method + ": expected path or whitted");
+  if (o.method != "path" && o.method != "whitted" && o.method != "radiosity")
+    throw rc::InputError("--method " + o.method + ": expected path, whitted or radiosity");
   check_output(o.output);
   rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
@@ -95,7 +98,18 @@ void run_render(const RenderOptions& o) {
   const rc::Camera camera = make_camera(scene, o);
 
   rc::RadianceFunction radiance;
-  if (o.method == "path") {
+  std::optional<radiosity::Solution> solution;
+  std::optional<radiosity::RadiosityView> view;
+  if (o.method == "radiosity") {
+    radiosity::SolverSettings solver = o.solver;
+    solver.seed = o.seed;
+    solver.threads = o.threads;
+    solver.progress = settings.progress;
+    solution.emplace(radiosity::solve(scene, solver));
+    for (const std::string& w : solution->mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
+    view.emplace(scene, *solution);
+    radiance = [&view](const rc::Ray& ray, rc::SampleContext& ctx) { return view->radiance(ray, ctx); };
+  } else if (o.method == "path") {
     rc::PathSettings ps;
     if (o.max_depth > 0) ps.max_depth = o.max_depth;
     radiance = [&scene, ps](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, ps); };
@@ -132,6 +146,10 @@ void run_render(const RenderOptions& o) {
                         {"seconds", stats.seconds},
                         {"non_finite_samples", stats.non_finite},
                         {"output", o.output}};
+    if (solution) {
+      j["radiosity"] = {{"elements", solution->mesh.element_count()}, {"shots", solution->shots},
+                        {"residual", solution->residual}, {"seconds", solution->seconds}};
+    }
     std::cout << j.dump() << std::endl;
   } else {
     std::printf("gilt render: %s, method %s, %dx%d, %d spp, seed %llu, %d thread(s)\n", o.scene.c_str(),
@@ -143,7 +161,10 @@ void run_render(const RenderOptions& o) {
                 double(stats.rays) / secs * 1e-6);
     std::printf("  samples: %llu, %.3f Msamples/s\n", static_cast<unsigned long long>(stats.samples),
                 double(stats.samples) / secs * 1e-6);
-    std::printf("  time:    %.3f s\n", stats.seconds);
+    if (solution)
+      std::printf("  solve:   %zu elements, %llu shots, residual %.3g, %.3f s\n", solution->mesh.element_count(),
+                  static_cast<unsigned long long>(solution->shots), solution->residual, solution->seconds);
+    std::printf("  time:    %.3f s%s\n", stats.seconds, solution ? " (render, after the solve)" : "");
     std::printf("  wrote %s\n", o.output.c_str());
   }
 }
@@ -157,8 +178,9 @@ std::function<void()> add_render_command(CLI::App& app) {
                                      "(cornell, cornell-caustics, furnace, smallpt)")
       ->required();
   cmd->add_option("-o,--output", o->output, "Output image (.exr, .hdr linear; .png sRGB)")->required();
-  cmd->add_option("--method", o->method, "Rendering method: path (reference) or whitted")
-      ->check(CLI::IsMember({"path", "whitted"}));
+  cmd->add_option("--method", o->method, "Rendering method: path (reference), whitted or radiosity")
+      ->check(CLI::IsMember({"path", "whitted", "radiosity"}));
+  add_solver_options(*cmd, o->solver);
   auto* spp = cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's, 64)")
                   ->check(CLI::PositiveNumber);
   cmd->add_option("--time", o->time_limit, "Render whole passes until this many seconds are spent")

@@ -1,0 +1,117 @@
+// `gilt radiosity SCENE -o OUT.ply|.obj|.gltf|.glb`: solve, then export vertex colours.
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.h"
+#include "radiosity/export.h"
+#include "radiosity/solver.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/scene_io.h"
+
+namespace gilt::cli {
+namespace rc = gilt::raytrace_core;
+namespace {
+
+struct RadiosityOptions {
+  std::string scene, output, quantity = "radiance";
+  radiosity::SolverSettings solver;
+  bool srgb8 = false, json = false, quiet = false;
+  float exposure = 0.0f;
+};
+
+void check_mesh_output(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext != ".ply" && ext != ".obj" && ext != ".gltf" && ext != ".glb")
+    throw rc::InputError("-o " + path + ": unsupported mesh type (use .ply, .obj, .gltf or .glb)");
+  const std::filesystem::path parent = std::filesystem::absolute(path).parent_path();
+  if (!std::filesystem::is_directory(parent))
+    throw rc::InputError("-o " + path + ": folder " + parent.string() + " does not exist");
+}
+
+void run_radiosity(RadiosityOptions& o) {
+  check_mesh_output(o.output);
+  radiosity::ExportSettings ex;
+  ex.quantity = radiosity::parse_quantity(o.quantity);
+  ex.srgb8 = o.srgb8;
+  ex.exposure = o.exposure;
+  if (o.srgb8 && std::filesystem::path(o.output).extension() != ".ply")
+    throw rc::InputError("--srgb8 applies to .ply output only");
+  const rc::Scene scene = rc::load_scene(o.scene);
+  for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
+  o.solver.progress = !o.quiet && !o.json;
+  const radiosity::Solution sol = radiosity::solve(scene, o.solver);
+  for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
+  radiosity::write_solution(o.output, scene, sol, ex);
+
+  const double secs = std::max(sol.seconds, 1e-9);
+  const int threads = o.solver.threads > 0 ? o.solver.threads : rc::hardware_threads();
+  if (o.json) {
+    nlohmann::json j = {{"command", "radiosity"},
+                        {"scene", o.scene},
+                        {"elements", sol.mesh.element_count()},
+                        {"vertices", sol.mesh.vertex_count()},
+                        {"max_edge", sol.mesh_report.max_edge},
+                        {"shots", sol.shots},
+                        {"residual", sol.residual},
+                        {"tolerance", o.solver.tolerance},
+                        {"form_factors", sol.form_factors},
+                        {"form_factors_per_second", double(sol.form_factors) / secs},
+                        {"shadow_rays", sol.shadow_rays},
+                        {"pairs_without_visibility_rays", sol.skipped_pairs},
+                        {"convex_enclosure", sol.convex_enclosure},
+                        {"seconds", sol.seconds},
+                        {"threads", threads},
+                        {"quantity", o.quantity},
+                        {"output", o.output}};
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::printf("gilt radiosity: %s, %d thread(s)\n", o.scene.c_str(), threads);
+  std::printf("  mesh:    %zu elements, %zu vertices, target edge %.4g\n", sol.mesh.element_count(),
+              sol.mesh.vertex_count(), sol.mesh_report.max_edge);
+  std::printf("  solve:   %llu shots, residual %.3g (tolerance %.3g)\n", static_cast<unsigned long long>(sol.shots),
+              sol.residual, o.solver.tolerance);
+  std::printf("  work:    %llu form factors (%.3g/s), %llu shadow rays%s\n",
+              static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
+              static_cast<unsigned long long>(sol.shadow_rays),
+              sol.convex_enclosure ? " (convex enclosure: visibility rays skipped)" : "");
+  std::printf("  time:    %.3f s\n", sol.seconds);
+  std::printf("  wrote %s (%s)\n", o.output.c_str(), o.quantity.c_str());
+}
+
+}  // namespace
+
+void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
+  auto* edge = cmd.add_option("--max-edge", s.mesh.max_edge, "Radiosity: target element edge length (scene units)")
+                   ->check(CLI::PositiveNumber);
+  cmd.add_option("--elements", s.mesh.elements, "Radiosity: approximate element count (default " +
+                                                    std::to_string(radiosity::kDefaultElements) + ")")
+      ->check(CLI::Range(1, 50000000))
+      ->excludes(edge);
+  cmd.add_option("--tolerance", s.tolerance, "Radiosity: stop when unshot power < T x emitted power (default 1e-3)")
+      ->check(CLI::Range(1e-12, 1.0));
+}
+
+std::function<void()> add_radiosity_command(CLI::App& app) {
+  auto o = std::make_shared<RadiosityOptions>();
+  CLI::App* cmd = app.add_subcommand("radiosity", "Solve radiosity and export the mesh with vertex colours");
+  cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
+  cmd->add_option("-o,--output", o->output, "Output mesh (.ply, .obj, .gltf, .glb)")->required();
+  add_solver_options(*cmd, o->solver);
+  cmd->add_option("--time", o->solver.time_limit, "Stop after this many seconds")->check(CLI::PositiveNumber);
+  cmd->add_option("--quantity", o->quantity, "Vertex colour: radiance (default), irradiance or radiosity")
+      ->check(CLI::IsMember({"radiance", "irradiance", "radiosity"}));
+  cmd->add_flag("--srgb8", o->srgb8, "PLY: 8-bit sRGB colours instead of linear float");
+  cmd->add_option("--exposure", o->exposure, "With --srgb8: scale by 2^exposure")->check(CLI::Range(-64.0f, 64.0f));
+  cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
+  cmd->add_option("--seed", o->solver.seed, "Random seed for the visibility samples");
+  cmd->add_flag("--json", o->json, "Print the statistics as one JSON object");
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
+  return [o] { run_radiosity(*o); };
+}
+
+}  // namespace gilt::cli

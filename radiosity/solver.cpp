@@ -1,0 +1,322 @@
+// Progressive refinement radiosity: Cohen, Chen, Wallace & Greenberg 1988, "A Progressive
+// Refinement Approach to Fast Radiosity Image Generation". Receiver-vertex to source-element
+// form factors, analytic with ray-traced visibility: Wallace, Elmquist & Haines 1989.
+//
+// The unknowns are vertex values: B_v = B0_v + ρ_v Σ_j F(v → j) B̄_j, where B̄_j is the mean of
+// element j's vertex radiosities and F(v → j) the point-to-element factor. Each row of F sums to
+// at most 1 (exactly 1 in a closed scene), so the iteration contracts by ρ_max in the max norm:
+// it cannot diverge for any albedo below 1, and all terms stay non-negative.
+
+#include "radiosity/solver.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "radiosity/form_factor.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/light.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/progress.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/sampling.h"
+
+namespace gilt::radiosity {
+namespace {
+
+using rc::DVec3;
+
+constexpr float kPi = rc::kPi;
+
+/// Where a vertex receives: nudged a thousandth of the way towards the centroid of one of its
+/// elements. A vertex in a corner lies in the planes of the walls beside it, sees them edge-on
+/// and would miss their light (its form factors to a closed box sum to 1/4, not 1); just inside
+/// its element it sees them as the surface around it does, and its shadow rays do not start on
+/// the other wall.
+std::vector<Vec3> visibility_origins(const RadiosityMesh& mesh) {
+  std::vector<Vec3> origin(mesh.positions);
+  std::vector<bool> done(mesh.vertex_count(), false);
+  for (const auto& e : mesh.elements) {
+    const Vec3 centroid = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f;
+    for (uint32_t v : e) {
+      if (done[v]) continue;
+      origin[v] = mesh.positions[v] + 1e-3f * (centroid - mesh.positions[v]);
+      done[v] = true;
+    }
+  }
+  return origin;
+}
+
+/// A surface point for spawning rays at p on a surface with normal n; the error bound allows for
+/// rounding in meshing (γ(16)·|p|).
+rc::SurfacePoint surface_point(const Vec3& p, const Vec3& n) {
+  rc::SurfacePoint sp;
+  sp.p = p;
+  sp.p_error = rc::error_gamma(16) * rc::abs(p);
+  sp.ng = n;
+  return sp;
+}
+
+/// Potential occluders: boxes around every part of the scene that could block a segment between
+/// two mesh points. A segment between two points of a convex region never crosses the region's
+/// boundary planes, so elements lying on a plane that has every mesh vertex on its front (a wall
+/// of the room) never block anything; what remains are the blocks, spheres and other objects
+/// inside, plus every mirror and dielectric (meshed or not, they are opaque to the solver).
+std::vector<rc::Bounds3> occluder_boxes(const rc::Scene& scene, const RadiosityMesh& mesh) {
+  // Distinct element planes: a box has six, however finely it is meshed.
+  const float scale = std::max(1e-30f, scene.bounds().radius());
+  const float eps = 1e-4f * scale;
+  std::map<std::array<long, 4>, bool> hull;  // plane key → every vertex on or in front of it
+  auto key_of = [&](size_t e) {
+    const Vec3 n = mesh.element_normal[e];
+    const float d = glm::dot(n, mesh.positions[mesh.elements[e][0]]) / scale;
+    return std::array<long, 4>{std::lround(n.x * 1e4f), std::lround(n.y * 1e4f), std::lround(n.z * 1e4f),
+                               std::lround(d * 1e4f)};
+  };
+  std::vector<std::array<long, 4>> keys(mesh.element_count());
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    keys[e] = key_of(e);
+    if (hull.count(keys[e]) || hull.size() > 256) continue;
+    const Vec3 n = mesh.element_normal[e];
+    const float d = glm::dot(n, mesh.positions[mesh.elements[e][0]]);
+    bool all_in_front = true;
+    for (const Vec3& p : mesh.positions)
+      if (glm::dot(n, p) - d < -eps) {
+        all_in_front = false;
+        break;
+      }
+    hull.emplace(keys[e], all_in_front);
+  }
+  std::map<uint32_t, rc::Bounds3> by_surface;
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const auto it = hull.find(keys[e]);
+    if (it != hull.end() && it->second) continue;
+    rc::Bounds3& b = by_surface[mesh.element_surface[e]];
+    for (uint32_t v : mesh.elements[e]) b.extend(mesh.positions[v]);
+  }
+  std::vector<rc::Bounds3> boxes;
+  for (auto& [surface, b] : by_surface) boxes.push_back(b);
+  for (const rc::TriangleMesh& m : scene.meshes) {
+    if (!scene.materials[m.material].is_specular()) continue;
+    rc::Bounds3 b;
+    for (uint32_t i : m.indices) b.extend(m.positions[i]);
+    if (!b.empty()) boxes.push_back(b);
+  }
+  for (const rc::Sphere& sp : scene.spheres)
+    if (scene.materials[sp.material].is_specular()) boxes.push_back({sp.center - Vec3(sp.radius), sp.center + Vec3(sp.radius)});
+  // Grow each box by the rounding slack so the test stays conservative.
+  for (rc::Bounds3& b : boxes) {
+    b.lo -= Vec3(eps);
+    b.hi += Vec3(eps);
+  }
+  return boxes;
+}
+
+/// True when the tetrahedron (p, a, b, c), which holds every segment from p to the triangle,
+/// may meet the box: its bounding box overlaps the box and no face plane of the tetrahedron
+/// has the whole box outside. Conservative: it may say yes when the two are disjoint.
+bool tetrahedron_may_meet_box(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, const rc::Bounds3& box) {
+  const Vec3 lo = glm::min(glm::min(p, a), glm::min(b, c)), hi = glm::max(glm::max(p, a), glm::max(b, c));
+  if (lo.x > box.hi.x || lo.y > box.hi.y || lo.z > box.hi.z || hi.x < box.lo.x || hi.y < box.lo.y || hi.z < box.lo.z)
+    return false;
+  const Vec3 v[4] = {p, a, b, c};
+  static constexpr int faces[4][4] = {{0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 3, 1}, {1, 2, 3, 0}};  // 3 on the face, 1 opposite
+  for (const auto& f : faces) {
+    Vec3 n = glm::cross(v[f[1]] - v[f[0]], v[f[2]] - v[f[0]]);
+    if (glm::dot(n, v[f[3]] - v[f[0]]) > 0.0f) n = -n;  // outward
+    if (glm::dot(n, n) == 0.0f) continue;              // flat tetrahedron: skip this plane
+    // The box corner least far along n: if even it is outside, the whole box is.
+    const Vec3 corner(n.x > 0 ? box.lo.x : box.hi.x, n.y > 0 ? box.lo.y : box.hi.y, n.z > 0 ? box.lo.z : box.hi.z);
+    if (glm::dot(n, corner - v[f[0]]) > 0.0f) return false;
+  }
+  return true;
+}
+
+/// Irradiance at vertex v from a punctual or environment light, with visibility.
+Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc::SurfacePoint& at, const Vec3& n,
+                        rc::Rng& rng, int samples, uint64_t& rays) {
+  if (light.kind == rc::LightKind::environment) {
+    // E = L ∫ V cos dω, by cosine-weighted stratified directions: π L · (fraction unblocked).
+    const rc::Frame frame = rc::Frame::from_normal(n);
+    const int side = std::max(1, int(std::sqrt(double(samples))));
+    int open = 0;
+    for (int i = 0; i < side; ++i)
+      for (int j = 0; j < side; ++j) {
+        const rc::Vec2 u((i + rng.uniform()) / side, (j + rng.uniform()) / side);
+        ++rays;
+        open += !scene.occluded(rc::spawn_shadow_ray_to_infinity(at, frame.to_world(rc::sample_cosine_hemisphere(u))));
+      }
+    return light.radiance * (kPi * float(open) / float(side * side));
+  }
+  const rc::LightSample ls = rc::sample_light(scene, light, at, rng.uniform2());
+  const float cos_theta = glm::dot(ls.wi, n);
+  if (!(cos_theta > 0.0f) || ls.radiance.is_black()) return Rgb(0.0f);
+  ++rays;
+  if (scene.occluded(ls.shadow_ray)) return Rgb(0.0f);
+  return ls.radiance * cos_theta;
+}
+
+}  // namespace
+
+Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
+  if (!scene.committed()) throw std::logic_error("radiosity::solve: the scene was not committed");
+  if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance))
+    throw rc::InputError("--tolerance must be a positive number");
+  if (settings.visibility_samples < 1) throw rc::InputError("visibility samples must be at least 1");
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const rc::ThreadLimit limit(settings.threads);
+
+  Solution sol;
+  sol.mesh = build_mesh(scene, settings.mesh, &sol.mesh_report);
+  const RadiosityMesh& mesh = sol.mesh;
+  const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
+  sol.vertex_irradiance.assign(nv, Rgb(0.0f));
+  sol.vertex_radiosity.assign(nv, Rgb(0.0f));
+  const std::vector<rc::Bounds3> occluders = occluder_boxes(scene, mesh);
+  sol.convex_enclosure = occluders.empty();
+
+  auto albedo = [&](uint32_t material) { return scene.materials[material].albedo; };
+  auto emitted = [&](uint32_t material) { return scene.materials[material].emission * kPi; };  // B0 = π Le
+
+  const std::vector<Vec3> ray_origin = visibility_origins(mesh);
+  std::vector<rc::SurfacePoint> vertex_point(nv);
+  for (size_t v = 0; v < nv; ++v) vertex_point[v] = surface_point(ray_origin[v], mesh.normals[v]);
+
+  // Unshot radiosity per element, and each element's reflectance.
+  std::vector<Rgb> unshot(ne);
+  double emitted_power = 0.0;
+  for (size_t e = 0; e < ne; ++e) {
+    unshot[e] = emitted(mesh.element_material[e]);
+    emitted_power += double(unshot[e].average()) * mesh.element_area[e];
+  }
+
+  // Lights that are not meshed shoot first, straight to the vertices.
+  std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
+  std::atomic<uint64_t> rays{0}, form_factors{0}, skipped{0};
+  auto add_received = [&] {
+    // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
+    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
+    double gained = 0.0;
+    for (size_t e = 0; e < ne; ++e) {
+      const auto& el = mesh.elements[e];
+      const Rgb mean = (received[el[0]] + received[el[1]] + received[el[2]]) * (1.0f / 3.0f);
+      const Rgb db = albedo(mesh.element_material[e]) * mean;
+      unshot[e] += db;
+      gained += double(db.average()) * mesh.element_area[e];
+    }
+    std::fill(received.begin(), received.end(), Rgb(0.0f));
+    return gained;
+  };
+  for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
+    const rc::Light& light = scene.punctual_lights[li];
+    rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+      uint64_t local_rays = 0;
+      for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
+        rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
+        received[v] = punctual_irradiance(scene, light, vertex_point[v], mesh.normals[v], rng,
+                                          settings.visibility_samples, local_rays);
+      }
+      rays += local_rays;
+    });
+    emitted_power += add_received();
+  }
+  if (!(emitted_power > 0.0)) {
+    sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
+  }
+
+  // Shooting.
+  const int strata = std::max(1, int(std::round(std::sqrt(double(settings.visibility_samples)))));
+  // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
+  rc::Progress progress("radiosity", 1000, "‰", settings.progress);
+  uint64_t shown = 0;
+  double unshot_power = emitted_power;
+  while (emitted_power > 0.0) {
+    // The element with the most unshot power.
+    size_t src = 0;
+    double best = -1.0;
+    unshot_power = 0.0;
+    for (size_t e = 0; e < ne; ++e) {
+      const double p = double(unshot[e].average()) * mesh.element_area[e];
+      unshot_power += p;
+      if (p > best) best = p, src = e;
+    }
+    sol.residual = unshot_power / emitted_power;
+    const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
+    if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
+    if (sol.residual < settings.tolerance) break;
+    if (settings.time_limit > 0.0 && elapsed() > settings.time_limit) break;
+
+    const Rgb shot = unshot[src];
+    unshot[src] = Rgb(0.0f);
+    const auto& se = mesh.elements[src];
+    const DVec3 a(mesh.positions[se[0]]), b(mesh.positions[se[1]]), c(mesh.positions[se[2]]);
+    const Vec3 src_normal = mesh.element_normal[src];
+    const uint64_t shot_index = sol.shots++;
+
+    rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+      uint64_t local_ff = 0, local_rays = 0, local_skipped = 0;
+      for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
+        const Vec3& p = ray_origin[v];
+        // Receivers behind the source, or facing away from all of it, get nothing.
+        if (glm::dot(src_normal, p - mesh.positions[se[0]]) <= 0.0f) continue;
+        const double f = point_to_triangle_form_factor(DVec3(p), DVec3(mesh.normals[v]), a, b, c);
+        ++local_ff;
+        if (!(f > 0.0)) continue;
+        double visible = 1.0;
+        bool may_be_blocked = false;
+        for (const rc::Bounds3& box : occluders)
+          if (tetrahedron_may_meet_box(p, mesh.positions[se[0]], mesh.positions[se[1]], mesh.positions[se[2]], box)) {
+            may_be_blocked = true;
+            break;
+          }
+        if (!may_be_blocked) {
+          ++local_skipped;
+        } else {
+          // Adaptive visibility: a 2×2 stratified probe of the source; only when it is split
+          // between blocked and open (a penumbra) the full strata × strata set decides.
+          rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
+          auto fraction_open = [&](int n) {
+            int open = 0;
+            for (int i = 0; i < n; ++i)
+              for (int j = 0; j < n; ++j) {
+                const rc::Vec2 u((i + rng.uniform()) / n, (j + rng.uniform()) / n);
+                const rc::Vec2 bary = rc::sample_uniform_triangle(u);
+                const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[se[0]] + bary.x * mesh.positions[se[1]] +
+                               bary.y * mesh.positions[se[2]];
+                ++local_rays;
+                open += !scene.occluded(rc::spawn_shadow_ray(vertex_point[v], surface_point(q, src_normal)));
+              }
+            return double(open) / double(n * n);
+          };
+          visible = fraction_open(std::min(2, strata));
+          if (visible > 0.0 && visible < 1.0 && strata > 2) visible = fraction_open(strata);
+        }
+        received[v] = shot * float(f * visible);
+      }
+      form_factors += local_ff;
+      rays += local_rays;
+      skipped += local_skipped;
+    });
+    add_received();
+  }
+  progress.finish();
+
+  for (size_t v = 0; v < nv; ++v)
+    sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + albedo(mesh.vertex_material[v]) * sol.vertex_irradiance[v];
+  sol.element_radiosity.resize(ne);
+  for (size_t e = 0; e < ne; ++e) {
+    const auto& el = mesh.elements[e];
+    sol.element_radiosity[e] =
+        (sol.vertex_radiosity[el[0]] + sol.vertex_radiosity[el[1]] + sol.vertex_radiosity[el[2]]) * (1.0f / 3.0f);
+  }
+  sol.form_factors = form_factors;
+  sol.shadow_rays = rays;
+  sol.skipped_pairs = skipped;
+  sol.seconds = elapsed();
+  return sol;
+}
+
+}  // namespace gilt::radiosity

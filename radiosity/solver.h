@@ -1,0 +1,54 @@
+#pragma once
+// Progressive-refinement radiosity (Cohen, Chen, Wallace & Greenberg 1988) with receiver-vertex
+// to source-element form factors (Wallace, Elmquist & Haines 1989): the element with the most
+// unshot power shoots to every vertex; the unoccluded form factor is analytic (Lambert), the
+// visible fraction comes from shadow rays to stratified points on the source.
+
+#include <cstdint>
+#include <vector>
+
+#include "radiosity/mesh.h"
+#include "raytrace_core/rgb.h"
+
+namespace gilt::radiosity {
+
+using rc::Rgb;
+
+/// Solver parameters; the defaults are the documented defaults.
+struct SolverSettings {
+  MeshSettings mesh;
+  double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
+  double time_limit = 0.0;   ///< seconds; 0 = no limit
+  int visibility_samples = 16;  ///< shadow rays per vertex–element pair in a penumbra (stratified
+                                ///< on the source); pairs a 2×2 probe finds all open or all blocked take 4
+  uint64_t seed = 0;
+  int threads = 0;           ///< 0 = all
+  bool progress = true;
+};
+
+/// The solution on the mesh. Radiance is what the path tracer sees: L = B / π for a Lambertian
+/// surface, in W·sr⁻¹·m⁻².
+struct Solution {
+  RadiosityMesh mesh;
+  std::vector<Rgb> vertex_radiosity;   ///< B (W·m⁻²): emitted + reflected, leaving the front
+  std::vector<Rgb> vertex_irradiance;  ///< E (W·m⁻²) arriving at the front
+  std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
+
+  // What the solve did.
+  uint64_t shots = 0;
+  uint64_t form_factors = 0;     ///< vertex–element form factors evaluated
+  uint64_t shadow_rays = 0;
+  uint64_t skipped_pairs = 0;    ///< pairs whose visibility the scene proved without rays
+  double residual = 0.0;         ///< unshot power / emitted power at the end
+  double seconds = 0.0;
+  bool convex_enclosure = false; ///< nothing can occlude (an empty convex room): no visibility rays at all
+  MeshReport mesh_report;
+
+  /// Radiance at vertex v (W·sr⁻¹·m⁻²).
+  Rgb vertex_radiance(size_t v) const { return vertex_radiosity[v] * (1.0f / 3.14159265358979f); }
+};
+
+/// Meshes and solves the committed scene.
+Solution solve(const rc::Scene& scene, const SolverSettings& settings);
+
+}  // namespace gilt::radiosity

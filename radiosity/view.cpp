@@ -1,0 +1,67 @@
+// Two-pass display of a radiosity solution (Wallace, Cohen & Greenberg 1987): diffuse radiance
+// from the solution, specular transport by ray tracing.
+
+#include "radiosity/view.h"
+
+#include "raytrace_core/bsdf.h"
+
+namespace gilt::radiosity {
+
+RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution)
+    : scene_(scene), elements_(solution.mesh.elements) {
+  const RadiosityMesh& mesh = solution.mesh;
+  vertex_radiance_.resize(mesh.vertex_count());
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) vertex_radiance_[v] = solution.vertex_radiance(v);
+
+  // Geometry 0: every element; then the scene's specular meshes; spheres: the specular ones.
+  display_.materials = scene.materials;
+  rc::TriangleMesh elements;
+  elements.name = "radiosity elements";
+  elements.positions = mesh.positions;
+  elements.indices.reserve(3 * mesh.element_count());
+  for (const auto& e : mesh.elements) elements.indices.insert(elements.indices.end(), e.begin(), e.end());
+  // A neutral material: the elements' radiance comes from the solution, not from shading.
+  elements.material = static_cast<uint32_t>(display_.materials.size());
+  display_.materials.push_back(rc::Material::make_diffuse("radiosity elements", rc::Rgb(0.0f)));
+  display_.meshes.push_back(std::move(elements));
+  for (const rc::TriangleMesh& m : scene.meshes)
+    if (scene.materials[m.material].is_specular()) display_.meshes.push_back(m);
+  for (const rc::Sphere& s : scene.spheres)
+    if (scene.materials[s.material].is_specular()) display_.spheres.push_back(s);
+  for (const rc::Light& l : scene.punctual_lights)
+    if (l.kind == rc::LightKind::environment) environment_ += l.radiance;
+  display_.name = scene.name;
+  display_.commit();
+}
+
+Rgb RadiosityView::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+  Rgb beta(1.0f);
+  rc::Ray ray = camera_ray;
+  for (int depth = 0; depth < 64; ++depth) {
+    ++ctx.rays;
+    const std::optional<rc::Hit> hit = display_.intersect(ray);
+    if (!hit) return beta * environment_;
+    const rc::SurfaceInteraction si = display_.surface(ray, *hit);
+    if (hit->geom_id == 0) {
+      // Radiosity is solved for the element fronts; their backs are not part of the answer.
+      if (!si.front_face) return Rgb(0.0f);
+      const auto& e = elements_[hit->prim_id];
+      const Rgb l = vertex_radiance_[e[0]] * (1.0f - hit->u - hit->v) + vertex_radiance_[e[1]] * hit->u +
+                    vertex_radiance_[e[2]] * hit->v;
+      return beta * l;
+    }
+    const rc::Material& m = display_.materials[si.material];
+    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+      beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+    const rc::Frame frame = rc::Frame::from_normal(si.ns);
+    const rc::Vec3 wo = frame.to_local(-glm::normalize(ray.direction));
+    const float u_lobe = ctx.rng.uniform();
+    const auto bs = rc::bsdf_sample(m, wo, u_lobe, ctx.rng.uniform2());
+    if (!bs || !(bs->pdf > 0.0f)) return Rgb(0.0f);
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+    ray = rc::spawn_ray(si, frame.to_world(bs->wi));
+  }
+  return Rgb(0.0f);
+}
+
+}  // namespace gilt::radiosity
