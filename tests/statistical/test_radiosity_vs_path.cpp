@@ -1,0 +1,80 @@
+// The radiosity render of the (all-diffuse) Cornell box against a long path-traced render of the
+// same camera.
+//
+// Error measure: mean relative error over pixels, mean |R − P| / (P + 0.01), with P the path
+// reference and R the radiosity render (ε = 0.01 keeps black pixels from dominating).
+// The two solve the same equation; what separates them is the radiosity discretisation (element
+// size h: irradiance estimated at vertices, linear over each element), plus the path reference's
+// own noise. The bound is derived from the meshing: with first-order convergence e(h) ≈ C·h + n,
+// four times the elements (h/2) must bring the error to at most 0.6 of its value (0.5 expected)
+// plus the noise n of the reference; n is measured as the same error between two independent
+// path renders, halved (both carry noise; the reference alone carries about half).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "radiosity/solver.h"
+#include "radiosity/view.h"
+#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/render.h"
+#include "raytrace_core/scene_io.h"
+
+namespace rc = gilt::raytrace_core;
+namespace rad = gilt::radiosity;
+
+namespace {
+
+constexpr int kSize = 40;
+
+rc::RenderSettings settings(int spp, uint64_t seed) {
+  rc::RenderSettings s;
+  s.width = s.height = kSize;
+  s.spp = spp;
+  s.seed = seed;
+  s.progress = false;
+  return s;
+}
+
+std::vector<rc::Rgb> path_render(const rc::Scene& scene, int spp, uint64_t seed) {
+  const rc::PathSettings path;
+  return rc::render_image(scene, scene.effective_camera(), settings(spp, seed),
+                          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); })
+      .pixels();
+}
+
+std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, int elements) {
+  rad::SolverSettings s;
+  s.mesh.elements = elements;
+  s.tolerance = 1e-4;
+  s.progress = false;
+  const rad::Solution sol = rad::solve(scene, s);
+  const rad::RadiosityView view(scene, sol);
+  // Same pixel filter and sample positions as the reference (same seed): only the radiance differs.
+  return rc::render_image(scene, scene.effective_camera(), settings(64, 1),
+                          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); })
+      .pixels();
+}
+
+double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
+  double sum = 0.0;
+  for (size_t i = 0; i < image.size(); ++i)
+    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
+  return sum / (3.0 * image.size());
+}
+
+}  // namespace
+
+TEST(RadiosityVsPath, CornellErrorFallsWithTheMesh) {
+  rc::Scene scene = rc::load_scene("cornell");
+  const std::vector<rc::Rgb> reference = path_render(scene, 2048, 1);
+  const double noise = 0.5 * mean_relative_error(path_render(scene, 2048, 2), reference);
+  const double coarse = mean_relative_error(radiosity_render(scene, 400), reference);
+  const double fine = mean_relative_error(radiosity_render(scene, 1600), reference);
+  std::printf("mean relative error: 400 elements %.4f, 1600 elements %.4f; reference noise %.4f\n", coarse, fine, noise);
+  ::testing::Test::RecordProperty("error_400", std::to_string(coarse));
+  ::testing::Test::RecordProperty("error_1600", std::to_string(fine));
+  ::testing::Test::RecordProperty("reference_noise", std::to_string(noise));
+  EXPECT_LT(fine, 0.6 * coarse + noise) << "the radiosity render does not converge to the path-traced one";
+}
