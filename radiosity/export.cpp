@@ -42,12 +42,14 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
+#include "raytrace_core/staged_file.h"
 
 namespace gilt::radiosity {
 
 namespace fs = std::filesystem;
 using rc::InputError;
 using rc::Material;
+using rc::StagedFile;
 
 // glTF buffers and OpenMesh's LSB option are little-endian; the buffers below are copied raw.
 static_assert(std::endian::native == std::endian::little, "mesh export assumes a little-endian host");
@@ -68,64 +70,6 @@ Format format_of(const fs::path& path) {
 }
 
 // --- Atomic files ---------------------------------------------------------------------------
-
-/// Hidden sibling of `destination` that keeps its extension, unique within this machine.
-fs::path temporary_path_for(const fs::path& destination) {
-  static std::atomic<uint64_t> counter{0};
-  const std::string tag = ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  return destination.parent_path() /
-         ("." + destination.filename().string() + tag + destination.extension().string());
-}
-
-/// Bytes staged in a hidden temporary beside `destination`, flushed to disk; commit() renames
-/// them into place. The destination is untouched until then, and an uncommitted temporary is
-/// removed when the object goes away.
-class StagedFile {
- public:
-  StagedFile(const fs::path& destination, std::string_view bytes)
-      : destination_(destination), temporary_(temporary_path_for(destination)) {
-    const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0) fail(errno, false);
-    size_t written = 0;
-    int error = 0;
-    while (written < bytes.size()) {
-      const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        error = n < 0 ? errno : EIO;
-        break;
-      }
-      written += static_cast<size_t>(n);
-    }
-    if (error == 0 && ::fsync(fd) != 0) error = errno;
-    if (::close(fd) != 0 && error == 0) error = errno;
-    if (error != 0) fail(error, true);
-  }
-  StagedFile(const StagedFile&) = delete;
-  StagedFile& operator=(const StagedFile&) = delete;
-  ~StagedFile() {
-    std::error_code ec;
-    if (!temporary_.empty()) fs::remove(temporary_, ec);
-  }
-
-  /// Renames the temporary over the destination; throws InputError (and removes it) on failure.
-  void commit() {
-    std::error_code ec;
-    fs::rename(temporary_, destination_, ec);
-    if (ec) fail(ec.value(), true);
-    temporary_.clear();
-  }
-
- private:
-  [[noreturn]] void fail(int error, bool remove_temporary) {
-    if (remove_temporary) ::unlink(temporary_.c_str());
-    temporary_.clear();
-    throw InputError("cannot write '" + destination_.string() +
-                     "': " + std::generic_category().message(error));
-  }
-
-  fs::path destination_, temporary_;
-};
 
 /// Throws InputError unless the folder `destination` goes into exists.
 void require_folder(const fs::path& destination) {

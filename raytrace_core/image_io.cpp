@@ -29,6 +29,7 @@
 #include <system_error>
 
 #include "raytrace_core/error.h"
+#include "raytrace_core/staged_file.h"
 
 namespace gilt::raytrace_core {
 
@@ -71,14 +72,6 @@ uint8_t to_srgb8(float linear, float scale) {
   return static_cast<uint8_t>(std::lround(encoded * 255.0f));
 }
 
-/// Hidden sibling of `destination` that keeps its extension, unique within this machine.
-fs::path temporary_path_for(const fs::path& destination) {
-  static std::atomic<uint64_t> counter{0};
-  const std::string name = destination.filename().string();
-  const std::string tag = ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  return destination.parent_path() / ("." + name + tag + destination.extension().string());
-}
-
 /// Encodes `pixels` (laid out as `spec` says) in the format named by `path`'s extension into
 /// `bytes`; returns OIIO's error message, empty on success. Encoding in memory lets us check every
 /// write to disk ourselves: OIIO's PNG writer, for one, ignores a short write (disk full).
@@ -96,29 +89,6 @@ std::string encode_with_oiio(const fs::path& path, const OIIO::ImageSpec& spec, 
   }
   if (!out->close()) return out->geterror();
   return {};
-}
-
-/// Creates `path` (which must not exist) holding `bytes`, flushed to disk; returns the system's
-/// error message, empty on success. On failure, a file it created is removed again.
-std::string write_new_file(const fs::path& path, const std::vector<unsigned char>& bytes) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) return std::generic_category().message(errno);
-  size_t written = 0;
-  int error = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      error = n < 0 ? errno : EIO;
-      break;
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (error == 0 && ::fsync(fd) != 0) error = errno;
-  if (::close(fd) != 0 && error == 0) error = errno;
-  if (error == 0) return {};
-  ::unlink(path.c_str());
-  return std::generic_category().message(error);
 }
 
 }  // namespace
@@ -171,18 +141,11 @@ void write_image(const std::string& path, const Image& image, float exposure) {
   // one keeps files bit-identical across runs, so equal images give equal files.
   spec.attribute("DateTime", "1970:01:01 00:00:00");
 
-  const fs::path temporary = temporary_path_for(destination);
+  // The path only tells OIIO the format: the bytes go to memory, then through a StagedFile.
   std::vector<unsigned char> bytes;
-  std::string error = encode_with_oiio(temporary, spec, data, bytes);
-  if (error.empty()) error = write_new_file(temporary, bytes);
-  if (error.empty()) {
-    fs::rename(temporary, destination, ec);
-    if (ec) {
-      error = ec.message();
-      fs::remove(temporary, ec);
-    }
-  }
+  const std::string error = encode_with_oiio(destination, spec, data, bytes);
   if (!error.empty()) throw InputError("cannot write '" + path + "': " + error);
+  StagedFile(destination, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size())).commit();
 }
 
 Image read_image(const std::string& path) {
