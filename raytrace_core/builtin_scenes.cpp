@@ -1,6 +1,7 @@
 // Built-in scenes: the Cornell box (with blocks, or with a glass and a mirror sphere), a white
 // furnace with a closed-form answer, and Kevin Beason's smallpt scene.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -22,9 +23,16 @@ using Quad = std::array<Vec3, 4>;
 void add_quad(TriangleMesh& mesh, const Quad& q, const Vec3& facing) {
   const Vec3 normal = glm::cross(q[1] - q[0], q[2] - q[0]);
   const bool flip = glm::dot(normal, facing) < 0.0f;
-  const auto base = static_cast<uint32_t>(mesh.positions.size());
-  for (int i = 0; i < 4; ++i) mesh.positions.push_back(q[flip ? 3 - i : i]);
-  mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+  // Corners shared with quads already in the mesh are reused, so the mesh is connected (the
+  // radiosity mesher would otherwise report merging them).
+  uint32_t corner[4];
+  for (int i = 0; i < 4; ++i) {
+    const Vec3& p = q[flip ? 3 - i : i];
+    const auto found = std::find(mesh.positions.begin(), mesh.positions.end(), p);
+    corner[i] = static_cast<uint32_t>(found - mesh.positions.begin());
+    if (found == mesh.positions.end()) mesh.positions.push_back(p);
+  }
+  mesh.indices.insert(mesh.indices.end(), {corner[0], corner[1], corner[2], corner[0], corner[2], corner[3]});
 }
 
 uint32_t add_material(Scene& scene, Material material) {
