@@ -185,7 +185,7 @@ void Scene::commit() {
     }
     mesh.indices = std::move(kept);
   }
-  if (dropped > 0) warnings.push_back(std::to_string(dropped) + " degenerate triangle(s) dropped");
+  if (dropped > 0) warnings.push_back(where + ": " + std::to_string(dropped) + " degenerate triangle(s) dropped");
 
   for (size_t si = 0; si < spheres.size(); ++si) {
     const Sphere& s = spheres[si];
