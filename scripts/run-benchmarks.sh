@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the Google Benchmark programs, runs them, and prints the ray core's throughput next to
-# raw Embree's on the same rays, plus the path tracer's samples/s. Figures are medians of
+# raw Embree's on the same rays, the path tracer's samples/s, and the radiosity solver's error
+# against time, form factors/s and solve cost at 1k/10k/100k elements. Figures are medians of
 # REPETITIONS runs whose order is shuffled, so that a slow spell of the machine does not land on
 # one side of a comparison only. See bench/README.md for how to read them.
 #
@@ -8,7 +9,8 @@
 #
 # Exits 1 when the core keeps less than MIN_RATIO of raw Embree's single-thread throughput for
 # any ray kind. Environment: BUILD_DIR (default build), OUT_DIR (default out/bench),
-# REPETITIONS (default 5), MIN_RATIO (default 0.90), JOBS (default: number of cores).
+# REPETITIONS (default 5), MIN_RATIO (default 0.90), JOBS (default: number of cores),
+# RADIOSITY (default 1; 0 skips bench_radiosity, which takes two to three minutes on two cores).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -17,6 +19,7 @@ out_dir=${OUT_DIR:-$root/out/bench}
 repetitions=${REPETITIONS:-5}
 min_ratio=${MIN_RATIO:-0.90}
 jobs=${JOBS:-$(nproc)}
+radiosity=${RADIOSITY:-1}
 
 # Timings only mean something in an optimised build.
 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DGILT_BUILD_BENCH=ON
@@ -34,12 +37,22 @@ echo
 echo
 "$build_dir/bench/bench_path" "${flags[@]}" --benchmark_out="$out_dir/path.json" "$@"
 echo
+if [[ $radiosity != 0 ]]; then
+  # Its sweep and scaling parts are not Google Benchmarks: they write CSV files to out_dir (where
+  # the path-traced references are cached too) and ignore the repetitions.
+  "$build_dir/bench/bench_radiosity" "${flags[@]}" --benchmark_out="$out_dir/radiosity.json" \
+    --out-dir="$out_dir" "$@"
+  echo
+fi
 
-python3 - "$out_dir/raycore.json" "$out_dir/path.json" "$min_ratio" <<'PYTHON'
+python3 - "$out_dir/raycore.json" "$out_dir/path.json" "$min_ratio" "$radiosity" "$out_dir" <<'PYTHON'
+import csv
 import json
+import os
 import sys
 
 raycore_path, path_path, min_ratio = sys.argv[1], sys.argv[2], float(sys.argv[3])
+radiosity, out_dir = sys.argv[4] != "0", sys.argv[5]
 
 
 def load(path):
@@ -97,6 +110,41 @@ for threads in (1, 2):
     name = f"BM_PathTracer_Cornell/threads:{threads}/real_time"
     print(f"  {threads:<8} {median(paths, name, 'samples'):>12,.0f} {spread(paths, name, 'samples'):>5.1f}% "
           f"{median(paths, name, 'rays') / 1e6:>9.3f}")
+
+if radiosity:
+    _, ff = load(os.path.join(out_dir, "radiosity.json"))
+    print(f"\nForm factors (point_to_triangle_form_factor, 1 thread, CPU time); median of {repetitions} runs")
+    print(f"  {'configurations':<16} {'M/s':>7} {'cv':>6}")
+    for kind in ("Random", "Cornell"):
+        name = f"BM_FormFactor_{kind}"
+        print(f"  {kind.lower():<16} {median(ff, name, 'form_factors') / 1e6:>7.2f} "
+              f"{spread(ff, name, 'form_factors'):>5.1f}%")
+
+    with open(os.path.join(out_dir, "radiosity_sweep.csv")) as f:
+        sweep = list(csv.DictReader(f))
+    first = sweep[0]
+    print(f"\nRadiosity error against time on cornell (one run, wall time, all cores); reference "
+          f"{first['reference_spp']} spp, its noise {100 * float(first['reference_noise_centres']):.2f} % "
+          f"(centres) / {100 * float(first['reference_noise_filtered']):.2f} % (filtered); "
+          f"16-spp display noise {100 * float(first['display_noise_16spp']):.2f} %")
+    print(f"  {'elements':>8} {'vertices':>8} {'shots':>7} {'seconds':>8} {'16-spp %':>9} {'centre %':>9} "
+          f"{'less noise %':>12}")
+    for row in sweep:
+        print(f"  {int(row['elements']):>8} {int(row['vertices']):>8} {int(row['shots']):>7} "
+              f"{float(row['seconds']):>8.2f} {100 * float(row['error_16spp']):>9.3f} "
+              f"{100 * float(row['error_centres']):>9.3f} {100 * float(row['error_centres_less_noise']):>12.3f}")
+
+    with open(os.path.join(out_dir, "radiosity_scaling.csv")) as f:
+        scaling = list(csv.DictReader(f))
+    print("\nRadiosity solve cost on cornell (one run, wall time, all cores)")
+    print(f"  {'elements':>8} {'vertices':>8} {'mesh s':>7} {'shots':>7} {'shots/s':>8} {'MFF/s':>6} "
+          f"{'Mrays/s':>8} {'no rays %':>9} {'residual':>9}  stopped by")
+    for row in scaling:
+        print(f"  {int(row['elements']):>8} {int(row['vertices']):>8} {float(row['mesh_seconds']):>7.2f} "
+              f"{int(row['shots']):>7} {float(row['shots_per_second']):>8.1f} "
+              f"{float(row['form_factors_per_second']) / 1e6:>6.2f} {float(row['shadow_rays_per_second']) / 1e6:>8.2f} "
+              f"{100 * float(row['pairs_without_rays']):>9.1f} {float(row['residual']):>9.2e}  "
+              f"{'time limit' if row['hit_time_limit'] == '1' else 'tolerance'}")
 
 if failures:
     print(f"\nrun-benchmarks: FAILED: the core keeps less than {min_ratio:.0%} of raw Embree's throughput:")

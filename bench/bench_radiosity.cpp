@@ -1,0 +1,586 @@
+// Radiosity benchmarks, in three parts (all three when no part is named):
+//
+//   --sweep         error against time on `cornell`: the element count is swept, each mesh is
+//                   solved and rendered, and the render is compared with a path-traced reference
+//                   (mean relative error, as in tests/statistical/test_radiosity_vs_path.cpp),
+//                   once as a 16-spp render with the usual pixel filter and once through the pixel
+//                   centres, where the radiosity render is exact and only the reference's noise
+//                   remains. Prints the curve, the floor each measure cannot go below, and the
+//                   time it takes to reach 1 % (target: under 2 s on two cores).
+//   --form-factors  point_to_triangle_form_factor per second, a Google Benchmark on one thread.
+//   --scaling       solve cost at 1k, 10k and 100k elements on `cornell`, each run given about
+//                   20 s of shooting: shots, form factors and shadow rays per second, residual.
+//
+// Other options: --out-dir=DIR (default out/bench) for the CSV files and the cached references,
+// --reference-spp=N (default 4096) for the references' samples per pixel, --fresh-reference to
+// render them again. Google Benchmark flags apply to the form-factor part. Every part checks its
+// results before it reports a time, and stops with a message when they are wrong.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "radiosity/form_factor.h"
+#include "radiosity/mesh.h"
+#include "radiosity/solver.h"
+#include "radiosity/view.h"
+#include "raytrace_core/image_io.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/render.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/scene_io.h"
+
+namespace rc = gilt::raytrace_core;
+namespace rad = gilt::radiosity;
+namespace fs = std::filesystem;
+using rad::DVec3;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& message) {
+  std::fprintf(stderr, "bench_radiosity: %s\n", message.c_str());
+  std::exit(EXIT_FAILURE);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool all_finite(const std::vector<rc::Rgb>& pixels) {
+  return std::all_of(pixels.begin(), pixels.end(), [](const rc::Rgb& p) { return p.is_finite(); });
+}
+
+// ================================================================================================
+// Part 1: error against time.
+
+constexpr int kImageSize = 64;          // reference and radiosity renders: 64 × 64 pixels
+constexpr int kHalfSpp = 2048;          // default spp of each of the reference's two halves
+constexpr uint64_t kSeeds[2] = {1, 2};  // seeds of the two halves; radiosity renders use the first
+constexpr int kRadiositySpp = 16;
+constexpr int kDisplaySpp = 1024;  // for the display-noise floor (below)
+constexpr double kTolerance = 1e-3;
+constexpr double kTargetError = 0.01;
+constexpr double kTargetSeconds = 2.0;
+constexpr int kSweepElements[] = {250, 500, 1000, 2000, 4000, 8000};
+constexpr double kPointBudget = 60.0;  // a sweep point predicted to take longer is skipped
+
+/// Where a pixel looks. `filtered`: as `gilt render` does, positions drawn from the default
+/// Gaussian pixel filter (radius 1.5 px), so a 16-spp radiosity render is itself noisy wherever
+/// the image varies within a pixel's footprint. `centres`: every sample through the pixel centre,
+/// which makes a radiosity render exact at one sample and leaves the reference's noise only.
+enum class Pixels { filtered, centres };
+
+/// Short name, for file names.
+const char* name_of(Pixels pixels) { return pixels == Pixels::filtered ? "filtered" : "centres"; }
+/// For the printed report.
+const char* label_of(Pixels pixels) {
+  return pixels == Pixels::filtered ? "filtered pixels" : "pixel centres";
+}
+
+rc::RenderSettings render_settings(Pixels pixels, int spp, uint64_t seed) {
+  rc::RenderSettings s;
+  s.width = s.height = kImageSize;
+  s.spp = spp;
+  s.seed = seed;
+  s.threads = 0;
+  s.progress = false;
+  if (pixels == Pixels::centres) s.filter.radius = 0.0f;
+  return s;
+}
+
+/// Mean over pixels and channels of |image − reference| / (reference + 0.01).
+double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
+  double sum = 0.0;
+  for (size_t i = 0; i < image.size(); ++i)
+    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
+  return sum / (3.0 * double(image.size()));
+}
+
+/// The path-traced reference: the mean of two independent halves, and its own noise, measured as
+/// half the error between the halves (the mean of two halves carries half the noise of their
+/// difference): the error a perfect image would show against this reference.
+struct Reference {
+  std::vector<rc::Rgb> image;
+  double noise = 0.0;
+  int half_spp = 0;
+  bool cached = true;  ///< both halves were read from the cache
+  double seconds = 0.0;
+};
+
+/// One half of the reference, from the cache in `dir` when it holds one made with the same
+/// settings, else rendered now and cached. The cache is keyed by the settings, not by the code:
+/// after changing the path tracer, run with --fresh-reference.
+std::vector<rc::Rgb> reference_half(const rc::Scene& scene, Pixels pixels, int spp, uint64_t seed,
+                                    const fs::path& dir, bool fresh, bool& cached) {
+  const fs::path file = dir / ("reference_" + scene.name + "_" + name_of(pixels) + "_" +
+                               std::to_string(kImageSize) + "x" + std::to_string(kImageSize) + "_" +
+                               std::to_string(spp) + "spp_seed" + std::to_string(seed) + ".exr");
+  if (!fresh && fs::exists(file)) {
+    const rc::Image image = rc::read_image(file.string());
+    if (image.width == kImageSize && image.height == kImageSize && all_finite(image.pixels))
+      return image.pixels;
+  }
+  const rc::PathSettings path;
+  rc::RenderStats stats;
+  const rc::Film film = rc::render_image(
+      scene, scene.effective_camera(), render_settings(pixels, spp, seed),
+      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); },
+      &stats);
+  if (stats.non_finite != 0 || film.non_finite_count() != 0)
+    fail("the path-traced reference has non-finite samples");
+  rc::write_image(file.string(), rc::Image{kImageSize, kImageSize, film.pixels()});
+  cached = false;
+  return film.pixels();
+}
+
+Reference make_reference(const rc::Scene& scene, Pixels pixels, int half_spp, const fs::path& dir,
+                         bool fresh) {
+  const auto start = std::chrono::steady_clock::now();
+  Reference ref;
+  ref.half_spp = half_spp;
+  const std::vector<rc::Rgb> a = reference_half(scene, pixels, half_spp, kSeeds[0], dir, fresh, ref.cached);
+  const std::vector<rc::Rgb> b = reference_half(scene, pixels, half_spp, kSeeds[1], dir, fresh, ref.cached);
+  ref.image.resize(a.size());
+  double luminance = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    ref.image[i] = (a[i] + b[i]) * 0.5f;
+    luminance += ref.image[i].luminance();
+  }
+  luminance /= double(a.size());
+  // A coarse band, like bench_path's: catches a black image, a missing light or runaway paths.
+  if (!(luminance > 0.045 && luminance < 0.4))
+    fail("implausible mean luminance " + std::to_string(luminance) +
+         " of the reference (expected about 0.135)");
+  for (size_t i = 0; i < a.size(); ++i)
+    for (int k = 0; k < 3; ++k) ref.noise += std::abs(a[i][k] - b[i][k]) / (ref.image[i][k] + 0.01);
+  ref.noise = 0.5 * ref.noise / (3.0 * double(a.size()));
+  ref.seconds = seconds_since(start);
+  std::printf("reference (%s): path tracer, 2 x %d spp, %s in %.1f s; mean luminance %.4f, noise %.3f %%\n",
+              label_of(pixels), half_spp, ref.cached ? "read from the cache" : "rendered", ref.seconds,
+              luminance, 100 * ref.noise);
+  return ref;
+}
+
+/// A radiosity render of a solution with the reference's camera, size and first seed.
+std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, const rad::RadiosityView& view, Pixels pixels,
+                                      int spp) {
+  rc::RenderStats stats;
+  const rc::Film film = rc::render_image(
+      scene, scene.effective_camera(), render_settings(pixels, spp, kSeeds[0]),
+      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); }, &stats);
+  if (stats.non_finite != 0 || film.non_finite_count() != 0) fail("a radiosity render has non-finite pixels");
+  return film.pixels();
+}
+
+rad::SolverSettings solver_settings(int elements) {
+  rad::SolverSettings s;
+  s.mesh.elements = elements;
+  s.tolerance = kTolerance;
+  s.threads = 0;
+  s.progress = false;
+  return s;
+}
+
+/// The error figures of a sweep point. `denoised` is the centre error with the reference's
+/// noise taken out in quadrature, √(e² − noise²): an estimate of the error against an exact
+/// reference, resting on the noise being independent of the discretisation error.
+enum Measure { kFiltered, kCentres, kDenoised, kMeasures };
+constexpr const char* kMeasureNames[kMeasures] = {"16-spp error", "centre error", "centre error less noise"};
+
+struct SweepPoint {
+  int requested = 0;
+  size_t elements = 0, vertices = 0;
+  uint64_t shots = 0, form_factors = 0, shadow_rays = 0;
+  double residual = 0.0, solve_seconds = 0.0, render_seconds = 0.0;
+  double error[kMeasures] = {};
+  double seconds() const { return solve_seconds + render_seconds; }
+};
+
+/// Least-squares slope of log(error) against log(seconds).
+double log_log_slope(const std::vector<SweepPoint>& points, Measure m) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = double(points.size());
+  for (const SweepPoint& p : points) {
+    const double x = std::log(p.seconds()), y = std::log(p.error[m]);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+/// Prints the time to reach the target error: interpolated in log-log between the first pair of
+/// points that brackets it, else extrapolated (and labelled so) along the slope of the last three.
+/// `floor` is the error a perfect solution would show by this measure.
+void report_time_to_target(const std::vector<SweepPoint>& points, Measure m, double floor) {
+  std::printf("  %s: ", kMeasureNames[m]);
+  if (points.front().error[m] <= kTargetError) {
+    std::printf("%.0f %% reached already by the coarsest mesh, in %.2f s\n", 100 * kTargetError,
+                points.front().seconds());
+    return;
+  }
+  for (size_t i = 0; i + 1 < points.size(); ++i) {
+    const SweepPoint &a = points[i], &b = points[i + 1];
+    if (a.error[m] > kTargetError && b.error[m] <= kTargetError) {
+      const double s =
+          (std::log(kTargetError) - std::log(a.error[m])) / (std::log(b.error[m]) - std::log(a.error[m]));
+      const double t = std::exp(std::log(a.seconds()) + s * (std::log(b.seconds()) - std::log(a.seconds())));
+      std::printf("%.0f %% after %.1f s (log-log interpolation between %d and %d elements); target %.0f s\n",
+                  100 * kTargetError, t, a.requested, b.requested, kTargetSeconds);
+      return;
+    }
+  }
+  const SweepPoint& best = points.back();
+  std::printf("%.0f %% not reached within the sweep (%.2f %% at %d elements, %.1f s)\n", 100 * kTargetError,
+              100 * best.error[m], best.requested, best.seconds());
+  if (floor >= kTargetError) {
+    std::printf("    no extrapolation: the floor of this measure (%.2f %%) is above the target\n",
+                100 * floor);
+    return;
+  }
+  const std::vector<SweepPoint> last(points.end() - std::min<size_t>(3, points.size()), points.end());
+  const double slope = last.size() >= 2 ? log_log_slope(last, m) : 0.0;
+  if (!(slope < 0.0)) {
+    std::printf("    no extrapolation: the error does not fall with time over the last points\n");
+    return;
+  }
+  const double t = best.seconds() * std::exp((std::log(kTargetError) - std::log(best.error[m])) / slope);
+  std::printf(
+      "    EXTRAPOLATED, not measured: along error ~ time^%.2f (fit to the last %zu points), %.0f %%\n"
+      "    would take about %.0f s; target %.0f s.",
+      slope, last.size(), 100 * kTargetError, t, kTargetSeconds);
+  if (floor > 0.0)
+    std::printf(
+        " Rough: the error cannot fall below this measure's floor\n"
+        "    (%.2f %%) and flattens as it nears it.",
+        100 * floor);
+  std::printf("\n");
+}
+
+void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
+  const rc::Scene scene = rc::load_scene("cornell");
+  std::printf("\n== Error against time on cornell, %d x %d: solver tolerance %g ==\n", kImageSize, kImageSize,
+              kTolerance);
+  const Reference refs[2] = {make_reference(scene, Pixels::filtered, half_spp, out_dir, fresh_reference),
+                             make_reference(scene, Pixels::centres, half_spp, out_dir, fresh_reference)};
+
+  // Untimed warm-up (thread pool, Embree), and the noise of a 16-spp display: the same solution
+  // at 16 and at 1024 filtered spp differs only by where the pixel filter was sampled.
+  const rad::Solution warm = rad::solve(scene, solver_settings(1000));
+  const rad::RadiosityView warm_view(scene, warm);
+  const double display_noise =
+      mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
+                          radiosity_render(scene, warm_view, Pixels::filtered, kDisplaySpp));
+  std::printf(
+      "display noise of a %d-spp filtered radiosity render: %.3f %% (1000 elements, against %d spp)\n",
+      kRadiositySpp, 100 * display_noise, kDisplaySpp);
+  std::printf(
+      "\n  time = solve (meshing included) + view + %d-spp render. 16-spp: that render against the\n"
+      "  filtered reference. centre: the same solution rendered through pixel centres (1 spp, exact)\n"
+      "  against the pixel-centre reference. less noise: sqrt(centre^2 - reference noise^2), an estimate\n"
+      "  of the centre error against an exact reference.\n",
+      kRadiositySpp);
+
+  std::vector<SweepPoint> points;
+  std::printf("\n  %9s %8s %8s %7s %9s %8s %8s %8s %9s %9s %12s\n", "requested", "elements", "vertices",
+              "shots", "residual", "solve s", "render s", "total s", "16-spp %", "centre %", "less noise %");
+  for (int requested : kSweepElements) {
+    if (!points.empty()) {
+      // Progressive refinement costs shots × vertices, both about proportional to the elements:
+      // predict this point quadratically from the last and skip it when over budget.
+      const SweepPoint& last = points.back();
+      const double predicted = last.seconds() * std::pow(double(requested) / last.requested, 2.0);
+      if (predicted > kPointBudget) {
+        std::printf(
+            "  %9d skipped: predicted %.0f s (time ~ elements^2 from the last point), budget %.0f s\n",
+            requested, predicted, kPointBudget);
+        continue;
+      }
+    }
+    SweepPoint p;
+    p.requested = requested;
+    const auto start = std::chrono::steady_clock::now();
+    const rad::Solution sol = rad::solve(scene, solver_settings(requested));
+    p.solve_seconds = seconds_since(start);
+    const auto render_start = std::chrono::steady_clock::now();
+    const rad::RadiosityView view(scene, sol);
+    const std::vector<rc::Rgb> image = radiosity_render(scene, view, Pixels::filtered, kRadiositySpp);
+    p.render_seconds = seconds_since(render_start);
+    if (!(sol.residual < kTolerance))
+      fail("the solve of " + std::to_string(requested) + " elements did not converge");
+    p.elements = sol.mesh.element_count();
+    p.vertices = sol.mesh.vertex_count();
+    p.shots = sol.shots;
+    p.form_factors = sol.form_factors;
+    p.shadow_rays = sol.shadow_rays;
+    p.residual = sol.residual;
+    p.error[kFiltered] = mean_relative_error(image, refs[int(Pixels::filtered)].image);
+    p.error[kCentres] = mean_relative_error(radiosity_render(scene, view, Pixels::centres, 1),
+                                            refs[int(Pixels::centres)].image);
+    const double noise = refs[int(Pixels::centres)].noise;
+    p.error[kDenoised] = std::sqrt(std::max(1e-12, p.error[kCentres] * p.error[kCentres] - noise * noise));
+    points.push_back(p);
+    std::printf("  %9d %8zu %8zu %7llu %9.2e %8.2f %8.2f %8.2f %9.3f %9.3f %12.3f\n", p.requested, p.elements,
+                p.vertices, (unsigned long long)p.shots, p.residual, p.solve_seconds, p.render_seconds,
+                p.seconds(), 100 * p.error[kFiltered], 100 * p.error[kCentres], 100 * p.error[kDenoised]);
+    std::fflush(stdout);
+  }
+  std::printf(
+      "\n  floors (error of a perfect solution): 16-spp about %.2f %% (display %.2f %% and reference %.2f "
+      "%%\n"
+      "  noise together), centre %.2f %% (reference noise)\n",
+      100 * std::hypot(display_noise, refs[0].noise), 100 * display_noise, 100 * refs[0].noise,
+      100 * refs[1].noise);
+  report_time_to_target(points, kFiltered, std::hypot(display_noise, refs[0].noise));
+  report_time_to_target(points, kCentres, refs[1].noise);
+  report_time_to_target(points, kDenoised, 0.0);
+
+  const fs::path csv = out_dir / "radiosity_sweep.csv";
+  std::ofstream out(csv);
+  out << "requested_elements,elements,vertices,shots,form_factors,shadow_rays,residual,solve_seconds,"
+         "render_seconds,seconds,error_16spp,error_centres,error_centres_less_noise,reference_spp,"
+         "reference_noise_filtered,reference_noise_centres,display_noise_16spp\n";
+  for (const SweepPoint& p : points) {
+    char line[400];
+    std::snprintf(line, sizeof line,
+                  "%d,%zu,%zu,%llu,%llu,%llu,%.6e,%.4f,%.4f,%.4f,%.8f,%.8f,%.8f,%d,%.8f,%.8f,%.8f\n",
+                  p.requested, p.elements, p.vertices, (unsigned long long)p.shots,
+                  (unsigned long long)p.form_factors, (unsigned long long)p.shadow_rays, p.residual,
+                  p.solve_seconds, p.render_seconds, p.seconds(), p.error[kFiltered], p.error[kCentres],
+                  p.error[kDenoised], 2 * half_spp, refs[0].noise, refs[1].noise, display_noise);
+    out << line;
+  }
+  if (!out) fail("cannot write " + csv.string());
+  std::printf("  written to %s\n", csv.string().c_str());
+}
+
+// ================================================================================================
+// Part 2: form factors per second.
+
+constexpr size_t kConfigurations = size_t(1) << 16;
+
+/// A receiving point with its unit normal and a source triangle.
+struct Configuration {
+  DVec3 p, n, a, b, c;
+};
+
+DVec3 uniform_in_cube(rc::Rng& rng) { return DVec3(rng.uniform(), rng.uniform(), rng.uniform()); }
+
+/// Random triangles in the unit cube, each seen by a random point in front of it (the solver
+/// only asks for those) whose normal is uniform on the sphere: some sources lie wholly in front
+/// of the receiver's tangent plane, some are clipped by it and some wholly behind it.
+std::vector<Configuration> random_configurations() {
+  std::vector<Configuration> configs;
+  configs.reserve(kConfigurations);
+  for (size_t i = 0; configs.size() < kConfigurations; ++i) {
+    rc::Rng rng = rc::Rng::for_item(7, i, 0);
+    Configuration c{uniform_in_cube(rng), DVec3(0.0), uniform_in_cube(rng), uniform_in_cube(rng),
+                    uniform_in_cube(rng)};
+    const DVec3 normal = glm::cross(c.b - c.a, c.c - c.a);
+    const double side = glm::dot(normal, c.p - c.a);
+    if (!(std::abs(side) > 1e-6)) continue;  // receiver (nearly) in the source's plane
+    if (side < 0.0) std::swap(c.b, c.c);     // let the source face the receiver
+    const double z = 2.0 * rng.uniform() - 1.0, phi = 2.0 * 3.14159265358979 * rng.uniform();
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    c.n = DVec3(r * std::cos(phi), r * std::sin(phi), z);
+    configs.push_back(c);
+  }
+  return configs;
+}
+
+/// Vertex–element pairs of the cornell mesh at 1000 elements, the vertex in front of the element,
+/// as the solver meets them.
+std::vector<Configuration> cornell_configurations() {
+  const rc::Scene scene = rc::load_scene("cornell");
+  rad::MeshSettings settings;
+  settings.elements = 1000;
+  const rad::RadiosityMesh mesh = rad::build_mesh(scene, settings);
+  std::vector<Configuration> configs;
+  configs.reserve(kConfigurations);
+  for (size_t i = 0; configs.size() < kConfigurations; ++i) {
+    rc::Rng rng = rc::Rng::for_item(8, i, 0);
+    const size_t v = std::min(mesh.vertex_count() - 1, size_t(rng.uniform() * float(mesh.vertex_count())));
+    const size_t e = std::min(mesh.element_count() - 1, size_t(rng.uniform() * float(mesh.element_count())));
+    const auto& el = mesh.elements[e];
+    if (!(glm::dot(mesh.element_normal[e], mesh.positions[v] - mesh.positions[el[0]]) > 0.0f)) continue;
+    configs.push_back({DVec3(mesh.positions[v]), DVec3(mesh.normals[v]), DVec3(mesh.positions[el[0]]),
+                       DVec3(mesh.positions[el[1]]), DVec3(mesh.positions[el[2]])});
+  }
+  return configs;
+}
+
+/// Stops the program unless every factor is finite and in [0, 1]; returns how many are zero.
+size_t check_configurations(const char* name, const std::vector<Configuration>& configs) {
+  size_t zero = 0;
+  for (size_t i = 0; i < configs.size(); ++i) {
+    const Configuration& c = configs[i];
+    const double f = rad::point_to_triangle_form_factor(c.p, c.n, c.a, c.b, c.c);
+    if (!std::isfinite(f) || f < 0.0 || f > 1.0)
+      fail(std::string(name) + " configuration " + std::to_string(i) + ": form factor " + std::to_string(f));
+    zero += f == 0.0;
+  }
+  return zero;
+}
+
+/// Howell's differential element under a parallel unit square at height 1, its normal through a
+/// corner: 0.138532. The square is split into two triangles, whose factors must add up.
+void check_howell() {
+  const DVec3 p(0.0), n(0.0, 0.0, 1.0);
+  const DVec3 a(0, 0, 1), b(0, 1, 1), c(1, 1, 1), d(1, 0, 1);  // counter-clockwise seen from below
+  const double f =
+      rad::point_to_triangle_form_factor(p, n, a, b, c) + rad::point_to_triangle_form_factor(p, n, a, c, d);
+  if (!(std::abs(f - 0.138532) <= 1e-6))
+    fail("Howell's corner case gives " + std::to_string(f) + ", not 0.138532");
+}
+
+void BM_FormFactor(benchmark::State& state, const std::vector<Configuration>& configs) {
+  for (auto _ : state)
+    for (const Configuration& c : configs) {
+      double f = rad::point_to_triangle_form_factor(c.p, c.n, c.a, c.b, c.c);
+      benchmark::DoNotOptimize(f);
+    }
+  // Shown as "form_factors=…M/s".
+  state.counters["form_factors"] =
+      benchmark::Counter(double(state.iterations()) * double(configs.size()), benchmark::Counter::kIsRate);
+}
+
+void run_form_factors() {
+  check_howell();
+  static const std::vector<Configuration> random = random_configurations();
+  static const std::vector<Configuration> cornell = cornell_configurations();
+  const size_t random_zero = check_configurations("random", random);
+  const size_t cornell_zero = check_configurations("cornell", cornell);
+  std::printf(
+      "\n== Form factors per second (one thread, CPU time) ==\n"
+      "checked: Howell's corner case 0.138532 within 1e-6; all %zu + %zu factors finite and in [0, 1]\n"
+      "  random: triangles in the unit cube, receiver in front, normal uniform on the sphere (%.1f %% zero)\n"
+      "  cornell: vertex-element pairs of the 1000-element cornell mesh, vertex in front (%.1f %% zero)\n",
+      random.size(), cornell.size(), 100.0 * double(random_zero) / double(random.size()),
+      100.0 * double(cornell_zero) / double(cornell.size()));
+  std::fflush(stdout);
+  benchmark::AddCustomContext("form_factor_configurations", std::to_string(kConfigurations));
+  benchmark::RegisterBenchmark("BM_FormFactor_Random", BM_FormFactor, std::cref(random))
+      ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("BM_FormFactor_Cornell", BM_FormFactor, std::cref(cornell))
+      ->Unit(benchmark::kMillisecond);
+  benchmark::RunSpecifiedBenchmarks();
+}
+
+// ================================================================================================
+// Part 3: how the solve cost grows with the element count.
+
+constexpr int kScalingElements[] = {1000, 10000, 100000};
+constexpr double kShootingBudget = 20.0;  // seconds of shooting per size
+
+void run_scaling(const fs::path& out_dir) {
+  const rc::Scene scene = rc::load_scene("cornell");
+  std::printf(
+      "\n== Solve cost against element count on cornell: tolerance %g, at most about %.0f s of shooting ==\n",
+      kTolerance, kShootingBudget);
+  std::printf("  %9s %8s %8s %7s %7s %8s %8s %10s %10s %9s %9s %s\n", "requested", "elements", "vertices",
+              "mesh s", "shots", "shoot s", "shots/s", "FF/s", "rays/s", "no rays %", "residual",
+              "stopped by");
+  std::ofstream csv(out_dir / "radiosity_scaling.csv");
+  csv << "requested_elements,elements,vertices,mesh_seconds,shots,shooting_seconds,shots_per_second,"
+         "form_factors_per_second,shadow_rays_per_second,pairs_without_rays,residual,hit_time_limit\n";
+  struct Limited {
+    size_t elements;
+    double shots_per_second;
+  };
+  std::vector<Limited> limited_runs;
+  double shots_per_element = 0.0;  // of the largest run that converged
+  for (int requested : kScalingElements) {
+    rad::SolverSettings settings = solver_settings(requested);
+    // solve() meshes too, and its time limit counts from its start: meshing is timed on its own
+    // first, and the limit leaves about the same time to shoot at every size.
+    const auto mesh_start = std::chrono::steady_clock::now();
+    const rad::RadiosityMesh mesh = rad::build_mesh(scene, settings.mesh);
+    const double mesh_seconds = seconds_since(mesh_start);
+    settings.time_limit = mesh_seconds + kShootingBudget;
+    const auto solve_start = std::chrono::steady_clock::now();
+    const rad::Solution sol = rad::solve(scene, settings);
+    const double shooting = std::max(1e-9, seconds_since(solve_start) - mesh_seconds);
+    if (sol.mesh.element_count() != mesh.element_count() || sol.mesh.vertex_count() != mesh.vertex_count())
+      fail("build_mesh and solve meshed " + std::to_string(requested) + " elements differently");
+    for (const rc::Rgb& b : sol.vertex_radiosity)
+      if (!(b.r >= 0.0f && b.g >= 0.0f && b.b >= 0.0f && std::isfinite(b.r + b.g + b.b)))
+        fail("negative or non-finite radiosity at " + std::to_string(requested) + " elements");
+    const bool limited = !(sol.residual < kTolerance);
+    if (limited)
+      limited_runs.push_back({mesh.element_count(), double(sol.shots) / shooting});
+    else
+      shots_per_element = double(sol.shots) / double(mesh.element_count());
+    const double without_rays = double(sol.skipped_pairs) / double(std::max<uint64_t>(1, sol.form_factors));
+    std::printf("  %9d %8zu %8zu %7.2f %7llu %8.2f %8.1f %10.3e %10.3e %9.1f %9.2e %s\n", requested,
+                mesh.element_count(), mesh.vertex_count(), mesh_seconds, (unsigned long long)sol.shots,
+                shooting, double(sol.shots) / shooting, double(sol.form_factors) / shooting,
+                double(sol.shadow_rays) / shooting, 100 * without_rays, sol.residual,
+                limited ? "TIME LIMIT" : "tolerance");
+    std::fflush(stdout);
+    char line[320];
+    std::snprintf(line, sizeof line, "%d,%zu,%zu,%.4f,%llu,%.4f,%.4f,%.6e,%.6e,%.6f,%.6e,%d\n", requested,
+                  mesh.element_count(), mesh.vertex_count(), mesh_seconds, (unsigned long long)sol.shots,
+                  shooting, double(sol.shots) / shooting, double(sol.form_factors) / shooting,
+                  double(sol.shadow_rays) / shooting, without_rays, sol.residual, limited ? 1 : 0);
+    csv << line;
+  }
+  if (!csv) fail("cannot write " + (out_dir / "radiosity_scaling.csv").string());
+  std::printf(
+      "  shoot s: solve time after meshing; FF/s and rays/s: form factors and shadow rays per second of\n"
+      "  it; no rays %%: pairs with a non-zero form factor proven visible without shadow rays, per form "
+      "factor\n");
+  if (shots_per_element > 0.0)
+    for (const Limited& run : limited_runs)
+      std::printf(
+          "  ESTIMATE, not measured: at %.1f shots per element (the largest converged run) and this run's\n"
+          "  shots/s, a full solve of %zu elements would take about %.0f s\n",
+          shots_per_element, run.elements, shots_per_element * double(run.elements) / run.shots_per_second);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  bool sweep = false, form_factors = false, scaling = false, fresh_reference = false;
+  int half_spp = kHalfSpp;
+  fs::path out_dir = "out/bench";
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--sweep")
+      sweep = true;
+    else if (arg == "--form-factors")
+      form_factors = true;
+    else if (arg == "--scaling")
+      scaling = true;
+    else if (arg == "--fresh-reference")
+      fresh_reference = true;
+    else if (arg.starts_with("--out-dir="))
+      out_dir = std::string(arg.substr(10));
+    else if (arg.starts_with("--reference-spp="))
+      half_spp = std::max(1, std::atoi(argv[i] + 16) / 2);
+    else
+      fail("unknown option '" + std::string(arg) + "' (parts: --sweep --form-factors --scaling)");
+  }
+  if (!sweep && !form_factors && !scaling) sweep = form_factors = scaling = true;
+  fs::create_directories(out_dir);
+
+  const auto start = std::chrono::steady_clock::now();
+  std::printf("bench_radiosity: %d hardware threads, all used (threads = 0)\n", rc::hardware_threads());
+  if (form_factors) run_form_factors();
+  if (sweep) run_sweep(out_dir, half_spp, fresh_reference);
+  if (scaling) run_scaling(out_dir);
+  std::printf("\nbench_radiosity: done in %.0f s\n", seconds_since(start));
+  benchmark::Shutdown();
+  return EXIT_SUCCESS;
+}
