@@ -54,4 +54,17 @@ double point_to_triangle_form_factor(const DVec3& p, const DVec3& n, const DVec3
   return point_to_polygon_form_factor(p, n, tri);
 }
 
+SourceTriangle::SourceTriangle(const Vec3& a, const Vec3& b, const Vec3& c)
+    : a_(a), b_(b), c_(c), centroid_((a + b + c) / 3.0f), twice_area_normal_(glm::cross(b - a, c - a)) {
+  const float twice_area = glm::length(twice_area_normal_);
+  normal_ = twice_area > 0.0f ? twice_area_normal_ / twice_area : Vec3(0.0f);
+  plane_offset_ = glm::dot(normal_, a);
+  for (const Vec3& v : {a, b, c}) radius_ = std::max(radius_, glm::length(v - centroid_));
+  far_distance2_ = kFarFieldRatio * kFarFieldRatio * radius_ * radius_;
+  const Vec3 m = (a + b + c) * (1.0f / 6.0f);
+  rule_points_[0] = m + 0.5f * a;
+  rule_points_[1] = m + 0.5f * b;
+  rule_points_[2] = m + 0.5f * c;
+}
+
 }  // namespace gilt::radiosity

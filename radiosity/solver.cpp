@@ -14,6 +14,8 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <span>
+#include <unordered_map>
 
 #include "radiosity/form_factor.h"
 #include "raytrace_core/error.h"
@@ -134,6 +136,69 @@ bool tetrahedron_may_meet_box(const Vec3& p, const Vec3& a, const Vec3& b, const
   return true;
 }
 
+/// Largest shooting patch: the per-vertex scratch arrays live on the stack.
+constexpr size_t kMaxPatchElements = 64;
+
+/// Shooting patches: groups of adjacent elements of one surface and material, all facing about
+/// the same way, grown breadth-first from a seed so they come out compact. Shooting a patch
+/// sends each element's own unshot radiosity through its own exact form factor; only the
+/// visibility estimate is shared, so the patch size trades shadow-ray count against how finely
+/// visibility resolves across the source.
+struct Patches {
+  std::vector<uint32_t> offsets{0};  ///< patch q holds elements[offsets[q] .. offsets[q + 1])
+  std::vector<uint32_t> elements;
+
+  size_t count() const { return offsets.size() - 1; }
+  std::span<const uint32_t> of(size_t q) const {
+    return {elements.data() + offsets[q], elements.data() + offsets[q + 1]};
+  }
+};
+
+Patches build_patches(const RadiosityMesh& mesh, int patch_elements) {
+  const size_t target = std::clamp<size_t>(size_t(std::max(1, patch_elements)), 1, kMaxPatchElements);
+  const size_t ne = mesh.element_count();
+  // Elements across each edge (vertices are split at material and sharp-normal changes, so an
+  // edge joins elements of one smooth surface).
+  std::unordered_map<uint64_t, std::array<uint32_t, 2>> by_edge;
+  by_edge.reserve(ne * 2);
+  auto edge_key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
+  constexpr uint32_t none = ~0u;
+  for (uint32_t e = 0; e < ne; ++e)
+    for (int i = 0; i < 3; ++i) {
+      auto [it, fresh] = by_edge.try_emplace(edge_key(mesh.elements[e][i], mesh.elements[e][(i + 1) % 3]),
+                                             std::array<uint32_t, 2>{e, none});
+      if (!fresh && it->second[1] == none) it->second[1] = e;
+    }
+  Patches patches;
+  patches.elements.reserve(ne);
+  std::vector<bool> taken(ne, false);
+  std::vector<uint32_t> queue;
+  for (uint32_t seed = 0; seed < ne; ++seed) {
+    if (taken[seed]) continue;
+    queue.assign(1, seed);
+    taken[seed] = true;
+    const size_t first = patches.elements.size();
+    for (size_t head = 0; head < queue.size() && patches.elements.size() - first < target; ++head) {
+      const uint32_t e = queue[head];
+      patches.elements.push_back(e);
+      for (int i = 0; i < 3; ++i) {
+        const auto& pair = by_edge[edge_key(mesh.elements[e][i], mesh.elements[e][(i + 1) % 3])];
+        const uint32_t other = pair[0] == e ? pair[1] : pair[0];
+        if (other == none || taken[other] || mesh.element_material[other] != mesh.element_material[seed] ||
+            mesh.element_surface[other] != mesh.element_surface[seed] ||
+            glm::dot(mesh.element_normal[other], mesh.element_normal[seed]) < 0.9f)
+          continue;
+        taken[other] = true;
+        queue.push_back(other);
+      }
+    }
+    // Queued elements that did not fit go back to the pool.
+    for (size_t i = patches.elements.size() - first; i < queue.size(); ++i) taken[queue[i]] = false;
+    patches.offsets.push_back(uint32_t(patches.elements.size()));
+  }
+  return patches;
+}
+
 /// Irradiance at vertex v from a punctual or environment light, with visibility.
 Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc::SurfacePoint& at, const Vec3& n,
                         rc::Rng& rng, int samples, uint64_t& rays) {
@@ -227,21 +292,24 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
   }
 
-  // Shooting.
+  // Shooting, patch by patch.
+  const Patches patches = build_patches(mesh, settings.patch_elements);
+  sol.patches = patches.count();
   const int strata = std::max(1, int(std::round(std::sqrt(double(settings.visibility_samples)))));
   // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
   rc::Progress progress("radiosity", 1000, "‰", settings.progress);
   uint64_t shown = 0;
-  double unshot_power = emitted_power;
+  std::vector<Rgb> shot;  // the shooting patch's unshot radiosity, per element
+  std::vector<SourceTriangle> source_triangle;
   while (emitted_power > 0.0) {
-    // The element with the most unshot power.
+    // The patch with the most unshot power.
     size_t src = 0;
-    double best = -1.0;
-    unshot_power = 0.0;
-    for (size_t e = 0; e < ne; ++e) {
-      const double p = double(unshot[e].average()) * mesh.element_area[e];
+    double best = -1.0, unshot_power = 0.0;
+    for (size_t q = 0; q < patches.count(); ++q) {
+      double p = 0.0;
+      for (uint32_t e : patches.of(q)) p += double(unshot[e].average()) * mesh.element_area[e];
       unshot_power += p;
-      if (p > best) best = p, src = e;
+      if (p > best) best = p, src = q;
     }
     sol.residual = unshot_power / emitted_power;
     const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
@@ -249,52 +317,98 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     if (sol.residual < settings.tolerance) break;
     if (settings.time_limit > 0.0 && elapsed() > settings.time_limit) break;
 
-    const Rgb shot = unshot[src];
-    unshot[src] = Rgb(0.0f);
-    const auto& se = mesh.elements[src];
-    const DVec3 a(mesh.positions[se[0]]), b(mesh.positions[se[1]]), c(mesh.positions[se[2]]);
-    const Vec3 src_normal = mesh.element_normal[src];
+    const std::span<const uint32_t> source = patches.of(src);
+    shot.resize(source.size());
+    source_triangle.resize(source.size());
+    for (size_t k = 0; k < source.size(); ++k) {
+      shot[k] = unshot[source[k]];
+      unshot[source[k]] = Rgb(0.0f);
+      const auto& el = mesh.elements[source[k]];
+      source_triangle[k] = SourceTriangle(mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]]);
+    }
     const uint64_t shot_index = sol.shots++;
+    // Light that has been reflected at least once is soft: one stratified ray per pair and shot
+    // estimates its visibility without bias, and the noise averages out over the many shots that
+    // reach each vertex. Emitters cast the sharp shadows and get the adaptive probe.
+    bool emitter = false;
+    for (uint32_t e : source) emitter = emitter || !scene.materials[mesh.element_material[e]].emission.is_black();
+    rc::Bounds3 source_box;
+    for (uint32_t e : source)
+      for (uint32_t v : mesh.elements[e]) source_box.extend(mesh.positions[v]);
+    const int probe = emitter ? std::min(2, strata) : std::min(settings.reflected_visibility_probe, strata);
 
     rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
       uint64_t local_ff = 0, local_rays = 0, local_skipped = 0;
+      // Per source element: its share of what the vertex receives, as a running sum for sampling.
+      std::array<float, kMaxPatchElements> cdf;
+      std::array<uint32_t, kMaxPatchElements> which;
       for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
         const Vec3& p = ray_origin[v];
-        // Receivers behind the source, or facing away from all of it, get nothing.
-        if (glm::dot(src_normal, p - mesh.positions[se[0]]) <= 0.0f) continue;
-        const double f = point_to_triangle_form_factor(DVec3(p), DVec3(mesh.normals[v]), a, b, c);
-        ++local_ff;
-        if (!(f > 0.0)) continue;
-        double visible = 1.0;
+        const Vec3& n = mesh.normals[v];
+        Rgb gathered(0.0f);
+        float total = 0.0f;
+        size_t count = 0;
+        for (size_t k = 0; k < source.size(); ++k) {
+          const double f = source_triangle[k].form_factor(p, n);
+          ++local_ff;
+          if (!(f > 0.0)) continue;
+          const Rgb share = shot[k] * float(f);
+          if (share.is_black()) continue;
+          gathered += share;
+          total += share.average();
+          cdf[count] = total;
+          which[count++] = source[k];
+        }
+        if (count == 0 || !(total > 0.0f)) continue;
+        // Occluders that the box around v and the patch misses cannot block; for the sharp
+        // shadows of emitters the remaining ones are tested against each element's tetrahedron.
         bool may_be_blocked = false;
-        for (const rc::Bounds3& box : occluders)
-          if (tetrahedron_may_meet_box(p, mesh.positions[se[0]], mesh.positions[se[1]], mesh.positions[se[2]], box)) {
+        const rc::Bounds3 reach{glm::min(source_box.lo, p), glm::max(source_box.hi, p)};
+        for (const rc::Bounds3& box : occluders) {
+          if (!reach.overlaps(box)) continue;
+          if (!emitter) {
             may_be_blocked = true;
             break;
           }
+          for (size_t k = 0; k < count && !may_be_blocked; ++k) {
+            const auto& el = mesh.elements[which[k]];
+            may_be_blocked = tetrahedron_may_meet_box(p, mesh.positions[el[0]], mesh.positions[el[1]],
+                                                      mesh.positions[el[2]], box);
+          }
+          if (may_be_blocked) break;
+        }
+        double visible = 1.0;
         if (!may_be_blocked) {
           ++local_skipped;
         } else {
-          // Adaptive visibility: a 2×2 stratified probe of the source; only when it is split
-          // between blocked and open (a penumbra) the full strata × strata set decides.
+          // Adaptive visibility: a 2×2 stratified probe of the patch, each point drawn in
+          // proportion to what its element sends to v; only when it is split between blocked
+          // and open (a penumbra) the full strata × strata set decides.
           rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
           auto fraction_open = [&](int n) {
             int open = 0;
             for (int i = 0; i < n; ++i)
               for (int j = 0; j < n; ++j) {
-                const rc::Vec2 u((i + rng.uniform()) / n, (j + rng.uniform()) / n);
-                const rc::Vec2 bary = rc::sample_uniform_triangle(u);
-                const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[se[0]] + bary.x * mesh.positions[se[1]] +
-                               bary.y * mesh.positions[se[2]];
+                // u.x picks the element by the running sum and is then stretched back to [0, 1).
+                float ux = (float(i) + rng.uniform()) / float(n) * total;
+                size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + count, ux) - cdf.begin());
+                k = std::min(k, count - 1);
+                const float lo = k ? cdf[k - 1] : 0.0f;
+                ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
+                const rc::Vec2 bary = rc::sample_uniform_triangle({ux, (float(j) + rng.uniform()) / float(n)});
+                const auto& el = mesh.elements[which[k]];
+                const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
+                               bary.y * mesh.positions[el[2]];
                 ++local_rays;
-                open += !scene.occluded(rc::spawn_shadow_ray(vertex_point[v], surface_point(q, src_normal)));
+                open += !scene.occluded(
+                    rc::spawn_shadow_ray(vertex_point[v], surface_point(q, mesh.element_normal[which[k]])));
               }
             return double(open) / double(n * n);
           };
-          visible = fraction_open(std::min(2, strata));
-          if (visible > 0.0 && visible < 1.0 && strata > 2) visible = fraction_open(strata);
+          visible = fraction_open(probe);
+          if (emitter && visible > 0.0 && visible < 1.0 && strata > probe) visible = fraction_open(strata);
         }
-        received[v] = shot * float(f * visible);
+        received[v] = gathered * float(visible);
       }
       form_factors += local_ff;
       rays += local_rays;

@@ -1,8 +1,9 @@
 #pragma once
 // Progressive-refinement radiosity (Cohen, Chen, Wallace & Greenberg 1988) with receiver-vertex
-// to source-element form factors (Wallace, Elmquist & Haines 1989): the element with the most
-// unshot power shoots to every vertex; the unoccluded form factor is analytic (Lambert), the
-// visible fraction comes from shadow rays to stratified points on the source.
+// to source-element form factors (Wallace, Elmquist & Haines 1989): the patch (a few adjacent
+// elements of one surface) with the most unshot power shoots to every vertex; each element's
+// unoccluded form factor is analytic (Lambert), the visible fraction of the patch comes from
+// shadow rays to stratified points on it.
 
 #include <cstdint>
 #include <vector>
@@ -19,8 +20,10 @@ struct SolverSettings {
   MeshSettings mesh;
   double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
   double time_limit = 0.0;   ///< seconds; 0 = no limit
-  int visibility_samples = 16;  ///< shadow rays per vertex–element pair in a penumbra (stratified
+  int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (stratified
                                 ///< on the source); pairs a 2×2 probe finds all open or all blocked take 4
+  int reflected_visibility_probe = 1;  ///< probe side (rays = side²) for patches that only reflect light
+  int patch_elements = 16;      ///< elements per shooting patch (1: every element shoots alone)
   uint64_t seed = 0;
   int threads = 0;           ///< 0 = all
   bool progress = true;
@@ -35,10 +38,11 @@ struct Solution {
   std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
 
   // What the solve did.
-  uint64_t shots = 0;
+  uint64_t shots = 0;            ///< patches shot
+  size_t patches = 0;            ///< shooting patches the elements were grouped into
   uint64_t form_factors = 0;     ///< vertex–element form factors evaluated
   uint64_t shadow_rays = 0;
-  uint64_t skipped_pairs = 0;    ///< pairs whose visibility the scene proved without rays
+  uint64_t skipped_pairs = 0;    ///< vertex–patch pairs whose visibility the scene proved without rays
   double residual = 0.0;         ///< unshot power / emitted power at the end
   double seconds = 0.0;
   bool convex_enclosure = false; ///< nothing can occlude (an empty convex room): no visibility rays at all

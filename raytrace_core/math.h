@@ -56,6 +56,10 @@ struct Bounds3 {
   void extend(const Vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
   void extend(const Bounds3& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
   bool empty() const { return lo.x > hi.x; }
+  /// True when the two boxes share at least a point.
+  bool overlaps(const Bounds3& b) const {
+    return lo.x <= b.hi.x && b.lo.x <= hi.x && lo.y <= b.hi.y && b.lo.y <= hi.y && lo.z <= b.hi.z && b.lo.z <= hi.z;
+  }
   Vec3 center() const { return 0.5f * (lo + hi); }
   Vec3 diagonal() const { return hi - lo; }
   /// Radius of the bounding sphere centred on center().
