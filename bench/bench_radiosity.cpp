@@ -13,7 +13,9 @@
 //
 // Other options: --out-dir=DIR (default out/bench) for the CSV files and the cached references,
 // --reference-spp=N (default 4096) for the references' samples per pixel, --fresh-reference to
-// render them again. Google Benchmark flags apply to the form-factor part. Every part checks its
+// render them again, --subdivision-levels=N to override the solver's adaptive subdivision (0:
+// none). The sweep also writes radiosity_error_<elements>.png: per-pixel relative error against
+// the centre reference, 10 % white. Google Benchmark flags apply to the form-factor part. Every part checks its
 // results before it reports a time, and stops with a message when they are wrong.
 
 #include <benchmark/benchmark.h>
@@ -185,8 +187,24 @@ std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, const rad::Radiosi
   return film.pixels();
 }
 
+/// Where the error is: each pixel's relative error (channel mean, as in mean_relative_error),
+/// scaled so that 10 % shows white, written as a greyscale PNG.
+void write_error_image(const fs::path& file, const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
+  std::vector<rc::Rgb> error(image.size());
+  for (size_t i = 0; i < image.size(); ++i) {
+    float e = 0.0f;
+    for (int k = 0; k < 3; ++k) e += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01f);
+    error[i] = rc::Rgb(e / 3.0f * 10.0f);
+  }
+  rc::write_image(file.string(), rc::Image{kImageSize, kImageSize, error});
+}
+
+/// Adaptive subdivision levels for every solve (--subdivision-levels=N; default: the solver's).
+int g_subdivision_levels = rad::SolverSettings{}.subdivision_levels;
+
 rad::SolverSettings solver_settings(int elements) {
   rad::SolverSettings s;
+  s.subdivision_levels = g_subdivision_levels;
   s.mesh.elements = elements;
   s.tolerance = kTolerance;
   s.threads = 0;
@@ -326,8 +344,10 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
     p.shadow_rays = sol.shadow_rays;
     p.residual = sol.residual;
     p.error[kFiltered] = mean_relative_error(image, refs[int(Pixels::filtered)].image);
-    p.error[kCentres] = mean_relative_error(radiosity_render(scene, view, Pixels::centres, 1),
-                                            refs[int(Pixels::centres)].image);
+    const std::vector<rc::Rgb> centres = radiosity_render(scene, view, Pixels::centres, 1);
+    p.error[kCentres] = mean_relative_error(centres, refs[int(Pixels::centres)].image);
+    write_error_image(out_dir / ("radiosity_error_" + std::to_string(requested) + ".png"), centres,
+                      refs[int(Pixels::centres)].image);
     const double noise = refs[int(Pixels::centres)].noise;
     p.error[kDenoised] = std::sqrt(std::max(1e-12, p.error[kCentres] * p.error[kCentres] - noise * noise));
     points.push_back(p);
@@ -563,6 +583,8 @@ int main(int argc, char** argv) {
       form_factors = true;
     else if (arg == "--scaling")
       scaling = true;
+    else if (arg.starts_with("--subdivision-levels="))
+      g_subdivision_levels = std::max(0, std::atoi(argv[i] + 21));
     else if (arg == "--fresh-reference")
       fresh_reference = true;
     else if (arg.starts_with("--out-dir="))

@@ -55,6 +55,8 @@ void run_radiosity(RadiosityOptions& o) {
                         {"elements", sol.mesh.element_count()},
                         {"vertices", sol.mesh.vertex_count()},
                         {"max_edge", sol.mesh_report.max_edge},
+                        {"refined_elements", sol.refined_elements},
+                        {"patches", sol.patches},
                         {"shots", sol.shots},
                         {"residual", sol.residual},
                         {"tolerance", o.solver.tolerance},
@@ -71,8 +73,8 @@ void run_radiosity(RadiosityOptions& o) {
     return;
   }
   std::printf("gilt radiosity: %s, %d thread(s)\n", o.scene.c_str(), threads);
-  std::printf("  mesh:    %zu elements, %zu vertices, target edge %.4g\n", sol.mesh.element_count(),
-              sol.mesh.vertex_count(), sol.mesh_report.max_edge);
+  std::printf("  mesh:    %zu elements, %zu vertices, target edge %.4g, %zu elements bisected at steep direct light\n",
+              sol.mesh.element_count(), sol.mesh.vertex_count(), sol.mesh_report.max_edge, sol.refined_elements);
   std::printf("  solve:   %llu shots, residual %.3g (tolerance %.3g)\n", static_cast<unsigned long long>(sol.shots),
               sol.residual, o.solver.tolerance);
   std::printf("  work:    %llu form factors (%.3g/s), %llu shadow rays%s\n",
@@ -94,6 +96,12 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
       ->excludes(edge);
   cmd.add_option("--tolerance", s.tolerance, "Radiosity: stop when unshot power < T x emitted power (default 1e-3)")
       ->check(CLI::Range(1e-12, 1.0));
+  cmd.add_option("--subdivision-levels", s.subdivision_levels,
+                 "Radiosity: adaptive subdivision may halve the edge length this many times (default 2; 0 = off)")
+      ->check(CLI::Range(0, 8));
+  cmd.add_option("--subdivision-threshold", s.subdivision_threshold,
+                 "Radiosity: bisect elements whose direct light spreads by more than this fraction (default 0.6)")
+      ->check(CLI::Range(1e-3, 1.0));
 }
 
 std::function<void()> add_radiosity_command(CLI::App& app) {

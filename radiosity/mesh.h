@@ -24,7 +24,7 @@ struct MeshSettings {
 };
 
 /// Default element count when neither size is given: accurate on the built-in scenes.
-inline constexpr int kDefaultElements = 6000;
+inline constexpr int kDefaultElements = 4000;
 
 /// One mesh of elements. Element e has vertices elements[e], material element_material[e].
 struct RadiosityMesh {
@@ -54,6 +54,14 @@ struct MeshReport {
 /// reported), then remeshed isotropically with boundaries and sharp edges protected. Spheres
 /// are tessellated to the same edge length.
 RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report = nullptr);
+
+/// Splits the longest edge of each listed element at its midpoint (at most once per element per
+/// call; elements whose longest edge is shorter than `min_edge` are left alone). Every element on
+/// that edge is split with it, on both sides of a sharp or material border too (each side gets
+/// its own vertex), so the mesh stays conforming: no T-junctions. Existing vertex and element
+/// indices keep their meaning (a split element keeps its index for one half); new vertices and
+/// elements are appended. Returns the number of vertices added.
+size_t split_longest_edges(RadiosityMesh& mesh, const std::vector<uint32_t>& elements, float min_edge);
 
 /// The edge length `settings` asks for on this scene (resolving `elements` and the default).
 float target_edge_length(const rc::Scene& scene, const MeshSettings& settings);

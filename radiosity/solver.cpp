@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <span>
 #include <unordered_map>
@@ -223,6 +224,129 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc
   return ls.radiance * cos_theta;
 }
 
+/// A patch about to shoot: its elements, each with its own form-factor geometry and the
+/// radiosity it sends (W·m⁻²), and how its visibility is estimated.
+struct ShootingPatch {
+  std::vector<uint32_t> elements;
+  std::vector<SourceTriangle> triangles;
+  std::vector<Rgb> radiosity;
+  rc::Bounds3 box;
+  bool emitter = false;  ///< sharp shadows: the per-element occluder test and the adaptive probe
+  int probe = 2;         ///< side of the first stratified visibility probe (rays = probe²)
+  int strata = 4;        ///< side of the full set used in a penumbra (emitters only)
+
+  void assign(const RadiosityMesh& mesh, std::span<const uint32_t> source, std::vector<Rgb>& unshot) {
+    elements.assign(source.begin(), source.end());
+    triangles.resize(source.size());
+    radiosity.resize(source.size());
+    box = rc::Bounds3{};
+    for (size_t k = 0; k < source.size(); ++k) {
+      radiosity[k] = unshot[source[k]];
+      unshot[source[k]] = Rgb(0.0f);
+      const auto& el = mesh.elements[source[k]];
+      triangles[k] = SourceTriangle(mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]]);
+      for (uint32_t v : el) box.extend(mesh.positions[v]);
+    }
+  }
+};
+
+/// Counters of one worker.
+struct Counts {
+  uint64_t form_factors = 0, rays = 0, skipped = 0;
+};
+
+/// What receives light: the mesh with the points its vertices receive at, and the occluders.
+struct Receivers {
+  const rc::Scene& scene;
+  const RadiosityMesh& mesh;
+  std::vector<Vec3> origin;                 ///< per vertex, see visibility_origins
+  std::vector<rc::SurfacePoint> point;      ///< per vertex, for spawning shadow rays
+  std::vector<rc::Bounds3> occluders;
+
+  Receivers(const rc::Scene& s, const RadiosityMesh& m) : scene(s), mesh(m), occluders(occluder_boxes(s, m)) {
+    update();
+  }
+  void update() {
+    origin = visibility_origins(mesh);
+    point.resize(mesh.vertex_count());
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) point[v] = surface_point(origin[v], mesh.normals[v]);
+  }
+
+  /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
+  /// factor times its radiosity, times the patch's visible fraction seen from v.
+  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts) const {
+    const Vec3& p = origin[v];
+    const Vec3& n = mesh.normals[v];
+    // Per source element: its share of what v receives, as a running sum for sampling.
+    std::array<float, kMaxPatchElements> cdf;
+    std::array<uint32_t, kMaxPatchElements> which;
+    Rgb gathered(0.0f);
+    float total = 0.0f;
+    size_t count = 0;
+    for (size_t k = 0; k < src.elements.size(); ++k) {
+      const double f = src.triangles[k].form_factor(p, n);
+      ++counts.form_factors;
+      if (!(f > 0.0)) continue;
+      const Rgb share = src.radiosity[k] * float(f);
+      if (share.is_black()) continue;
+      gathered += share;
+      total += share.average();
+      cdf[count] = total;
+      which[count++] = src.elements[k];
+    }
+    if (count == 0 || !(total > 0.0f)) return Rgb(0.0f);
+
+    // Occluders that the box around v and the patch misses cannot block; for the sharp shadows
+    // of emitters the remaining ones are tested against each element's tetrahedron.
+    bool may_be_blocked = false;
+    const rc::Bounds3 reach{glm::min(src.box.lo, p), glm::max(src.box.hi, p)};
+    for (const rc::Bounds3& box : occluders) {
+      if (!reach.overlaps(box)) continue;
+      if (!src.emitter) {
+        may_be_blocked = true;
+        break;
+      }
+      for (size_t k = 0; k < count && !may_be_blocked; ++k) {
+        const auto& el = mesh.elements[which[k]];
+        may_be_blocked =
+            tetrahedron_may_meet_box(p, mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]], box);
+      }
+      if (may_be_blocked) break;
+    }
+    if (!may_be_blocked) {
+      ++counts.skipped;
+      return gathered;
+    }
+    // Stratified points on the patch, each drawn in proportion to what its element sends to v;
+    // only when the probe is split between blocked and open (a penumbra) the full set decides.
+    auto fraction_open = [&](int side) {
+      int open = 0;
+      for (int i = 0; i < side; ++i)
+        for (int j = 0; j < side; ++j) {
+          // u.x picks the element by the running sum and is then stretched back to [0, 1).
+          float ux = (float(i) + rng.uniform()) / float(side) * total;
+          size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + count, ux) - cdf.begin());
+          k = std::min(k, count - 1);
+          const float lo = k ? cdf[k - 1] : 0.0f;
+          ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
+          const rc::Vec2 bary = rc::sample_uniform_triangle({ux, (float(j) + rng.uniform()) / float(side)});
+          const auto& el = mesh.elements[which[k]];
+          const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
+                         bary.y * mesh.positions[el[2]];
+          ++counts.rays;
+          open += !scene.occluded(rc::spawn_shadow_ray(point[v], surface_point(q, mesh.element_normal[which[k]])));
+        }
+      return float(open) / float(side * side);
+    };
+    float visible = fraction_open(src.probe);
+    if (src.emitter && visible > 0.0f && visible < 1.0f && src.strata > src.probe) visible = fraction_open(src.strata);
+    return gathered * visible;
+  }
+};
+
+/// Luminance-like scalar of a colour, for refinement decisions.
+float level(const Rgb& c) { return c.average(); }
+
 }  // namespace
 
 Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
@@ -230,77 +354,124 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance))
     throw rc::InputError("--tolerance must be a positive number");
   if (settings.visibility_samples < 1) throw rc::InputError("visibility samples must be at least 1");
+  if (settings.subdivision_levels < 0) throw rc::InputError("subdivision levels must be at least 0");
+  if (!(settings.subdivision_threshold > 0.0) || !std::isfinite(settings.subdivision_threshold))
+    throw rc::InputError("the subdivision threshold must be a positive number");
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const rc::ThreadLimit limit(settings.threads);
 
   Solution sol;
   sol.mesh = build_mesh(scene, settings.mesh, &sol.mesh_report);
-  const RadiosityMesh& mesh = sol.mesh;
-  const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
-  sol.vertex_irradiance.assign(nv, Rgb(0.0f));
-  sol.vertex_radiosity.assign(nv, Rgb(0.0f));
-  const std::vector<rc::Bounds3> occluders = occluder_boxes(scene, mesh);
-  sol.convex_enclosure = occluders.empty();
-
+  RadiosityMesh& mesh = sol.mesh;
+  Receivers receivers(scene, mesh);
+  sol.convex_enclosure = receivers.occluders.empty();
   auto albedo = [&](uint32_t material) { return scene.materials[material].albedo; };
   auto emitted = [&](uint32_t material) { return scene.materials[material].emission * kPi; };  // B0 = π Le
+  auto is_emitter = [&](uint32_t e) { return !scene.materials[mesh.element_material[e]].emission.is_black(); };
+  const int strata = std::max(1, int(std::round(std::sqrt(double(settings.visibility_samples)))));
+  std::atomic<uint64_t> rays{0}, form_factors{0}, skipped{0};
+  auto add_counts = [&](const Counts& c) {
+    form_factors += c.form_factors;
+    rays += c.rays;
+    skipped += c.skipped;
+  };
 
-  const std::vector<Vec3> ray_origin = visibility_origins(mesh);
-  std::vector<rc::SurfacePoint> vertex_point(nv);
-  for (size_t v = 0; v < nv; ++v) vertex_point[v] = surface_point(ray_origin[v], mesh.normals[v]);
+  // Pass 1, direct light: every vertex gathers from the punctual lights and from the emitting
+  // patches. Sharp shadows and near-field falloff show up here, so this is where the mesh is
+  // refined: elements whose vertices disagree steeply are bisected and only the new vertices
+  // gather. Vertex indices are stable under refinement, so the arrays just grow.
+  std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
+  auto gather_direct = [&](size_t first_vertex) {
+    const Patches patches = build_patches(mesh, settings.patch_elements);
+    std::vector<ShootingPatch> emitters;
+    std::vector<Rgb> radiosity(mesh.element_count());
+    for (size_t q = 0; q < patches.count(); ++q) {
+      if (!is_emitter(patches.of(q)[0])) continue;
+      for (uint32_t e : patches.of(q)) radiosity[e] = emitted(mesh.element_material[e]);
+      ShootingPatch& sp = emitters.emplace_back();
+      sp.assign(mesh, patches.of(q), radiosity);
+      sp.emitter = true;
+      sp.probe = std::min(2, strata);
+      sp.strata = strata;
+    }
+    const size_t nv = mesh.vertex_count();
+    direct_punctual.resize(nv, Rgb(0.0f));
+    direct_emitted.resize(nv, Rgb(0.0f));
+    const size_t count = nv - first_vertex;
+    rc::parallel_for((count + 127) / 128, [&](size_t chunk) {
+      Counts counts;
+      for (size_t v = first_vertex + chunk * 128; v < std::min(nv, first_vertex + chunk * 128 + 128); ++v) {
+        for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
+          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
+          direct_punctual[v] += punctual_irradiance(scene, scene.punctual_lights[li], receivers.point[v],
+                                                    mesh.normals[v], rng, settings.visibility_samples, counts.rays);
+        }
+        for (size_t q = 0; q < emitters.size(); ++q) {
+          // Keyed by the emitter's first element, which refinement never renumbers.
+          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0xa000000000ull + emitters[q].elements[0]);
+          direct_emitted[v] += receivers.receive(emitters[q], v, rng, counts);
+        }
+      }
+      add_counts(counts);
+    });
+  };
+  gather_direct(0);
+  const float base_edge = target_edge_length(scene, settings.mesh);
+  const float min_edge = base_edge * std::ldexp(1.0f, -settings.subdivision_levels);
+  for (int round = 0; round < 2 * settings.subdivision_levels; ++round) {
+    // Mark elements whose vertices' direct irradiance spreads by more than the threshold times
+    // the brightest of them (plus a floor of 1 % of the mean, so that darkness does not refine).
+    double mean = 0.0, area = 0.0;
+    for (size_t e = 0; e < mesh.element_count(); ++e) {
+      const auto& el = mesh.elements[e];
+      for (uint32_t v : el) mean += double(level(direct_punctual[v] + direct_emitted[v])) * mesh.element_area[e] / 3.0;
+      area += mesh.element_area[e];
+    }
+    const float floor = float(0.01 * mean / std::max(area, 1e-30));
+    std::vector<uint32_t> marked;
+    for (uint32_t e = 0; e < mesh.element_count(); ++e) {
+      if (is_emitter(e)) continue;
+      float lo = std::numeric_limits<float>::max(), hi = 0.0f;
+      for (uint32_t v : mesh.elements[e]) {
+        const float x = level(direct_punctual[v] + direct_emitted[v]);
+        lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+      if (hi - lo > float(settings.subdivision_threshold) * (hi + floor)) marked.push_back(e);
+    }
+    const size_t first_new = mesh.vertex_count();
+    if (marked.empty() || split_longest_edges(mesh, marked, min_edge * 1.5f) == 0) break;
+    receivers.update();
+    gather_direct(first_new);
+    sol.refined_elements += marked.size();
+  }
 
-  // Unshot radiosity per element, and each element's reflectance.
+  // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
+  // and has not shot yet.
+  const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
+  sol.vertex_irradiance.resize(nv);
+  for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
   std::vector<Rgb> unshot(ne);
   double emitted_power = 0.0;
   for (size_t e = 0; e < ne; ++e) {
-    unshot[e] = emitted(mesh.element_material[e]);
-    emitted_power += double(unshot[e].average()) * mesh.element_area[e];
+    const auto& el = mesh.elements[e];
+    const Rgb rho = albedo(mesh.element_material[e]);
+    emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
+    emitted_power += double((rho * (direct_punctual[el[0]] + direct_punctual[el[1]] + direct_punctual[el[2]])).average()) /
+                     3.0 * mesh.element_area[e];
+    unshot[e] = rho * (sol.vertex_irradiance[el[0]] + sol.vertex_irradiance[el[1]] + sol.vertex_irradiance[el[2]]) *
+                (1.0f / 3.0f);
   }
-
-  // Lights that are not meshed shoot first, straight to the vertices.
-  std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
-  std::atomic<uint64_t> rays{0}, form_factors{0}, skipped{0};
-  auto add_received = [&] {
-    // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
-    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
-    double gained = 0.0;
-    for (size_t e = 0; e < ne; ++e) {
-      const auto& el = mesh.elements[e];
-      const Rgb mean = (received[el[0]] + received[el[1]] + received[el[2]]) * (1.0f / 3.0f);
-      const Rgb db = albedo(mesh.element_material[e]) * mean;
-      unshot[e] += db;
-      gained += double(db.average()) * mesh.element_area[e];
-    }
-    std::fill(received.begin(), received.end(), Rgb(0.0f));
-    return gained;
-  };
-  for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
-    const rc::Light& light = scene.punctual_lights[li];
-    rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
-      uint64_t local_rays = 0;
-      for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
-        rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
-        received[v] = punctual_irradiance(scene, light, vertex_point[v], mesh.normals[v], rng,
-                                          settings.visibility_samples, local_rays);
-      }
-      rays += local_rays;
-    });
-    emitted_power += add_received();
-  }
-  if (!(emitted_power > 0.0)) {
+  if (!(emitted_power > 0.0))
     sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
-  }
 
-  // Shooting, patch by patch.
   const Patches patches = build_patches(mesh, settings.patch_elements);
   sol.patches = patches.count();
-  const int strata = std::max(1, int(std::round(std::sqrt(double(settings.visibility_samples)))));
   // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
   rc::Progress progress("radiosity", 1000, "‰", settings.progress);
   uint64_t shown = 0;
-  std::vector<Rgb> shot;  // the shooting patch's unshot radiosity, per element
-  std::vector<SourceTriangle> source_triangle;
+  std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
+  ShootingPatch source;
   while (emitted_power > 0.0) {
     // The patch with the most unshot power.
     size_t src = 0;
@@ -317,107 +488,32 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     if (sol.residual < settings.tolerance) break;
     if (settings.time_limit > 0.0 && elapsed() > settings.time_limit) break;
 
-    const std::span<const uint32_t> source = patches.of(src);
-    shot.resize(source.size());
-    source_triangle.resize(source.size());
-    for (size_t k = 0; k < source.size(); ++k) {
-      shot[k] = unshot[source[k]];
-      unshot[source[k]] = Rgb(0.0f);
-      const auto& el = mesh.elements[source[k]];
-      source_triangle[k] = SourceTriangle(mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]]);
-    }
+    // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
+    // without bias, and the noise averages out over the many shots that reach each vertex.
+    source.assign(mesh, patches.of(src), unshot);
+    source.emitter = false;
+    source.probe = std::min(settings.reflected_visibility_probe, strata);
+    source.strata = source.probe;
     const uint64_t shot_index = sol.shots++;
-    // Light that has been reflected at least once is soft: one stratified ray per pair and shot
-    // estimates its visibility without bias, and the noise averages out over the many shots that
-    // reach each vertex. Emitters cast the sharp shadows and get the adaptive probe.
-    bool emitter = false;
-    for (uint32_t e : source) emitter = emitter || !scene.materials[mesh.element_material[e]].emission.is_black();
-    rc::Bounds3 source_box;
-    for (uint32_t e : source)
-      for (uint32_t v : mesh.elements[e]) source_box.extend(mesh.positions[v]);
-    const int probe = emitter ? std::min(2, strata) : std::min(settings.reflected_visibility_probe, strata);
-
     rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
-      uint64_t local_ff = 0, local_rays = 0, local_skipped = 0;
-      // Per source element: its share of what the vertex receives, as a running sum for sampling.
-      std::array<float, kMaxPatchElements> cdf;
-      std::array<uint32_t, kMaxPatchElements> which;
+      Counts counts;
       for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
-        const Vec3& p = ray_origin[v];
-        const Vec3& n = mesh.normals[v];
-        Rgb gathered(0.0f);
-        float total = 0.0f;
-        size_t count = 0;
-        for (size_t k = 0; k < source.size(); ++k) {
-          const double f = source_triangle[k].form_factor(p, n);
-          ++local_ff;
-          if (!(f > 0.0)) continue;
-          const Rgb share = shot[k] * float(f);
-          if (share.is_black()) continue;
-          gathered += share;
-          total += share.average();
-          cdf[count] = total;
-          which[count++] = source[k];
-        }
-        if (count == 0 || !(total > 0.0f)) continue;
-        // Occluders that the box around v and the patch misses cannot block; for the sharp
-        // shadows of emitters the remaining ones are tested against each element's tetrahedron.
-        bool may_be_blocked = false;
-        const rc::Bounds3 reach{glm::min(source_box.lo, p), glm::max(source_box.hi, p)};
-        for (const rc::Bounds3& box : occluders) {
-          if (!reach.overlaps(box)) continue;
-          if (!emitter) {
-            may_be_blocked = true;
-            break;
-          }
-          for (size_t k = 0; k < count && !may_be_blocked; ++k) {
-            const auto& el = mesh.elements[which[k]];
-            may_be_blocked = tetrahedron_may_meet_box(p, mesh.positions[el[0]], mesh.positions[el[1]],
-                                                      mesh.positions[el[2]], box);
-          }
-          if (may_be_blocked) break;
-        }
-        double visible = 1.0;
-        if (!may_be_blocked) {
-          ++local_skipped;
-        } else {
-          // Adaptive visibility: a 2×2 stratified probe of the patch, each point drawn in
-          // proportion to what its element sends to v; only when it is split between blocked
-          // and open (a penumbra) the full strata × strata set decides.
-          rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
-          auto fraction_open = [&](int n) {
-            int open = 0;
-            for (int i = 0; i < n; ++i)
-              for (int j = 0; j < n; ++j) {
-                // u.x picks the element by the running sum and is then stretched back to [0, 1).
-                float ux = (float(i) + rng.uniform()) / float(n) * total;
-                size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + count, ux) - cdf.begin());
-                k = std::min(k, count - 1);
-                const float lo = k ? cdf[k - 1] : 0.0f;
-                ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
-                const rc::Vec2 bary = rc::sample_uniform_triangle({ux, (float(j) + rng.uniform()) / float(n)});
-                const auto& el = mesh.elements[which[k]];
-                const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
-                               bary.y * mesh.positions[el[2]];
-                ++local_rays;
-                open += !scene.occluded(
-                    rc::spawn_shadow_ray(vertex_point[v], surface_point(q, mesh.element_normal[which[k]])));
-              }
-            return double(open) / double(n * n);
-          };
-          visible = fraction_open(probe);
-          if (emitter && visible > 0.0 && visible < 1.0 && strata > probe) visible = fraction_open(strata);
-        }
-        received[v] = gathered * float(visible);
+        rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
+        received[v] = receivers.receive(source, v, rng, counts);
       }
-      form_factors += local_ff;
-      rays += local_rays;
-      skipped += local_skipped;
+      add_counts(counts);
     });
-    add_received();
+    // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
+    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
+    for (size_t e = 0; e < ne; ++e) {
+      const auto& el = mesh.elements[e];
+      unshot[e] += albedo(mesh.element_material[e]) * (received[el[0]] + received[el[1]] + received[el[2]]) *
+                   (1.0f / 3.0f);
+    }
   }
   progress.finish();
 
+  sol.vertex_radiosity.resize(nv);
   for (size_t v = 0; v < nv; ++v)
     sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + albedo(mesh.vertex_material[v]) * sol.vertex_irradiance[v];
   sol.element_radiosity.resize(ne);

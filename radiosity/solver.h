@@ -23,7 +23,10 @@ struct SolverSettings {
   int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (stratified
                                 ///< on the source); pairs a 2×2 probe finds all open or all blocked take 4
   int reflected_visibility_probe = 1;  ///< probe side (rays = side²) for patches that only reflect light
-  int patch_elements = 16;      ///< elements per shooting patch (1: every element shoots alone)
+  int patch_elements = 16;
+  int subdivision_levels = 2;          ///< adaptive subdivision may halve the mesh's edge this many times
+  double subdivision_threshold = 0.6;  ///< bisect an element whose vertices' direct irradiance spreads by more
+                                       ///< than this fraction of the brightest      ///< elements per shooting patch (1: every element shoots alone)
   uint64_t seed = 0;
   int threads = 0;           ///< 0 = all
   bool progress = true;
@@ -40,6 +43,7 @@ struct Solution {
   // What the solve did.
   uint64_t shots = 0;            ///< patches shot
   size_t patches = 0;            ///< shooting patches the elements were grouped into
+  size_t refined_elements = 0;   ///< elements bisected by adaptive subdivision
   uint64_t form_factors = 0;     ///< vertex–element form factors evaluated
   uint64_t shadow_rays = 0;
   uint64_t skipped_pairs = 0;    ///< vertex–patch pairs whose visibility the scene proved without rays
