@@ -513,6 +513,21 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   }
   progress.finish();
 
+  {
+    Rgb unshot_sum(0.0f), reflectance_sum(0.0f);
+    double area = 0.0;
+    for (size_t e = 0; e < ne; ++e) {
+      unshot_sum += unshot[e] * mesh.element_area[e];
+      reflectance_sum += albedo(mesh.element_material[e]) * mesh.element_area[e];
+      area += mesh.element_area[e];
+    }
+    if (area > 0.0) {
+      const float inv_area = float(1.0 / area);
+      const Rgb rho = reflectance_sum * inv_area;
+      for (int k = 0; k < 3; ++k) sol.ambient[k] = unshot_sum[k] * inv_area / std::max(1e-3f, 1.0f - rho[k]);
+    }
+  }
+
   sol.vertex_radiosity.resize(nv);
   for (size_t v = 0; v < nv; ++v)
     sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + albedo(mesh.vertex_material[v]) * sol.vertex_irradiance[v];

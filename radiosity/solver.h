@@ -48,6 +48,10 @@ struct Solution {
   uint64_t shadow_rays = 0;
   uint64_t skipped_pairs = 0;    ///< vertex–patch pairs whose visibility the scene proved without rays
   double residual = 0.0;         ///< unshot power / emitted power at the end
+  /// Ambient radiosity (W·m⁻²) standing in for the light not yet shot, for displaying a partial
+  /// solution only (Cohen, Chen, Wallace & Greenberg 1988): the area-weighted mean unshot
+  /// radiosity times the interreflection factor 1 / (1 − ρ̄). Never part of exported values.
+  Rgb ambient{0.0f};
   double seconds = 0.0;
   bool convex_enclosure = false; ///< nothing can occlude (an empty convex room): no visibility rays at all
   MeshReport mesh_report;

@@ -7,11 +7,15 @@
 
 namespace gilt::radiosity {
 
-RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution)
+RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, bool ambient)
     : scene_(scene), elements_(solution.mesh.elements) {
   const RadiosityMesh& mesh = solution.mesh;
   vertex_radiance_.resize(mesh.vertex_count());
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) vertex_radiance_[v] = solution.vertex_radiance(v);
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    vertex_radiance_[v] = solution.vertex_radiance(v);
+    if (ambient)
+      vertex_radiance_[v] += scene.materials[mesh.vertex_material[v]].albedo * solution.ambient * (1.0f / rc::kPi);
+  }
 
   // Geometry 0: every element; then the scene's specular meshes; spheres: the specular ones.
   display_.materials = scene.materials;

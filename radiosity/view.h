@@ -11,8 +11,9 @@ namespace gilt::radiosity {
 class RadiosityView {
  public:
   /// Builds a scene of the solution's elements plus the specular primitives of `scene`. Both
-  /// arguments must outlive the view.
-  RadiosityView(const rc::Scene& scene, const Solution& solution);
+  /// arguments must outlive the view. With `ambient`, a partial solution is shown with each
+  /// vertex's reflectance times the solution's ambient term added (display only).
+  RadiosityView(const rc::Scene& scene, const Solution& solution, bool ambient = true);
 
   /// Radiance along a camera ray: the interpolated vertex radiance where it meets an element's
   /// front, through any chain of mirror and glass bounces (at most 64).
