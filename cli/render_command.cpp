@@ -1,5 +1,6 @@
 // `gilt render SCENE -o OUT`: options → RenderSettings, then the library does the work.
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -10,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "photonmap/photon_mapper.h"
+#include "photonmap/sppm.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
 #include "raytrace_core/error.h"
@@ -41,6 +44,12 @@ struct RenderOptions {
   bool json = false;
   bool quiet = false;
   radiosity::SolverSettings solver;
+  // Photon mapping (photon, sppm).
+  std::optional<uint64_t> photons, caustic_photons;
+  int k = 50;
+  float radius = 0.0f;
+  int gather_rays = 16;
+  float alpha = 2.0f / 3.0f;
 };
 
 /// Parses "x,y,z" into a vector; `flag` names the option in the error.
@@ -78,8 +87,9 @@ void check_output(const std::string& path) {
 }
 
 void run_render(const RenderOptions& o) {
-  if (o.method != "path" && o.method != "whitted" && o.method != "radiosity")
-    throw rc::InputError("--method " + o.method + ": expected path, whitted or radiosity");
+  if (o.method != "path" && o.method != "whitted" && o.method != "radiosity" && o.method != "photon" &&
+      o.method != "sppm")
+    throw rc::InputError("--method " + o.method + ": expected path, whitted, radiosity, photon or sppm");
   check_output(o.output);
   rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
@@ -100,7 +110,31 @@ void run_render(const RenderOptions& o) {
   rc::RadianceFunction radiance;
   std::optional<radiosity::Solution> solution;
   std::optional<radiosity::RadiosityView> view;
-  if (o.method == "radiosity") {
+  std::optional<photonmap::PhotonMapper> mapper;
+  std::optional<photonmap::SppmStats> sppm_stats;
+  const auto start = std::chrono::steady_clock::now();
+  if (o.method == "photon") {
+    photonmap::PhotonMapperSettings pm;
+    if (o.photons) pm.photons.global_photons = *o.photons;
+    if (o.caustic_photons) pm.photons.caustic_photons = *o.caustic_photons;
+    pm.photons.seed = o.seed;
+    pm.k = o.k;
+    pm.max_radius = o.radius;
+    pm.gather_rays = o.gather_rays;
+    if (o.max_depth > 0) pm.max_depth = pm.photons.max_depth = o.max_depth;
+    {
+      const rc::ThreadLimit limit(o.threads);
+      mapper.emplace(scene, pm);
+    }
+    for (const std::string& s : mapper->stats().skipped)
+      if (!o.json && !o.quiet) std::cerr << "gilt: " << s << "\n";
+    radiance = [&mapper](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper->radiance(ray, ctx); };
+    // A time budget covers the photon pass too.
+    if (settings.time_limit > 0.0)
+      settings.time_limit = std::max(1e-3, settings.time_limit - std::chrono::duration<double>(
+                                                                     std::chrono::steady_clock::now() - start)
+                                                                     .count());
+  } else if (o.method == "radiosity") {
     radiosity::SolverSettings solver = o.solver;
     solver.seed = o.seed;
     solver.threads = o.threads;
@@ -120,7 +154,24 @@ void run_render(const RenderOptions& o) {
   }
 
   rc::RenderStats stats;
-  const rc::Film film = rc::render_image(scene, camera, settings, radiance, &stats);
+  rc::Film film;
+  if (o.method == "sppm") {
+    photonmap::SppmSettings sp;
+    if (o.photons) sp.photons_per_iteration = *o.photons;
+    sp.initial_radius = o.radius;
+    sp.alpha = o.alpha;
+    if (o.max_depth > 0) sp.max_depth = o.max_depth;
+    sppm_stats.emplace();
+    film = photonmap::render_sppm(scene, camera, settings, sp, &*sppm_stats);
+    stats.spp = sppm_stats->iterations;
+    stats.samples = uint64_t(sppm_stats->iterations) * settings.width * settings.height;
+    stats.rays = sppm_stats->rays;
+    stats.seconds = sppm_stats->seconds;
+  } else {
+    film = rc::render_image(scene, camera, settings, radiance, &stats);
+  }
+  // The method's preparation (a radiosity solve, photon tracing) counts in the time.
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   rc::write_image(o.output, rc::Image{film.width(), film.height(), film.pixels()}, o.exposure);
   if (stats.non_finite > 0)
     std::cerr << "gilt: warning: " << stats.non_finite << " sample(s) were NaN or infinite and were discarded\n";
@@ -150,6 +201,19 @@ void run_render(const RenderOptions& o) {
       j["radiosity"] = {{"elements", solution->mesh.element_count()}, {"shots", solution->shots},
                         {"residual", solution->residual}, {"seconds", solution->seconds}};
     }
+    if (mapper) {
+      const photonmap::PhotonMapperStats& ps = mapper->stats();
+      j["photon"] = {{"global_photons", ps.global_photons},       {"caustic_photons", ps.caustic_photons},
+                     {"paths", ps.paths},                         {"irradiance_points", ps.irradiance_points},
+                     {"trace_seconds", ps.trace_seconds},         {"precompute_seconds", ps.precompute_seconds},
+                     {"max_radius", ps.max_radius},               {"skipped", ps.skipped}};
+    }
+    if (sppm_stats) {
+      j["sppm"] = {{"iterations", sppm_stats->iterations},
+                   {"photons", sppm_stats->photons},
+                   {"initial_radius", sppm_stats->initial_radius},
+                   {"mean_final_radius", sppm_stats->mean_final_radius}};
+    }
     std::cout << j.dump() << std::endl;
   } else {
     std::printf("gilt render: %s, method %s, %dx%d, %d spp, seed %llu, %d thread(s)\n", o.scene.c_str(),
@@ -164,7 +228,16 @@ void run_render(const RenderOptions& o) {
     if (solution)
       std::printf("  solve:   %zu elements, %llu shots, residual %.3g, %.3f s\n", solution->mesh.element_count(),
                   static_cast<unsigned long long>(solution->shots), solution->residual, solution->seconds);
-    std::printf("  time:    %.3f s%s\n", stats.seconds, solution ? " (render, after the solve)" : "");
+    if (mapper)
+      std::printf("  photons: %zu global, %zu caustic stored from %llu paths in %.3f s; %zu irradiance points in %.3f s\n",
+                  mapper->stats().global_photons, mapper->stats().caustic_photons,
+                  static_cast<unsigned long long>(mapper->stats().paths), mapper->stats().trace_seconds,
+                  mapper->stats().irradiance_points, mapper->stats().precompute_seconds);
+    if (sppm_stats)
+      std::printf("  sppm:    %d iterations, %llu photons, radius %.4g -> %.4g (mean)\n", sppm_stats->iterations,
+                  static_cast<unsigned long long>(sppm_stats->photons), sppm_stats->initial_radius,
+                  sppm_stats->mean_final_radius);
+    std::printf("  time:    %.3f s (all passes)\n", stats.seconds);
     std::printf("  wrote %s\n", o.output.c_str());
   }
 }
@@ -178,8 +251,22 @@ std::function<void()> add_render_command(CLI::App& app) {
                                      "(cornell, cornell-caustics, furnace, smallpt)")
       ->required();
   cmd->add_option("-o,--output", o->output, "Output image (.exr, .hdr linear; .png sRGB)")->required();
-  cmd->add_option("--method", o->method, "Rendering method: path (reference), whitted or radiosity")
-      ->check(CLI::IsMember({"path", "whitted", "radiosity"}));
+  cmd->add_option("--method", o->method, "Rendering method: path (reference), whitted, radiosity, photon or sppm")
+      ->check(CLI::IsMember({"path", "whitted", "radiosity", "photon", "sppm"}));
+  cmd->add_option("--photons", o->photons,
+                  "Photon: global photons emitted (default 200000); sppm: photons per iteration (default 100000)")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 34));
+  cmd->add_option("--caustic-photons", o->caustic_photons, "Photon: caustic photons emitted (default 200000; 0 = none)")
+      ->check(CLI::Range(uint64_t(0), uint64_t(1) << 34));
+  cmd->add_option("--k", o->k, "Photon: photons per density estimate (default 50)")->check(CLI::Range(1, 100000));
+  cmd->add_option("--radius", o->radius,
+                  "Photon: largest estimate radius; sppm: initial radius (scene units; default 5 % / 1 % of the "
+                  "scene's bounding radius)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--gather-rays", o->gather_rays, "Photon: final-gather rays per sample (default 16; 0 = none)")
+      ->check(CLI::Range(0, 65536));
+  cmd->add_option("--alpha", o->alpha, "Sppm: fraction of new photons kept per iteration (default 2/3)")
+      ->check(CLI::Range(1e-3f, 0.999f));
   add_solver_options(*cmd, o->solver);
   auto* spp = cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's, 64)")
                   ->check(CLI::PositiveNumber);

@@ -147,6 +147,72 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
   return 0.0f;
 }
 
+EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_position, Vec2 u_direction) {
+  EmissionSample es;
+  switch (light.kind) {
+    case LightKind::area_triangle:
+    case LightKind::area_sphere: {
+      const SurfaceInteraction q =
+          light.kind == LightKind::area_triangle
+              ? scene.triangle_point(light.geom_id, light.prim_id, sample_uniform_triangle(u_position))
+              : scene.sphere_point(light.prim_id, sample_uniform_sphere(u_position));
+      const Material& m = scene.primitive_material(light.geom_id, light.prim_id);
+      Vec3 n = q.ng;
+      float sides = 1.0f;
+      if (m.two_sided_emission) {
+        // The first coordinate picks the side and is stretched back to [0, 1).
+        sides = 2.0f;
+        if (u_direction.x < 0.5f) {
+          n = -n;
+          u_direction.x *= 2.0f;
+        } else {
+          u_direction.x = std::min(kOneMinusEpsilon, 2.0f * u_direction.x - 1.0f);
+        }
+      }
+      const Vec3 w = Frame::from_normal(n).to_world(sample_cosine_hemisphere(u_direction));
+      // Le cos / (1/A · cos/π · 1/sides) = Le π A · sides.
+      es.power = m.emission * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
+      SurfacePoint from = q;
+      from.ng = n;
+      es.ray = spawn_ray(from, w);
+      es.normal = n;
+      return es;
+    }
+    case LightKind::point:
+    case LightKind::spot: {
+      Vec3 w;
+      if (light.kind == LightKind::point) {
+        w = sample_uniform_sphere(u_direction);
+        es.power = light.intensity * (4.0f * kPi);
+      } else {
+        w = Frame::from_normal(light.direction).to_world(sample_uniform_cone(u_direction, light.cos_outer));
+        es.power = light.intensity * (spot_falloff(light, w) / uniform_cone_pdf(light.cos_outer));
+      }
+      es.ray = Ray{light.position, w};
+      es.normal = w;
+      return es;
+    }
+    case LightKind::directional:
+    case LightKind::environment: {
+      // A disk of the bounding radius, perpendicular to the direction of travel, just outside
+      // the bounding sphere: every line through the scene crosses it.
+      const Vec3 w = light.kind == LightKind::directional ? light.direction : -sample_uniform_sphere(u_direction);
+      const Bounds3& b = scene.bounds();
+      const Vec3 center = 0.5f * (b.lo + b.hi);
+      const float radius = std::max(b.radius(), 1e-30f);
+      const Vec2 d = sample_uniform_disk(u_position) * radius;
+      const Frame frame = Frame::from_normal(w);
+      es.ray = Ray{center - w * (1.01f * radius) + frame.s * d.x + frame.t * d.y, w};
+      es.normal = w;
+      const float disk_area = kPi * radius * radius;
+      es.power = light.kind == LightKind::directional ? light.irradiance * disk_area
+                                                       : light.radiance * (disk_area / uniform_sphere_pdf());
+      return es;
+    }
+  }
+  return es;
+}
+
 Rgb light_power(const Scene& scene, const Light& light) {
   const float scene_radius = scene.bounds().radius();
   switch (light.kind) {

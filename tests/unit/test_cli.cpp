@@ -90,6 +90,29 @@ TEST_F(Cli, WhittedRendersPng) {
   EXPECT_TRUE(fs::exists(out));
 }
 
+TEST_F(Cli, PhotonAndSppmRenderAndReport) {
+  const fs::path a = dir_ / "p.exr", b = dir_ / "s.exr";
+  const Result p = run("render cornell-caustics --method photon --photons 4000 --caustic-photons 4000 --gather-rays 2 "
+                       "--spp 1 --width 16 --height 16 --json -o '" + a.string() + "'");
+  ASSERT_EQ(p.code, 0) << p.err;
+  const nlohmann::json jp = nlohmann::json::parse(p.out);
+  EXPECT_GT(jp["photon"]["global_photons"].get<int>(), 0);
+  EXPECT_GT(jp["photon"]["caustic_photons"].get<int>(), 0);
+  EXPECT_EQ(jp["non_finite_samples"], 0);
+  const Result s = run("render cornell-caustics --method sppm --photons 2000 --spp 3 --alpha 0.5 --width 16 --height 16 "
+                       "--json -o '" + b.string() + "'");
+  ASSERT_EQ(s.code, 0) << s.err;
+  const nlohmann::json js = nlohmann::json::parse(s.out);
+  EXPECT_EQ(js["sppm"]["iterations"], 3);
+  EXPECT_EQ(js["sppm"]["photons"], 6000);
+  EXPECT_LT(js["sppm"]["mean_final_radius"].get<double>(), js["sppm"]["initial_radius"].get<double>());
+  // cornell has no mirror or glass: the caustic map is skipped, and said so.
+  const Result c = run("render cornell --method photon --photons 2000 --spp 1 --width 8 --height 8 --json -o '" +
+                       a.string() + "'");
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(c.out.find("no specular surface"), std::string::npos) << c.out;
+}
+
 struct BadCase {
   const char* name;
   std::string args;     // after "render"
@@ -114,6 +137,10 @@ TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
       {"zero fov", "render cornell --fov 0 --spp 1 -o " + out, "field of view"},
       {"camera up along view", "render cornell --lookfrom 0,0,0 --lookat 0,1,0 --up 0,1,0 -o " + out, "up"},
       {"unknown method", "render cornell --method magic -o " + out, "--method"},
+      {"alpha out of range", "render cornell --method sppm --alpha 1.5 -o " + out, "--alpha"},
+      {"zero k", "render cornell --method photon --k 0 -o " + out, "--k"},
+      {"negative radius", "render cornell --method photon --radius -1 -o " + out, "--radius"},
+      {"zero photons", "render cornell --method sppm --photons 0 -o " + out, "--photons"},
       {"unsupported output", "render cornell -o " + (dir_ / "out.jpg").string(), "out.jpg"},
       {"missing output folder", "render cornell -o " + (dir_ / "no/such/dir/out.png").string(), "does not exist"},
       {"no output", "render cornell", "--output"},

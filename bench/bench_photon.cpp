@@ -1,0 +1,220 @@
+// Photon-mapping benchmarks, in two parts (both when none is named):
+//
+//   --trace   photons traced per second on `cornell-caustics` (global and caustic maps, all
+//             threads), after checking that the emitted power adds up to the lights' power.
+//   --race    error against time on `cornell-caustics` for `photon`, `sppm` and `path`, each given
+//             time budgets of 1, 2, 4 and 8 s at 64 × 64, against a long path-traced reference
+//             (two halves of --reference-spp/2 samples, cached in --out-dir). The error is the mean
+//             relative error |I − R| / (R + 0.01) over pixels and channels, as everywhere in gilt's
+//             benchmarks; the reference's own noise is printed with it. For each method the time
+//             to reach the error `path` reaches in 8 s is interpolated (log-log) from its curve.
+//
+// Other options: --out-dir=DIR (default out/bench), --reference-spp=N (default 8192),
+// --fresh-reference. Results: photon_race.csv in the output folder.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "photonmap/photon_mapper.h"
+#include "photonmap/sppm.h"
+#include "raytrace_core/image_io.h"
+#include "raytrace_core/light.h"
+#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/render.h"
+#include "raytrace_core/scene_io.h"
+
+namespace rc = gilt::raytrace_core;
+namespace pm = gilt::photonmap;
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& message) {
+  std::fprintf(stderr, "bench_photon: %s\n", message.c_str());
+  std::exit(EXIT_FAILURE);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+constexpr int kSize = 64;
+constexpr double kBudgets[] = {1, 2, 4, 8};
+
+rc::RenderSettings settings(int spp, uint64_t seed, double time_limit = 0.0) {
+  rc::RenderSettings s;
+  s.width = s.height = kSize;
+  s.spp = spp;
+  s.seed = seed;
+  s.time_limit = time_limit;
+  s.progress = false;
+  return s;
+}
+
+double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
+  double sum = 0.0;
+  for (size_t i = 0; i < image.size(); ++i)
+    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
+  return sum / (3.0 * double(image.size()));
+}
+
+std::vector<rc::Rgb> path_half(const rc::Scene& scene, int spp, uint64_t seed, const fs::path& dir, bool fresh) {
+  const fs::path file = dir / ("reference_" + scene.name + "_" + std::to_string(kSize) + "x" + std::to_string(kSize) +
+                               "_" + std::to_string(spp) + "spp_seed" + std::to_string(seed) + ".exr");
+  if (!fresh && fs::exists(file)) {
+    const rc::Image image = rc::read_image(file.string());
+    if (image.width == kSize && image.height == kSize) return image.pixels;
+  }
+  const rc::PathSettings path;
+  rc::RenderStats stats;
+  const rc::Film film = rc::render_image(
+      scene, scene.effective_camera(), settings(spp, seed),
+      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); }, &stats);
+  if (stats.non_finite != 0) fail("the reference has non-finite samples");
+  rc::write_image(file.string(), rc::Image{kSize, kSize, film.pixels()});
+  return film.pixels();
+}
+
+void run_trace() {
+  const rc::Scene scene = rc::load_scene("cornell-caustics");
+  // Correctness first: every emission sample of this scene's lights carries the light's power.
+  for (const rc::Light& light : scene.lights()) {
+    rc::Rgb sum(0.0f);
+    for (int i = 0; i < 1000; ++i) {
+      rc::Rng rng = rc::Rng::for_item(1, uint64_t(i), 0);
+      sum += rc::sample_emission(scene, light, rng.uniform2(), rng.uniform2()).power;
+    }
+    const rc::Rgb expected = rc::light_power(scene, light);
+    if (std::abs(sum.average() / 1000.0f - expected.average()) > 1e-3f * expected.average())
+      fail("emitted power does not add up to the light's power");
+  }
+  pm::PhotonSettings s;
+  s.global_photons = 1'000'000;
+  s.caustic_photons = 1'000'000;
+  std::vector<double> times;
+  pm::PhotonMaps maps;
+  for (int r = 0; r < 5; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    maps = pm::trace_photons(scene, s);
+    times.push_back(seconds_since(start));
+  }
+  std::sort(times.begin(), times.end());
+  std::printf("photon tracing on cornell-caustics, 2 x 1M paths emitted (index build included), median of 5:\n");
+  std::printf("  %.3f s, %.2f M paths/s; stored %zu global and %zu caustic photons\n", times[2],
+              double(maps.paths) / times[2] * 1e-6, maps.global.photons.size(), maps.caustic.photons.size());
+}
+
+struct Point {
+  std::string method;
+  double budget, seconds, error;
+  int spp;
+};
+
+void run_race(const fs::path& out_dir, int half_spp, bool fresh) {
+  const rc::Scene scene = rc::load_scene("cornell-caustics");
+  const auto ref_start = std::chrono::steady_clock::now();
+  const std::vector<rc::Rgb> a = path_half(scene, half_spp, 1001, out_dir, fresh);
+  const std::vector<rc::Rgb> b = path_half(scene, half_spp, 1002, out_dir, fresh);
+  std::vector<rc::Rgb> reference(a.size());
+  for (size_t i = 0; i < a.size(); ++i) reference[i] = (a[i] + b[i]) * 0.5f;
+  const double noise = 0.5 * mean_relative_error(a, b);
+  std::printf("reference: path tracer, 2 x %d spp at %dx%d (%.1f s, cached when fast); its noise: %.2f %%\n", half_spp,
+              kSize, kSize, seconds_since(ref_start), 100 * noise);
+
+  const rc::Camera camera = scene.effective_camera();
+  std::vector<Point> points;
+  std::printf("\n  method  budget s  actual s   spp   error %%\n");
+  for (double budget : kBudgets) {
+    for (const char* method : {"path", "photon", "sppm"}) {
+      const auto start = std::chrono::steady_clock::now();
+      rc::Film film;
+      int spp = 0;
+      const std::string m = method;
+      if (m == "path") {
+        const rc::PathSettings path;
+        rc::RenderStats stats;
+        film = rc::render_image(
+            scene, camera, settings(1, 7, budget),
+            [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); }, &stats);
+        spp = stats.spp;
+      } else if (m == "photon") {
+        const pm::PhotonMapper mapper(scene, pm::PhotonMapperSettings{});
+        rc::RenderStats stats;
+        film = rc::render_image(
+            scene, camera, settings(1, 7, std::max(0.05, budget - seconds_since(start))),
+            [&](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper.radiance(ray, ctx); }, &stats);
+        spp = stats.spp;
+      } else {
+        pm::SppmStats stats;
+        film = pm::render_sppm(scene, camera, settings(1, 7, budget), pm::SppmSettings{}, &stats);
+        spp = stats.iterations;
+      }
+      const double seconds = seconds_since(start);
+      if (film.non_finite_count() != 0) fail(m + " produced non-finite pixels");
+      const Point p{m, budget, seconds, mean_relative_error(film.pixels(), reference), spp};
+      points.push_back(p);
+      std::printf("  %-6s  %8.0f  %8.2f  %4d  %8.2f\n", method, budget, seconds, spp, 100 * p.error);
+      std::fflush(stdout);
+    }
+  }
+  // Time to reach path's 8-second error, by log-log interpolation along each method's curve.
+  double target = 0.0;
+  for (const Point& p : points)
+    if (p.method == "path" && p.budget == kBudgets[3]) target = p.error;
+  std::printf("\n  time to reach %.2f %% (path's error at 8 s):\n", 100 * target);
+  for (const char* method : {"path", "photon", "sppm"}) {
+    std::vector<Point> curve;
+    for (const Point& p : points)
+      if (p.method == method) curve.push_back(p);
+    double reached = -1.0;
+    for (size_t i = 0; i < curve.size(); ++i) {
+      if (curve[i].error > target) continue;
+      if (i == 0) {
+        reached = curve[0].seconds;  // at or before the first budget
+      } else {
+        const double t = std::log(target / curve[i - 1].error) / std::log(curve[i].error / curve[i - 1].error);
+        reached = std::exp(std::log(curve[i - 1].seconds) + t * std::log(curve[i].seconds / curve[i - 1].seconds));
+      }
+      break;
+    }
+    if (reached < 0.0) std::printf("    %-6s not within 8 s (%.2f %% at 8 s)\n", method, 100 * curve.back().error);
+    else std::printf("    %-6s %.2f s%s\n", method, reached, reached <= curve[0].seconds ? " (at or before the first budget)" : "");
+  }
+  const fs::path csv = out_dir / "photon_race.csv";
+  std::ofstream out(csv);
+  out << "method,budget_seconds,seconds,spp_or_iterations,error,reference_noise\n";
+  for (const Point& p : points)
+    out << p.method << ',' << p.budget << ',' << p.seconds << ',' << p.spp << ',' << p.error << ',' << noise << '\n';
+  if (!out) fail("cannot write " + csv.string());
+  std::printf("  written to %s\n", csv.string().c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool trace = false, race = false, fresh = false;
+  int half_spp = 4096;
+  fs::path out_dir = "out/bench";
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--trace") trace = true;
+    else if (arg == "--race") race = true;
+    else if (arg == "--fresh-reference") fresh = true;
+    else if (arg.starts_with("--out-dir=")) out_dir = std::string(arg.substr(10));
+    else if (arg.starts_with("--reference-spp=")) half_spp = std::max(1, std::atoi(argv[i] + 16) / 2);
+    else fail("unknown option '" + std::string(arg) + "' (parts: --trace --race)");
+  }
+  if (!trace && !race) trace = race = true;
+  fs::create_directories(out_dir);
+  if (trace) run_trace();
+  if (race) run_race(out_dir, half_spp, fresh);
+  return 0;
+}

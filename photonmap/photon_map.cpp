@@ -1,0 +1,164 @@
+// Photon tracing into the caustic and global maps, and density estimation over them (Jensen
+// 1996; the Epanechnikov kernel as in Silverman 1986, "Density Estimation for Statistics and Data
+// Analysis", which unlike Jensen's cone filter is a consistent kernel of its own).
+
+#include "photonmap/photon_map.h"
+
+#include <chrono>
+
+#include "raytrace_core/bsdf.h"
+#include "raytrace_core/light.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/rng.h"
+
+namespace gilt::photonmap {
+namespace {
+
+/// Photons traced per parallel task; tasks are joined in order, so the maps do not depend on
+/// the thread count.
+constexpr uint64_t kChunk = 4096;
+
+/// Stored normals within about 25° of the query's count (cos 25° ≈ 0.9).
+constexpr float kNormalAgreement = 0.9f;
+
+/// Emits `count` photons and keeps those `keep` accepts, in photon order.
+template <class Keep>
+std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t count, uint64_t stream, const PhotonSettings& settings,
+                              uint64_t& paths, Keep keep) {
+  const auto& lights = scene.lights();
+  const rc::Distribution1D& choice = scene.light_distribution();
+  const size_t chunks = size_t((count + kChunk - 1) / kChunk);
+  std::vector<std::vector<Photon>> stored(chunks);
+  rc::parallel_for(chunks, [&](size_t c) {
+    std::vector<Photon>& out = stored[c];
+    for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
+      rc::Rng rng = rc::Rng::for_item(settings.seed, i, stream);
+      const uint32_t li = choice.sample(rng.uniform());
+      const float pmf = choice.pmf(li);
+      if (!(pmf > 0.0f)) continue;
+      const rc::Vec2 u_position = rng.uniform2(), u_direction = rng.uniform2();
+      const rc::EmissionSample es = rc::sample_emission(scene, lights[li], u_position, u_direction);
+      if (es.power.is_black()) continue;
+      const rc::Rgb power = es.power / (pmf * float(count));
+      trace_photon_path(scene, es.ray, power, rng, settings.max_depth,
+                        [&](const Photon& p, int depth, bool specular_only) { return keep(p, depth, specular_only, out); });
+    }
+  });
+  paths += count;
+  size_t total = 0;
+  for (const auto& s : stored) total += s.size();
+  std::vector<Photon> photons;
+  photons.reserve(total);
+  for (const auto& s : stored) photons.insert(photons.end(), s.begin(), s.end());
+  return photons;
+}
+
+/// Epanechnikov's kernel on a disk of squared radius r2, normalised over the disk:
+/// 2 / (π r²) · (1 − d² / r²).
+float epanechnikov(float d2, float r2) { return 2.0f * rc::kInvPi / r2 * std::max(0.0f, 1.0f - d2 / r2); }
+
+/// Runs the k-nearest query and calls f(photon, kernel weight) for each photon that agrees with
+/// the query's normal.
+template <class F>
+void for_each_estimate_photon(const PhotonMap& map, const EstimateQuery& q, EstimateScratch& scratch, F&& f) {
+  if (map.empty() || q.k == 0 || !(q.max_radius2 > 0.0f)) return;
+  if (scratch.neighbours.size() < q.k) scratch.neighbours.resize(q.k);
+  const size_t found = map.index.knn(q.position, q.k, q.max_radius2, scratch.neighbours.data());
+  if (found == 0) return;
+  // The disk reaches the k-th photon; with fewer found, it is the whole search radius.
+  const float r2 = found == q.k ? scratch.neighbours[found - 1].distance2 : q.max_radius2;
+  if (!(r2 > 0.0f)) return;
+  for (size_t i = 0; i < found; ++i) {
+    const Photon& p = map.photons[scratch.neighbours[i].index];
+    if (glm::dot(decode_direction(p.normal), q.normal) < kNormalAgreement) continue;
+    const float w = epanechnikov(scratch.neighbours[i].distance2, r2);
+    if (w > 0.0f) f(p, w);
+  }
+}
+
+}  // namespace
+
+void PhotonMap::build_index(IndexKind kind) {
+  std::vector<rc::Vec3> positions(photons.size());
+  for (size_t i = 0; i < photons.size(); ++i) positions[i] = photons[i].position;
+  index = PhotonIndex(positions, kind);
+}
+
+MapNeeds map_needs(const rc::Scene& scene) {
+  MapNeeds needs;
+  bool specular = false, reflective = false;
+  auto visit = [&](uint32_t material) {
+    const rc::Material& m = scene.materials[material];
+    if (m.is_specular()) specular = true;
+    else if (m.albedo.max_component() > 1e-4f || m.kind == rc::MaterialKind::glossy) reflective = true;
+  };
+  for (const rc::TriangleMesh& m : scene.meshes) visit(m.material);
+  for (const rc::Sphere& s : scene.spheres) visit(s.material);
+  if (scene.lights().empty()) {
+    needs.caustic_reason = needs.global_reason = "no lights";
+    return needs;
+  }
+  needs.caustic = specular;
+  if (!specular) needs.caustic_reason = "no specular surface";
+  needs.global = reflective;
+  if (!reflective) needs.global_reason = "no diffuse or glossy surface reflects light (no interreflection)";
+  return needs;
+}
+
+PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings) {
+  if (!scene.committed()) throw std::logic_error("trace_photons: the scene was not committed");
+  const auto start = std::chrono::steady_clock::now();
+  PhotonMaps maps;
+  const MapNeeds needs = map_needs(scene);
+  if (!needs.caustic) maps.skipped.push_back("caustic map skipped: " + needs.caustic_reason);
+  else if (settings.caustic_photons == 0) maps.skipped.push_back("caustic map skipped: --caustic-photons 0");
+  if (!needs.global) maps.skipped.push_back("global map skipped: " + needs.global_reason);
+  else if (settings.global_photons == 0) maps.skipped.push_back("global map skipped: --photons 0");
+
+  if (needs.global && settings.global_photons > 0) {
+    maps.global.emitted = settings.global_photons;
+    maps.global.photons = trace_map(scene, settings.global_photons, 0xb000000000ull, settings, maps.paths,
+                                    [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
+                                      // After at least one diffuse bounce: not direct, not a caustic.
+                                      if (!specular_only) out.push_back(p);
+                                      return true;
+                                    });
+    maps.global.build_index(settings.index);
+  }
+  if (needs.caustic && settings.caustic_photons > 0) {
+    maps.caustic.emitted = settings.caustic_photons;
+    maps.caustic.photons = trace_map(scene, settings.caustic_photons, 0xc000000000ull, settings, maps.paths,
+                                     [](const Photon& p, int depth, bool specular_only, std::vector<Photon>& out) {
+                                       // Light → specular⁺ → here: a caustic; the path ends either way.
+                                       if (specular_only && depth > 0) out.push_back(p);
+                                       return false;
+                                     });
+    maps.caustic.build_index(settings.index);
+  }
+  maps.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return maps;
+}
+
+rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, const rc::Material& material,
+                          const rc::Frame& shading, const rc::Vec3& wo_local, EstimateScratch& scratch) {
+  rc::Rgb sum(0.0f);
+  const bool lambertian = material.kind == rc::MaterialKind::diffuse;
+  for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) {
+    if (lambertian) {
+      sum += p.power * w;
+    } else {
+      const rc::Vec3 wi = shading.to_local(decode_direction(p.direction));
+      sum += rc::bsdf_eval(material, wo_local, wi) * p.power * w;
+    }
+  });
+  // Lambertian: f = ρ/π for every photon, taken out of the sum.
+  return lambertian ? material.albedo * sum * rc::kInvPi : sum;
+}
+
+rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, EstimateScratch& scratch) {
+  rc::Rgb sum(0.0f);
+  for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) { sum += p.power * w; });
+  return sum;
+}
+
+}  // namespace gilt::photonmap

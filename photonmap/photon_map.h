@@ -1,0 +1,98 @@
+#pragma once
+// Pass 1 of photon mapping (Jensen 1996, "Global Illumination Using Photon Maps"): photons leave
+// the lights in proportion to their power and are stored where they meet diffuse or glossy
+// surfaces, in two maps:
+//   caustic map  paths light → specular⁺ → diffuse (the photon stops there);
+//   global map   photons that have bounced off a diffuse surface at least once before the hit
+//                (direct light is left to shadow rays).
+// Then the density estimate that turns the photons around a point into reflected radiance.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "photonmap/photon.h"
+#include "photonmap/photon_index.h"
+#include "raytrace_core/material.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/scene.h"
+
+namespace gilt::photonmap {
+
+/// How many photons to emit and how far to follow them. The defaults are the documented ones.
+struct PhotonSettings {
+  uint64_t global_photons = 200'000;   ///< emitted for the global map (0: no global map)
+  uint64_t caustic_photons = 200'000;  ///< emitted for the caustic map (0: no caustic map)
+  int max_depth = 32;                  ///< bounces per photon path at most
+  uint64_t seed = 0;
+  IndexKind index = IndexKind::kd_tree;  ///< search structure over the stored photons
+};
+
+/// Stored photons of one map and their search structure. Each photon's power already includes
+/// the 1 / emitted factor, so a density estimate sums powers directly.
+struct PhotonMap {
+  std::vector<Photon> photons;
+  uint64_t emitted = 0;  ///< photon paths emitted for this map
+  PhotonIndex index;
+
+  bool empty() const { return photons.empty(); }
+  /// Builds `index` over the photon positions.
+  void build_index(IndexKind kind);
+};
+
+/// Both maps, and what the tracing pass did and skipped.
+struct PhotonMaps {
+  PhotonMap global, caustic;
+  std::vector<std::string> skipped;  ///< "caustic map skipped: no specular surface", …
+  uint64_t paths = 0;                ///< photon paths traced, both maps
+  double seconds = 0.0;
+};
+
+/// Whether a scene needs each map: a caustic map only with a mirror or dielectric surface, a
+/// global map only when some diffuse or glossy surface reflects light (albedo above 1e-4) and
+/// more than one such bounce can happen. `reason` says why a map is not needed.
+struct MapNeeds {
+  bool caustic = false, global = false;
+  std::string caustic_reason, global_reason;
+};
+MapNeeds map_needs(const rc::Scene& scene);
+
+/// Traces the photons of both maps (in parallel; photon i of a map draws from its own random
+/// stream, so the maps are identical for any thread count) and builds their indexes.
+PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings);
+
+/// Scratch space for density estimates, one per thread: queries do not allocate.
+struct EstimateScratch {
+  std::vector<Neighbour> neighbours;
+};
+
+/// A density-estimate query: where, which way the surface faces, how many photons and how far.
+struct EstimateQuery {
+  rc::Vec3 position;
+  rc::Vec3 normal;     ///< unit geometric normal on the side being lit
+  size_t k = 50;       ///< nearest photons
+  float max_radius2 = 0.0f;
+};
+
+/// Reflected radiance (W·sr⁻¹·m⁻²) towards wo from the photons around the query: the k nearest
+/// within the maximum radius whose stored normal agrees with the query's (same side, within
+/// about 25°), each weighted by the BSDF and by Epanechnikov's kernel over the disk of the
+/// k-th photon's distance (or the maximum radius when fewer are found).
+rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, const rc::Material& material,
+                          const rc::Frame& shading, const rc::Vec3& wo_local, EstimateScratch& scratch);
+
+/// Irradiance (W·m⁻²) at the query from the same photons, with the same kernel.
+rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, EstimateScratch& scratch);
+
+/// The photon-tracing loop, shared by the two-pass mapper and SPPM: follows a photon path from
+/// an emitted ray, calling store(photon, depth, specular_only) at every diffuse or glossy hit
+/// (depth 0 = straight from the light; specular_only = only mirror and glass bounces before),
+/// which returns false to end the path. Russian roulette by the bounce's albedo keeps the power
+/// of surviving photons steady. Returns the number of rays traced.
+template <class Store>
+uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, rc::Rng& rng, int max_depth,
+                           Store&& store);
+
+}  // namespace gilt::photonmap
+
+#include "photonmap/photon_map_inl.h"

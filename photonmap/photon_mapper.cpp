@@ -1,0 +1,260 @@
+// Two-pass photon mapping: Jensen 1996; final gather with precomputed irradiance: Christensen
+// 1999; multiple importance sampling of direct light: Veach & Guibas 1995.
+
+#include "photonmap/photon_mapper.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "raytrace_core/bsdf.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/light.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/sampling.h"
+
+namespace gilt::photonmap {
+namespace {
+
+/// A point for spawning shadow rays at a photon position, whose rounding error is not tracked:
+/// the bound allows for γ(16)·|p|, as the radiosity solver does for mesh points.
+rc::SurfacePoint point_at(const rc::Vec3& p, const rc::Vec3& n) {
+  rc::SurfacePoint sp;
+  sp.p = p;
+  sp.p_error = rc::error_gamma(16) * rc::abs(p);
+  sp.ng = n;
+  return sp;
+}
+
+EstimateScratch& thread_scratch() {
+  thread_local EstimateScratch scratch;
+  return scratch;
+}
+
+}  // namespace
+
+PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& settings)
+    : scene_(scene), settings_(settings) {
+  if (!scene.committed()) throw std::logic_error("PhotonMapper: the scene was not committed");
+  if (settings.k < 1) throw rc::InputError("--k must be at least 1");
+  if (settings.gather_rays < 0) throw rc::InputError("--gather-rays must not be negative");
+  if (settings.precompute_stride < 1) throw rc::InputError("the precompute stride must be at least 1");
+  if (settings.direct_samples < 1) throw rc::InputError("direct samples must be at least 1");
+  if (!(settings.max_radius >= 0.0f) || !std::isfinite(settings.max_radius))
+    throw rc::InputError("--radius must be a positive number");
+  if (settings.max_depth < 1) throw rc::InputError("--max-depth must be at least 1");
+
+  maps_ = trace_photons(scene, settings.photons);
+  stats_.skipped = maps_.skipped;
+  stats_.global_photons = maps_.global.photons.size();
+  stats_.caustic_photons = maps_.caustic.photons.size();
+  stats_.paths = maps_.paths;
+  stats_.trace_seconds = maps_.seconds;
+  const float radius = settings.max_radius > 0.0f ? settings.max_radius : 0.05f * scene.bounds().radius();
+  stats_.max_radius = radius;
+  max_radius2_ = radius * radius;
+  if (!map_needs(scene).global && settings_.gather_rays > 0) {
+    settings_.gather_rays = 0;
+    stats_.skipped.push_back("final gather skipped: no interreflection");
+  }
+
+  // Irradiance at every stride-th global photon, for the gather rays to look up.
+  const auto start = std::chrono::steady_clock::now();
+  if (settings_.gather_rays > 0 && !maps_.global.empty()) {
+    const size_t stride = size_t(settings.precompute_stride);
+    const size_t count = (maps_.global.photons.size() + stride - 1) / stride;
+    points_.resize(count);
+    rc::parallel_for((count + 1023) / 1024, [&](size_t chunk) {
+      for (size_t i = chunk * 1024; i < std::min(count, chunk * 1024 + 1024); ++i) {
+        const Photon& p = maps_.global.photons[i * stride];
+        rc::Rng rng = rc::Rng::for_item(settings.photons.seed, i, 0xd000000000ull);
+        points_[i] = {p.position, p.normal,
+                      compute_irradiance(p.position, decode_direction(p.normal), rng, settings.direct_samples)};
+      }
+    });
+    std::vector<rc::Vec3> positions(count);
+    for (size_t i = 0; i < count; ++i) positions[i] = points_[i].position;
+    point_index_ = PhotonIndex(positions, IndexKind::kd_tree);
+  }
+  stats_.irradiance_points = points_.size();
+  stats_.precompute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Rng& rng,
+                                         int direct_samples) const {
+  rc::Rgb e(0.0f);
+  const auto& lights = scene_.lights();
+  const rc::Distribution1D& choice = scene_.light_distribution();
+  if (choice.size() > 0) {
+    const rc::SurfacePoint at = point_at(p, normal);
+    for (int i = 0; i < direct_samples; ++i) {
+      const uint32_t li = choice.sample(rng.uniform());
+      const float pmf = choice.pmf(li);
+      const rc::LightSample ls = rc::sample_light(scene_, lights[li], at, rng.uniform2());
+      const float cos_theta = glm::dot(ls.wi, normal);
+      if (!(ls.pdf > 0.0f) || !(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
+      if (scene_.occluded(ls.shadow_ray)) continue;
+      e += ls.radiance * (cos_theta / (ls.pdf * pmf * float(direct_samples)));
+    }
+  }
+  const EstimateQuery query{p, normal, size_t(settings_.k), max_radius2_};
+  e += estimate_irradiance(maps_.global, query, thread_scratch());
+  e += estimate_irradiance(maps_.caustic, query, thread_scratch());
+  return e;
+}
+
+rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Rng& rng) const {
+  if (!points_.empty()) {
+    constexpr size_t kCandidates = 8;
+    Neighbour near[kCandidates];
+    const size_t found = point_index_.knn(p, kCandidates, max_radius2_, near);
+    for (size_t i = 0; i < found; ++i)
+      if (glm::dot(decode_direction(points_[near[i].index].normal), normal) > 0.9f)
+        return points_[near[i].index].irradiance;
+  }
+  return compute_irradiance(p, normal, rng, 4);
+}
+
+rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+  rc::Rgb radiance(0.0f), beta(1.0f);
+  rc::Ray ray = camera_ray;
+  for (int depth = 0; depth < settings_.max_depth; ++depth) {
+    ++ctx.rays;
+    const std::optional<rc::Hit> hit = scene_.intersect(ray);
+    if (!hit) {
+      for (const rc::Light& l : scene_.lights())
+        if (l.kind == rc::LightKind::environment) radiance += beta * l.radiance;
+      break;
+    }
+    const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
+    const rc::Material& m = scene_.materials[si.material];
+    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+      beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+    const rc::Vec3 wo_world = -glm::normalize(ray.direction);
+    // Seen from the camera or through mirrors and glass: emission counts in full.
+    if (m.is_emissive()) radiance += beta * rc::emitted_radiance(m, si.ng, wo_world);
+    if (!m.is_specular()) {
+      radiance += beta * shade(si, wo_world, ctx);
+      break;
+    }
+    const rc::Frame frame = rc::Frame::from_normal(si.ns);
+    const rc::Vec3 wo = frame.to_local(wo_world);
+    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.rng.uniform(), ctx.rng.uniform2());
+    if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
+    const rc::Vec3 wi_world = frame.to_world(bs->wi);
+    const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f, wi_above = glm::dot(wi_world, si.ng) > 0.0f;
+    if (wi_above != (bs->transmission ? !wo_above : wo_above)) break;
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+    ray = rc::spawn_ray(si, wi_world);
+  }
+  return radiance;
+}
+
+rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo_world, rc::SampleContext& ctx) const {
+  const rc::Material& m = scene_.materials[si.material];
+  const rc::Frame frame = rc::Frame::from_normal(si.ns);
+  const rc::Vec3 wo = frame.to_local(wo_world);
+  const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
+  const rc::Vec3 lit_side = wo_above ? si.ng : -si.ng;
+  const EstimateQuery query{si.p, lit_side, size_t(settings_.k), max_radius2_};
+  const auto& lights = scene_.lights();
+  const rc::Distribution1D& choice = scene_.light_distribution();
+  const int gather = settings_.gather_rays;
+  rc::Rgb l(0.0f);
+
+  // Caustics from their map.
+  l += estimate_radiance(maps_.caustic, query, m, frame, wo, thread_scratch());
+
+  // Direct light: one light sample, MIS-weighted against the gather rays as BSDF samples.
+  if (choice.size() > 0) {
+    const uint32_t li = choice.sample(ctx.rng.uniform());
+    const float pmf = choice.pmf(li);
+    const rc::LightSample ls = rc::sample_light(scene_, lights[li], si, ctx.rng.uniform2());
+    if (ls.pdf > 0.0f && !ls.radiance.is_black() && (glm::dot(ls.wi, si.ng) > 0.0f) == wo_above) {
+      const rc::Vec3 wi = frame.to_local(ls.wi);
+      const rc::Rgb f = rc::bsdf_eval(m, wo, wi) * std::fabs(wi.z);
+      if (!f.is_black()) {
+        ++ctx.rays;
+        if (!scene_.occluded(ls.shadow_ray)) {
+          const float p_light = ls.pdf * pmf;
+          const float w = ls.delta || gather == 0
+                              ? 1.0f
+                              : rc::power_heuristic(1.0f, p_light, float(gather), rc::bsdf_pdf(m, wo, wi));
+          l += f * ls.radiance * (w / p_light);
+        }
+      }
+    }
+  }
+  if (gather == 0) {
+    // Without a final gather the global map is read at x itself.
+    l += estimate_radiance(maps_.global, query, m, frame, wo, thread_scratch());
+    return l;
+  }
+
+  // Final gather.
+  rc::Rgb gathered(0.0f);
+  const bool caustics_in_map = !maps_.caustic.empty();
+  for (int j = 0; j < gather; ++j) {
+    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.rng.uniform(), ctx.rng.uniform2());
+    if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) continue;
+    const rc::Vec3 wi_world = frame.to_world(bs->wi);
+    const bool wi_above = glm::dot(wi_world, si.ng) > 0.0f;
+    if (wi_above != (bs->transmission ? !wo_above : wo_above)) continue;
+    rc::Rgb g = bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+    rc::Ray ray = rc::spawn_ray(si, wi_world);
+    bool through_specular = false;
+    for (int depth = 0; depth < settings_.max_depth; ++depth) {
+      ++ctx.rays;
+      const std::optional<rc::Hit> hit = scene_.intersect(ray);
+      const rc::Vec3 dir = glm::normalize(ray.direction);
+      if (!hit) {
+        for (size_t li = 0; li < lights.size(); ++li) {
+          if (lights[li].kind != rc::LightKind::environment) continue;
+          float w = 1.0f;
+          if (!through_specular && !bs->delta)
+            w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
+                                    choice.pmf(uint32_t(li)) * rc::light_pdf(scene_, lights[li], si, dir, si));
+          else if (through_specular && caustics_in_map)
+            w = 0.0f;
+          gathered += g * lights[li].radiance * w;
+        }
+        break;
+      }
+      const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
+      const rc::Material& mj = scene_.materials[sj.material];
+      if (mj.kind == rc::MaterialKind::dielectric && !sj.front_face && !mj.absorption.is_black())
+        g *= rc::exp(mj.absorption * (-hit->t * glm::length(ray.direction)));
+      if (mj.is_emissive()) {
+        const rc::Rgb le = rc::emitted_radiance(mj, sj.ng, -dir);
+        if (!le.is_black()) {
+          // Straight from x: the BSDF-sampled half of direct light. Through mirrors and glass:
+          // a caustic, which the caustic map already holds (when there is one).
+          float w = 1.0f;
+          if (!through_specular && sj.light >= 0)
+            w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
+                                    choice.pmf(uint32_t(sj.light)) * rc::light_pdf(scene_, lights[sj.light], si, dir, sj));
+          else if (through_specular && caustics_in_map)
+            w = 0.0f;
+          gathered += g * le * w;
+        }
+      }
+      if (mj.is_specular()) {
+        const rc::Frame fj = rc::Frame::from_normal(sj.ns);
+        const rc::Vec3 woj = fj.to_local(-dir);
+        const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, ctx.rng.uniform(), ctx.rng.uniform2());
+        if (!bj || !(bj->pdf > 0.0f) || bj->f.is_black()) break;
+        g *= bj->f * (std::fabs(bj->wi.z) / bj->pdf);
+        ray = rc::spawn_ray(sj, fj.to_world(bj->wi));
+        through_specular = true;
+        continue;
+      }
+      // A diffuse or glossy hit: its reflected light from the precomputed irradiance.
+      const rc::Vec3 side = glm::dot(-dir, sj.ng) > 0.0f ? sj.ng : -sj.ng;
+      gathered += g * mj.albedo * irradiance(sj.p, side, ctx.rng) * rc::kInvPi;
+      break;
+    }
+  }
+  l += gathered / float(gather);
+  return l;
+}
+
+}  // namespace gilt::photonmap

@@ -1,0 +1,231 @@
+// Stochastic progressive photon mapping: Hachisuka & Jensen 2009. Per-pixel statistics as in
+// their paper (and pbrt-v3's SPPMIntegrator); photons of each iteration are indexed with the
+// photon index's hash grid, cell size about the largest current radius.
+
+#include "photonmap/sppm.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "photonmap/photon_index.h"
+#include "photonmap/photon_map.h"
+#include "raytrace_core/bsdf.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/light.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/progress.h"
+
+namespace gilt::photonmap {
+namespace {
+
+/// One pixel's statistics and this iteration's visible point.
+struct PixelState {
+  rc::Rgb direct_sum{0.0f};  ///< emitted + direct light found by the camera paths, summed over iterations
+  rc::Rgb tau{0.0f};         ///< flux, unnormalised (divide by π R² · photons emitted)
+  float radius = 0.0f;
+  float n = 0.0f;            ///< accumulated photon count N
+  // Visible point of the current iteration.
+  bool visible = false;
+  rc::Vec3 position{0.0f}, lit_side{0.0f}, wo{0.0f};  ///< wo in the shading frame
+  rc::Frame frame;
+  uint32_t material = 0;
+  rc::Rgb beta{0.0f};
+  // Gathered this iteration.
+  rc::Rgb phi{0.0f};
+  uint32_t m = 0;
+};
+
+constexpr uint64_t kPhotonStream = 0xe000000000ull;
+
+/// Direct light at a visible point by one light sample (delta lights included).
+rc::Rgb direct_light(const rc::Scene& scene, const rc::SurfaceInteraction& si, const rc::Material& m,
+                     const rc::Frame& frame, const rc::Vec3& wo, bool wo_above, rc::Rng& rng, uint64_t& rays) {
+  const rc::Distribution1D& choice = scene.light_distribution();
+  if (choice.size() == 0) return rc::Rgb(0.0f);
+  const uint32_t li = choice.sample(rng.uniform());
+  const float pmf = choice.pmf(li);
+  const rc::LightSample ls = rc::sample_light(scene, scene.lights()[li], si, rng.uniform2());
+  if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) return rc::Rgb(0.0f);
+  const rc::Vec3 wi = frame.to_local(ls.wi);
+  const rc::Rgb f = rc::bsdf_eval(m, wo, wi) * std::fabs(wi.z);
+  if (f.is_black()) return rc::Rgb(0.0f);
+  ++rays;
+  if (scene.occluded(ls.shadow_ray)) return rc::Rgb(0.0f);
+  return f * ls.radiance / (ls.pdf * pmf);
+}
+
+}  // namespace
+
+rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc::RenderSettings& settings,
+                     const SppmSettings& sppm, SppmStats* stats) {
+  if (!scene.committed()) throw std::logic_error("render_sppm: the scene was not committed");
+  if (settings.width <= 0 || settings.height <= 0) throw rc::InputError("image size must be positive");
+  if (settings.time_limit <= 0.0 && settings.spp <= 0) throw rc::InputError("iterations (--spp) must be positive");
+  if (!(sppm.alpha > 0.0f && sppm.alpha < 1.0f)) throw rc::InputError("--alpha must lie in (0, 1)");
+  if (sppm.photons_per_iteration == 0) throw rc::InputError("--photons must be positive");
+  if (!(sppm.initial_radius >= 0.0f) || !std::isfinite(sppm.initial_radius))
+    throw rc::InputError("--radius must be a positive number");
+  const rc::ThreadLimit limit(settings.threads);
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+
+  const int width = settings.width, height = settings.height;
+  const size_t pixels = size_t(width) * height;
+  const float aspect = float(width) / float(height);
+  const float r0 = sppm.initial_radius > 0.0f ? sppm.initial_radius : 0.01f * scene.bounds().radius();
+  std::vector<PixelState> state(pixels);
+  for (PixelState& p : state) p.radius = r0;
+  const auto& lights = scene.lights();
+  const rc::Distribution1D& choice = scene.light_distribution();
+  std::atomic<uint64_t> rays{0};
+  const bool timed = settings.time_limit > 0.0;
+  rc::Progress progress(timed ? "sppm (time budget)" : "sppm", timed ? 0 : uint64_t(settings.spp), "iterations",
+                        settings.progress);
+
+  int iteration = 0;
+  std::vector<Photon> photons;
+  std::vector<rc::Vec3> positions;
+  for (;; ++iteration) {
+    if (timed ? elapsed() >= settings.time_limit && iteration > 0 : iteration >= settings.spp) break;
+
+    // 1. Camera pass: a visible point per pixel.
+    rc::parallel_for(size_t(height), [&](size_t y) {
+      uint64_t local_rays = 0;
+      for (int x = 0; x < width; ++x) {
+        const uint64_t pixel = uint64_t(y) * width + x;
+        PixelState& ps = state[pixel];
+        ps.visible = false;
+        rc::Rng rng = rc::Rng::for_item(settings.seed, pixel, uint64_t(iteration));
+        const rc::Vec2 offset = settings.filter.sample(rng.uniform2());
+        const rc::Vec2 film_pos((x + 0.5f + offset.x) / width, (y + 0.5f + offset.y) / height);
+        rc::Ray ray = camera.generate_ray(film_pos, rng.uniform2(), aspect);
+        rc::Rgb beta(1.0f), direct(0.0f);
+        for (int depth = 0; depth < sppm.max_depth; ++depth) {
+          ++local_rays;
+          const std::optional<rc::Hit> hit = scene.intersect(ray);
+          if (!hit) {
+            for (const rc::Light& l : lights)
+              if (l.kind == rc::LightKind::environment) direct += beta * l.radiance;
+            break;
+          }
+          const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+          const rc::Material& m = scene.materials[si.material];
+          if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+            beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+          const rc::Vec3 wo_world = -glm::normalize(ray.direction);
+          if (m.is_emissive()) direct += beta * rc::emitted_radiance(m, si.ng, wo_world);
+          const rc::Frame frame = rc::Frame::from_normal(si.ns);
+          const rc::Vec3 wo = frame.to_local(wo_world);
+          const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
+          if (!m.is_specular()) {
+            direct += beta * direct_light(scene, si, m, frame, wo, wo_above, rng, local_rays);
+            ps.visible = true;
+            ps.position = si.p;
+            ps.lit_side = wo_above ? si.ng : -si.ng;
+            ps.wo = wo;
+            ps.frame = frame;
+            ps.material = si.material;
+            ps.beta = beta;
+            break;
+          }
+          const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, rng.uniform(), rng.uniform2());
+          if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
+          const rc::Vec3 wi_world = frame.to_world(bs->wi);
+          if ((glm::dot(wi_world, si.ng) > 0.0f) != (bs->transmission ? !wo_above : wo_above)) break;
+          beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+          ray = rc::spawn_ray(si, wi_world);
+        }
+        if (direct.is_finite()) ps.direct_sum += direct;
+      }
+      rays += local_rays;
+    });
+
+    // 2. Photon pass: every diffuse or glossy hit but the first (direct light is the camera
+    //    pass's), unnormalised power.
+    const uint64_t count = sppm.photons_per_iteration;
+    constexpr uint64_t kChunk = 4096;
+    const size_t chunks = size_t((count + kChunk - 1) / kChunk);
+    std::vector<std::vector<Photon>> stored(chunks);
+    if (choice.size() > 0) {
+      rc::parallel_for(chunks, [&](size_t c) {
+        uint64_t local_rays = 0;
+        for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
+          rc::Rng rng = rc::Rng::for_item(settings.seed, i, kPhotonStream + uint64_t(iteration));
+          const uint32_t li = choice.sample(rng.uniform());
+          const float pmf = choice.pmf(li);
+          const rc::Vec2 u_position = rng.uniform2(), u_direction = rng.uniform2();
+          const rc::EmissionSample es = rc::sample_emission(scene, lights[li], u_position, u_direction);
+          if (es.power.is_black() || !(pmf > 0.0f)) continue;
+          local_rays += trace_photon_path(scene, es.ray, es.power / pmf, rng, sppm.max_depth,
+                                          [&](const Photon& p, int depth, bool) {
+                                            if (depth > 0) stored[c].push_back(p);
+                                            return true;
+                                          });
+        }
+        rays += local_rays;
+      });
+    }
+    photons.clear();
+    for (const auto& s : stored) photons.insert(photons.end(), s.begin(), s.end());
+    positions.resize(photons.size());
+    for (size_t i = 0; i < photons.size(); ++i) positions[i] = photons[i].position;
+    float max_radius = 0.0f;
+    for (const PixelState& p : state) max_radius = std::max(max_radius, p.radius);
+    const PhotonIndex index(positions, IndexKind::hash_grid, max_radius);
+
+    // 3. Gather at the visible points and shrink the radii.
+    rc::parallel_for(size_t(height), [&](size_t y) {
+      for (int x = 0; x < width; ++x) {
+        PixelState& ps = state[size_t(y) * width + x];
+        if (!ps.visible) continue;
+        const rc::Material& m = scene.materials[ps.material];
+        rc::Rgb phi(0.0f);
+        uint32_t m_count = 0;
+        index.for_each_within(ps.position, ps.radius * ps.radius, [&](Neighbour nb) {
+          const Photon& p = photons[nb.index];
+          if (glm::dot(decode_direction(p.normal), ps.lit_side) < 0.9f) return;
+          const rc::Vec3 wi = ps.frame.to_local(decode_direction(p.direction));
+          phi += rc::bsdf_eval(m, ps.wo, wi) * p.power;
+          ++m_count;
+        });
+        if (m_count == 0) continue;
+        const float n_new = ps.n + sppm.alpha * float(m_count);
+        const float shrink2 = n_new / (ps.n + float(m_count));
+        if (phi.is_finite()) ps.tau = (ps.tau + ps.beta * phi) * shrink2;
+        ps.n = n_new;
+        ps.radius *= std::sqrt(shrink2);
+      }
+    });
+    progress.advance(1);
+  }
+  progress.finish();
+
+  // 4. The image: mean direct light plus τ / (π R² · photons emitted).
+  rc::Film film(width, height);
+  const double emitted = double(iteration) * double(sppm.photons_per_iteration);
+  double radius_sum = 0.0;
+  size_t radius_count = 0;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const PixelState& ps = state[size_t(y) * width + x];
+      rc::Rgb value = ps.direct_sum / float(std::max(iteration, 1));
+      if (ps.n > 0.0f) {
+        value += ps.tau * float(1.0 / (rc::kPi * double(ps.radius) * ps.radius * emitted));
+        radius_sum += ps.radius;
+        ++radius_count;
+      }
+      film.add_sample(x, y, value);
+    }
+  if (stats) {
+    stats->iterations = iteration;
+    stats->photons = uint64_t(emitted);
+    stats->rays = rays;
+    stats->seconds = elapsed();
+    stats->initial_radius = r0;
+    stats->mean_final_radius = radius_count ? float(radius_sum / double(radius_count)) : r0;
+  }
+  return film;
+}
+
+}  // namespace gilt::photonmap
