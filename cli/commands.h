@@ -16,6 +16,9 @@ std::function<void()> add_render_command(CLI::App& app);
 /// `gilt radiosity`: solves radiosity and exports the mesh with vertex colours.
 std::function<void()> add_radiosity_command(CLI::App& app);
 
+/// `gilt info`: describes a scene and the passes each method will run or skip.
+std::function<void()> add_info_command(CLI::App& app);
+
 /// Registers the radiosity meshing and solver options (--max-edge, --elements, --tolerance) on
 /// a subcommand; both `render --method radiosity` and `radiosity` use them.
 void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& settings);

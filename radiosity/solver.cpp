@@ -349,6 +349,22 @@ float level(const Rgb& c) { return c.average(); }
 
 }  // namespace
 
+SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
+  if (!scene.committed()) throw std::logic_error("radiosity::plan_solve: the scene was not committed");
+  SolvePlan plan;
+  MeshReport report;
+  const RadiosityMesh mesh = build_mesh(scene, settings.mesh, &report);
+  plan.elements = mesh.element_count();
+  plan.vertices = mesh.vertex_count();
+  plan.max_edge = report.max_edge;
+  plan.occluder_boxes = occluder_boxes(scene, mesh).size();
+  plan.convex_enclosure = plan.occluder_boxes == 0;
+  plan.punctual_lights = scene.punctual_lights.size();
+  for (const rc::TriangleMesh& m : scene.meshes) plan.specular_surfaces += scene.materials[m.material].is_specular();
+  for (const rc::Sphere& s : scene.spheres) plan.specular_surfaces += scene.materials[s.material].is_specular();
+  return plan;
+}
+
 Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (!scene.committed()) throw std::logic_error("radiosity::solve: the scene was not committed");
   if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance))

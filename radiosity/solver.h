@@ -63,4 +63,15 @@ struct Solution {
 /// Meshes and solves the committed scene.
 Solution solve(const rc::Scene& scene, const SolverSettings& settings);
 
+/// What solve() will do on a scene, found by meshing it without solving.
+struct SolvePlan {
+  size_t elements = 0, vertices = 0;  ///< before adaptive subdivision
+  float max_edge = 0.0f;
+  bool convex_enclosure = false;      ///< nothing can occlude: no visibility rays at all
+  size_t occluder_boxes = 0;          ///< boxes that shadow rays are tested against first
+  size_t punctual_lights = 0;         ///< point, spot, directional and environment lights, shot unmeshed
+  size_t specular_surfaces = 0;       ///< meshes and spheres left to ray tracing (mirror, glass)
+};
+SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings);
+
 }  // namespace gilt::radiosity

@@ -1,0 +1,165 @@
+// `gilt info SCENE`: what the scene holds and, for each method, which passes will run and which
+// are skipped and why.
+
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.h"
+#include "photonmap/photon_map.h"
+#include "radiosity/solver.h"
+#include "raytrace_core/scene_io.h"
+
+namespace gilt::cli {
+namespace rc = gilt::raytrace_core;
+namespace {
+
+struct InfoOptions {
+  std::string scene;
+  bool json = false;
+};
+
+const char* light_kind_name(rc::LightKind k) {
+  switch (k) {
+    case rc::LightKind::area_triangle: return "area triangles";
+    case rc::LightKind::area_sphere: return "area spheres";
+    case rc::LightKind::point: return "point";
+    case rc::LightKind::spot: return "spot";
+    case rc::LightKind::directional: return "directional";
+    case rc::LightKind::environment: return "environment";
+  }
+  return "?";
+}
+
+const char* material_kind_name(rc::MaterialKind k) {
+  switch (k) {
+    case rc::MaterialKind::diffuse: return "diffuse";
+    case rc::MaterialKind::glossy: return "glossy";
+    case rc::MaterialKind::mirror: return "mirror";
+    case rc::MaterialKind::dielectric: return "dielectric";
+  }
+  return "?";
+}
+
+std::string short_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", x);
+  return text;
+}
+
+/// One method's plan: passes that run and passes skipped with the reason.
+struct MethodPlan {
+  std::string method;
+  std::vector<std::string> runs, skipped;
+};
+
+std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
+  std::vector<MethodPlan> plans;
+  const bool lit = !scene.lights().empty();
+  const std::string nee = lit ? "next-event estimation over " + std::to_string(scene.lights().size()) +
+                                    " light(s), chosen by power"
+                              : "";
+  plans.push_back({"path", lit ? std::vector<std::string>{"camera paths with " + nee + ", MIS, Russian roulette"}
+                               : std::vector<std::string>{"camera paths (the image will be black)"},
+                   lit ? std::vector<std::string>{} : std::vector<std::string>{"light sampling: no lights"}});
+  plans.push_back({"whitted", {"camera rays, shadow rays to point-sampled lights, mirror and glass recursion"}, {}});
+
+  MethodPlan rad{"radiosity", {}, {}};
+  const radiosity::SolvePlan rp = radiosity::plan_solve(scene, radiosity::SolverSettings{});
+  rad.runs.push_back("mesh: about " + std::to_string(rp.elements) + " elements, " + std::to_string(rp.vertices) +
+                     " vertices (edge " + short_number(rp.max_edge) + "), adaptive subdivision at steep direct light");
+  if (rp.convex_enclosure) rad.skipped.push_back("visibility rays: convex enclosure, nothing can occlude");
+  else rad.runs.push_back("visibility rays only where " + std::to_string(rp.occluder_boxes) + " occluder box(es) may block");
+  if (rp.punctual_lights > 0)
+    rad.runs.push_back(std::to_string(rp.punctual_lights) + " punctual/environment light(s) shot without meshing");
+  if (rp.specular_surfaces > 0)
+    rad.runs.push_back(std::to_string(rp.specular_surfaces) + " mirror/glass surface(s) left to ray tracing (two-pass view)");
+  if (!lit) rad.skipped.push_back("shooting: no lights, the radiosity is zero");
+  plans.push_back(rad);
+
+  const photonmap::MapNeeds needs = photonmap::map_needs(scene);
+  MethodPlan photon{"photon", {}, {}};
+  if (needs.caustic) photon.runs.push_back("caustic map (light, mirror/glass+, diffuse)");
+  else photon.skipped.push_back("caustic map: " + needs.caustic_reason);
+  if (needs.global) photon.runs.push_back("global map, irradiance precomputed at every 4th photon, final gather");
+  else photon.skipped.push_back("global map and final gather: " + needs.global_reason);
+  if (lit) photon.runs.push_back("direct light by light sampling with MIS against the gather rays");
+  plans.push_back(photon);
+  MethodPlan sppm{"sppm", {}, {}};
+  if (lit) sppm.runs.push_back("per iteration: a visible point per pixel, direct light, photons, radius update");
+  else sppm.skipped.push_back("photons: no lights (the image will be black)");
+  plans.push_back(sppm);
+  return plans;
+}
+
+void run_info(const InfoOptions& o) {
+  const rc::Scene scene = rc::load_scene(o.scene);
+  for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
+  std::map<std::string, size_t> lights, materials;
+  for (const rc::Light& l : scene.lights()) ++lights[light_kind_name(l.kind)];
+  for (const rc::Material& m : scene.materials) ++materials[material_kind_name(m.kind)];
+  size_t emissive = 0;
+  for (const rc::Material& m : scene.materials) emissive += m.is_emissive();
+  // Memory: the scene's arrays plus Embree's BVH, estimated at 96 bytes per primitive (nodes
+  // and primitive references; an order-of-magnitude figure, not a measurement).
+  size_t vertices = 0, bytes = 0;
+  for (const rc::TriangleMesh& m : scene.meshes) {
+    vertices += m.positions.size();
+    bytes += m.positions.size() * sizeof(rc::Vec3) + m.normals.size() * sizeof(rc::Vec3) +
+             m.uvs.size() * sizeof(rc::Vec2) + m.indices.size() * sizeof(uint32_t);
+  }
+  const size_t bvh = scene.triangle_count() * 96 + scene.spheres.size() * 96;
+  bytes += bvh + scene.spheres.size() * sizeof(rc::Sphere);
+  const rc::Bounds3& b = scene.bounds();
+  const std::vector<MethodPlan> plans = plan_methods(scene);
+
+  if (o.json) {
+    nlohmann::json j = {{"command", "info"},
+                        {"scene", o.scene},
+                        {"triangles", scene.triangle_count()},
+                        {"vertices", vertices},
+                        {"meshes", scene.meshes.size()},
+                        {"spheres", scene.spheres.size()},
+                        {"lights", lights},
+                        {"materials", materials},
+                        {"emissive_materials", emissive},
+                        {"bounds", {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}}},
+                        {"memory_estimate_bytes", bytes}};
+    for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::printf("gilt info: %s\n", o.scene.c_str());
+  std::printf("  geometry:  %zu triangles (%zu vertices) in %zu mesh(es), %zu sphere(s)\n", scene.triangle_count(),
+              vertices, scene.meshes.size(), scene.spheres.size());
+  std::printf("  bounds:    (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  std::printf("  lights:   ");
+  if (lights.empty()) std::printf(" none");
+  for (const auto& [kind, n] : lights) std::printf(" %zu %s;", n, kind.c_str());
+  std::printf("\n  materials:");
+  for (const auto& [kind, n] : materials) std::printf(" %zu %s;", n, kind.c_str());
+  std::printf(" %zu emissive\n", emissive);
+  if (bytes < 1000000) std::printf("  memory:    about %.1f kB (geometry and BVH, estimated)\n", double(bytes) / 1e3);
+  else std::printf("  memory:    about %.1f MB (geometry and BVH, estimated)\n", double(bytes) / 1e6);
+  for (const MethodPlan& p : plans) {
+    std::printf("  %s:\n", p.method.c_str());
+    for (const std::string& r : p.runs) std::printf("    runs:    %s\n", r.c_str());
+    for (const std::string& s : p.skipped) std::printf("    skipped: %s\n", s.c_str());
+  }
+}
+
+}  // namespace
+
+std::function<void()> add_info_command(CLI::App& app) {
+  auto o = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand("info", "Describe a scene and what each method will run or skip on it");
+  cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
+  cmd->add_flag("--json", o->json, "Print the description as one JSON object");
+  return [o] { run_info(*o); };
+}
+
+}  // namespace gilt::cli
