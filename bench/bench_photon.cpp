@@ -9,6 +9,8 @@
 //             benchmarks; the reference's own noise is printed with it. For each method the time
 //             to reach the error `path` reaches in 8 s is interpolated (log-log) from its curve.
 //
+//   --index   the kd-tree against the hash grid inside the two-pass mapper and SPPM.
+//
 // Other options: --out-dir=DIR (default out/bench), --reference-spp=N (default 8192),
 // --fresh-reference. Results: photon_race.csv in the output folder.
 
@@ -112,6 +114,50 @@ void run_trace() {
               double(maps.paths) / times[2] * 1e-6, maps.global.photons.size(), maps.caustic.photons.size());
 }
 
+/// The index for each use: the two-pass mapper (k-nearest queries over both maps and the
+/// irradiance points) and SPPM (radius queries), each run with the kd-tree and the hash grid on
+/// the same photons, alternating, five times; medians of the render times. The images must be
+/// identical, since both indexes return exactly the brute-force neighbours.
+void run_index() {
+  const rc::Scene scene = rc::load_scene("cornell-caustics");
+  const rc::Camera camera = scene.effective_camera();
+  std::vector<double> times[2][2];
+  std::vector<rc::Rgb> images[2][2];
+  for (int r = 0; r < 5; ++r)
+    for (int kind = 0; kind < 2; ++kind) {
+      const pm::IndexKind index = kind == 0 ? pm::IndexKind::kd_tree : pm::IndexKind::hash_grid;
+      pm::PhotonMapperSettings s;
+      s.photons.index = index;
+      s.index = index;
+      const pm::PhotonMapper mapper(scene, s);
+      auto start = std::chrono::steady_clock::now();
+      images[kind][0] = rc::render_image(scene, camera, settings(2, 3),
+                                         [&](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper.radiance(ray, ctx); })
+                            .pixels();
+      times[kind][0].push_back(seconds_since(start));
+      pm::SppmSettings sp;
+      sp.index = index;
+      start = std::chrono::steady_clock::now();
+      images[kind][1] = pm::render_sppm(scene, camera, settings(8, 3), sp).pixels();
+      times[kind][1].push_back(seconds_since(start));
+    }
+  // The two-pass mapper sums neighbours in the same (sorted) order: identical images. SPPM's
+  // radius query visits them in each index's own order, so its float sums may differ in the
+  // last bits: 1e-5 relative.
+  if (images[0][0] != images[1][0]) fail("kd-tree and hash grid give different photon-mapped images");
+  for (size_t i = 0; i < images[0][1].size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(images[0][1][i][c] - images[1][1][i][c]) > 1e-5f * std::abs(images[0][1][i][c]) + 1e-12f)
+        fail("kd-tree and hash grid give different SPPM images at pixel " + std::to_string(i));
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  std::printf("index on cornell-caustics at %dx%d, medians of 5 (same images checked):\n", kSize, kSize);
+  std::printf("  photon render (2 spp, k-nearest): kd-tree %.3f s, hash grid %.3f s\n", median(times[0][0]), median(times[1][0]));
+  std::printf("  sppm (8 iterations, radius):      kd-tree %.3f s, hash grid %.3f s\n", median(times[0][1]), median(times[1][1]));
+}
+
 struct Point {
   std::string method;
   double budget, seconds, error;
@@ -200,21 +246,23 @@ void run_race(const fs::path& out_dir, int half_spp, bool fresh) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool trace = false, race = false, fresh = false;
+  bool trace = false, race = false, index = false, fresh = false;
   int half_spp = 4096;
   fs::path out_dir = "out/bench";
   for (int i = 1; i < argc; ++i) {
     const std::string_view arg = argv[i];
     if (arg == "--trace") trace = true;
     else if (arg == "--race") race = true;
+    else if (arg == "--index") index = true;
     else if (arg == "--fresh-reference") fresh = true;
     else if (arg.starts_with("--out-dir=")) out_dir = std::string(arg.substr(10));
     else if (arg.starts_with("--reference-spp=")) half_spp = std::max(1, std::atoi(argv[i] + 16) / 2);
     else fail("unknown option '" + std::string(arg) + "' (parts: --trace --race)");
   }
-  if (!trace && !race) trace = race = true;
+  if (!trace && !race && !index) trace = race = index = true;
   fs::create_directories(out_dir);
   if (trace) run_trace();
+  if (index) run_index();
   if (race) run_race(out_dir, half_spp, fresh);
   return 0;
 }

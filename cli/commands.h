@@ -16,6 +16,9 @@ std::function<void()> add_render_command(CLI::App& app);
 /// `gilt radiosity`: solves radiosity and exports the mesh with vertex colours.
 std::function<void()> add_radiosity_command(CLI::App& app);
 
+/// `gilt compare`: every method at every time budget against a reference, as a report.
+std::function<void()> add_compare_command(CLI::App& app);
+
 /// `gilt info`: describes a scene and the passes each method will run or skip.
 std::function<void()> add_info_command(CLI::App& app);
 

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   app.get_subcommand("render")->callback([&] { action = render; });
   const auto radiosity = gilt::cli::add_radiosity_command(app);
   app.get_subcommand("radiosity")->callback([&] { action = radiosity; });
+  const auto compare = gilt::cli::add_compare_command(app);
+  app.get_subcommand("compare")->callback([&] { action = compare; });
   const auto info = gilt::cli::add_info_command(app);
   app.get_subcommand("info")->callback([&] { action = info; });
 

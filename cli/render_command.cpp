@@ -11,8 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "photonmap/photon_mapper.h"
-#include "photonmap/sppm.h"
+#include "cli/methods.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
 #include "raytrace_core/error.h"
@@ -87,9 +86,6 @@ void check_output(const std::string& path) {
 }
 
 void run_render(const RenderOptions& o) {
-  if (o.method != "path" && o.method != "whitted" && o.method != "radiosity" && o.method != "photon" &&
-      o.method != "sppm")
-    throw rc::InputError("--method " + o.method + ": expected path, whitted, radiosity, photon or sppm");
   check_output(o.output);
   rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
@@ -107,71 +103,23 @@ void run_render(const RenderOptions& o) {
   settings.progress = !o.quiet && !o.json;
   const rc::Camera camera = make_camera(scene, o);
 
-  rc::RadianceFunction radiance;
-  std::optional<radiosity::Solution> solution;
-  std::optional<radiosity::RadiosityView> view;
-  std::optional<photonmap::PhotonMapper> mapper;
-  std::optional<photonmap::SppmStats> sppm_stats;
-  const auto start = std::chrono::steady_clock::now();
-  if (o.method == "photon") {
-    photonmap::PhotonMapperSettings pm;
-    if (o.photons) pm.photons.global_photons = *o.photons;
-    if (o.caustic_photons) pm.photons.caustic_photons = *o.caustic_photons;
-    pm.photons.seed = o.seed;
-    pm.k = o.k;
-    pm.max_radius = o.radius;
-    pm.gather_rays = o.gather_rays;
-    if (o.max_depth > 0) pm.max_depth = pm.photons.max_depth = o.max_depth;
-    {
-      const rc::ThreadLimit limit(o.threads);
-      mapper.emplace(scene, pm);
-    }
-    for (const std::string& s : mapper->stats().skipped)
-      if (!o.json && !o.quiet) std::cerr << "gilt: " << s << "\n";
-    radiance = [&mapper](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper->radiance(ray, ctx); };
-    // A time budget covers the photon pass too.
-    if (settings.time_limit > 0.0)
-      settings.time_limit = std::max(1e-3, settings.time_limit - std::chrono::duration<double>(
-                                                                     std::chrono::steady_clock::now() - start)
-                                                                     .count());
-  } else if (o.method == "radiosity") {
-    radiosity::SolverSettings solver = o.solver;
-    solver.seed = o.seed;
-    solver.threads = o.threads;
-    solver.progress = settings.progress;
-    solution.emplace(radiosity::solve(scene, solver));
-    for (const std::string& w : solution->mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
-    view.emplace(scene, *solution);
-    radiance = [&view](const rc::Ray& ray, rc::SampleContext& ctx) { return view->radiance(ray, ctx); };
-  } else if (o.method == "path") {
-    rc::PathSettings ps;
-    if (o.max_depth > 0) ps.max_depth = o.max_depth;
-    radiance = [&scene, ps](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, ps); };
-  } else {
-    rc::WhittedSettings ws;
-    if (o.max_depth > 0) ws.max_depth = o.max_depth;
-    radiance = [&scene, ws](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::whitted_radiance(scene, ray, ctx, ws); };
-  }
-
-  rc::RenderStats stats;
-  rc::Film film;
-  if (o.method == "sppm") {
-    photonmap::SppmSettings sp;
-    if (o.photons) sp.photons_per_iteration = *o.photons;
-    sp.initial_radius = o.radius;
-    sp.alpha = o.alpha;
-    if (o.max_depth > 0) sp.max_depth = o.max_depth;
-    sppm_stats.emplace();
-    film = photonmap::render_sppm(scene, camera, settings, sp, &*sppm_stats);
-    stats.spp = sppm_stats->iterations;
-    stats.samples = uint64_t(sppm_stats->iterations) * settings.width * settings.height;
-    stats.rays = sppm_stats->rays;
-    stats.seconds = sppm_stats->seconds;
-  } else {
-    film = rc::render_image(scene, camera, settings, radiance, &stats);
-  }
-  // The method's preparation (a radiosity solve, photon tracing) counts in the time.
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  MethodOptions mo;
+  mo.solver = o.solver;
+  if (o.photons) mo.photon.photons.global_photons = mo.sppm.photons_per_iteration = *o.photons;
+  if (o.caustic_photons) mo.photon.photons.caustic_photons = *o.caustic_photons;
+  mo.photon.k = o.k;
+  mo.photon.max_radius = mo.sppm.initial_radius = o.radius;
+  mo.photon.gather_rays = o.gather_rays;
+  mo.sppm.alpha = o.alpha;
+  mo.max_depth = o.max_depth;
+  const MethodResult result = run_method(scene, camera, o.method, settings, mo);
+  const rc::Film& film = result.film;
+  const rc::RenderStats& stats = result.stats;
+  const std::optional<radiosity::Solution>& solution = result.solution;
+  const std::optional<photonmap::PhotonMapperStats>& photon = result.photon;
+  const std::optional<photonmap::SppmStats>& sppm_stats = result.sppm;
+  for (const std::string& n : result.notes)
+    if (!o.json) std::cerr << "gilt: " << n << "\n";
   rc::write_image(o.output, rc::Image{film.width(), film.height(), film.pixels()}, o.exposure);
   if (stats.non_finite > 0)
     std::cerr << "gilt: warning: " << stats.non_finite << " sample(s) were NaN or infinite and were discarded\n";
@@ -201,8 +149,8 @@ void run_render(const RenderOptions& o) {
       j["radiosity"] = {{"elements", solution->mesh.element_count()}, {"shots", solution->shots},
                         {"residual", solution->residual}, {"seconds", solution->seconds}};
     }
-    if (mapper) {
-      const photonmap::PhotonMapperStats& ps = mapper->stats();
+    if (photon) {
+      const photonmap::PhotonMapperStats& ps = *photon;
       j["photon"] = {{"global_photons", ps.global_photons},       {"caustic_photons", ps.caustic_photons},
                      {"paths", ps.paths},                         {"irradiance_points", ps.irradiance_points},
                      {"trace_seconds", ps.trace_seconds},         {"precompute_seconds", ps.precompute_seconds},
@@ -228,11 +176,10 @@ void run_render(const RenderOptions& o) {
     if (solution)
       std::printf("  solve:   %zu elements, %llu shots, residual %.3g, %.3f s\n", solution->mesh.element_count(),
                   static_cast<unsigned long long>(solution->shots), solution->residual, solution->seconds);
-    if (mapper)
+    if (photon)
       std::printf("  photons: %zu global, %zu caustic stored from %llu paths in %.3f s; %zu irradiance points in %.3f s\n",
-                  mapper->stats().global_photons, mapper->stats().caustic_photons,
-                  static_cast<unsigned long long>(mapper->stats().paths), mapper->stats().trace_seconds,
-                  mapper->stats().irradiance_points, mapper->stats().precompute_seconds);
+                  photon->global_photons, photon->caustic_photons, static_cast<unsigned long long>(photon->paths),
+                  photon->trace_seconds, photon->irradiance_points, photon->precompute_seconds);
     if (sppm_stats)
       std::printf("  sppm:    %d iterations, %llu photons, radius %.4g -> %.4g (mean)\n", sppm_stats->iterations,
                   static_cast<unsigned long long>(sppm_stats->photons), sppm_stats->initial_radius,

@@ -25,7 +25,7 @@ struct PhotonSettings {
   uint64_t caustic_photons = 200'000;  ///< emitted for the caustic map (0: no caustic map)
   int max_depth = 32;                  ///< bounces per photon path at most
   uint64_t seed = 0;
-  IndexKind index = IndexKind::kd_tree;  ///< search structure over the stored photons
+  IndexKind index = IndexKind::hash_grid;  ///< search structure over the stored photons (bench_photon --index)
 };
 
 /// Stored photons of one map and their search structure. Each photon's power already includes

@@ -73,7 +73,7 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
     });
     std::vector<rc::Vec3> positions(count);
     for (size_t i = 0; i < count; ++i) positions[i] = points_[i].position;
-    point_index_ = PhotonIndex(positions, IndexKind::kd_tree);
+    point_index_ = PhotonIndex(positions, settings.index);
   }
   stats_.irradiance_points = points_.size();
   stats_.precompute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

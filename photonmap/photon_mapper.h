@@ -28,6 +28,7 @@ struct PhotonMapperSettings {
   int precompute_stride = 4;   ///< irradiance is precomputed at every n-th global photon
   int direct_samples = 16;     ///< shadow rays per precomputed irradiance point
   int max_depth = 32;          ///< specular bounces followed from the camera and along gather rays
+  IndexKind index = IndexKind::hash_grid;  ///< over the irradiance points (bench_photon --index)
 };
 
 /// What building the mapper did.

@@ -172,7 +172,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
     for (size_t i = 0; i < photons.size(); ++i) positions[i] = photons[i].position;
     float max_radius = 0.0f;
     for (const PixelState& p : state) max_radius = std::max(max_radius, p.radius);
-    const PhotonIndex index(positions, IndexKind::hash_grid, max_radius);
+    const PhotonIndex index(positions, sppm.index, max_radius);
 
     // 3. Gather at the visible points and shrink the radii.
     rc::parallel_for(size_t(height), [&](size_t y) {

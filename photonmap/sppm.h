@@ -7,6 +7,7 @@
 
 #include <cstdint>
 
+#include "photonmap/photon_index.h"
 #include "raytrace_core/camera.h"
 #include "raytrace_core/film.h"
 #include "raytrace_core/render.h"
@@ -22,6 +23,7 @@ struct SppmSettings {
   float initial_radius = 0.0f;  ///< scene units; 0: 1 % of the scene's bounding radius
   float alpha = 2.0f / 3.0f;    ///< fraction of new photons kept per iteration, in (0, 1)
   int max_depth = 32;           ///< bounces per camera or photon path
+  IndexKind index = IndexKind::hash_grid;  ///< over each iteration's photons (bench_photon --index)
 };
 
 /// What an SPPM render did.

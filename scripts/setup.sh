@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # gilt set-up on Debian 12: installs what is missing, builds, then runs one job.
-#   bash scripts/setup.sh demo   install, build, render the built-in Cornell box to out/cornell.png
+#   bash scripts/setup.sh demo   install, build, compare every method on the built-in cornell-caustics
+#                                scene: the report is out/compare/index.html (about 4 minutes)
 #   bash scripts/setup.sh test   install, build with warnings as errors, run the whole test suite,
 #                                then build the unit tests with AddressSanitizer + UBSan and run them
 #                                (what CI runs; SANITIZE=0 skips the sanitizer stage)
@@ -20,6 +21,8 @@ packages=(
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev
   libgtest-dev libbenchmark-dev
 )
+# The report test looks at index.html in a real browser.
+[ "$job" = test ] && packages+=(chromium)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -41,9 +44,11 @@ cmake --build "$build_dir" -j "$jobs"
 case "$job" in
   demo)
     mkdir -p "$root/out"
-    "$build_dir/cli/gilt" render cornell --spp 256 -o "$root/out/cornell.png"
+    "$build_dir/cli/gilt" compare cornell-caustics -o "$root/out/compare"
+    echo "setup: open $root/out/compare/index.html"
     ;;
   test)
+    export GILT_REQUIRE_CHROMIUM=1
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     if [ "${SANITIZE:-1}" != 0 ]; then
       # The fast label again, under AddressSanitizer and UndefinedBehaviorSanitizer.

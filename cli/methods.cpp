@@ -1,0 +1,77 @@
+#include "cli/methods.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "radiosity/view.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/whitted.h"
+
+namespace gilt::cli {
+namespace rc = gilt::raytrace_core;
+
+MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const std::string& method,
+                        const rc::RenderSettings& base, const MethodOptions& options) {
+  if (std::find(kMethods.begin(), kMethods.end(), method) == kMethods.end())
+    throw rc::InputError("--method " + method + ": expected path, whitted, radiosity, photon or sppm");
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  rc::RenderSettings settings = base;
+  MethodResult result;
+  rc::RadianceFunction radiance;
+  std::optional<radiosity::RadiosityView> view;
+  std::optional<photonmap::PhotonMapper> mapper;
+  // What is left of a time budget after the preparation: at least one pass gets rendered.
+  auto remaining = [&] { return std::max(1e-3, base.time_limit - elapsed()); };
+
+  if (method == "sppm") {
+    photonmap::SppmSettings sp = options.sppm;
+    if (options.max_depth > 0) sp.max_depth = options.max_depth;
+    result.sppm.emplace();
+    result.film = photonmap::render_sppm(scene, camera, settings, sp, &*result.sppm);
+    result.stats.spp = result.sppm->iterations;
+    result.stats.samples = uint64_t(result.sppm->iterations) * settings.width * settings.height;
+    result.stats.rays = result.sppm->rays;
+    result.stats.seconds = elapsed();
+    return result;
+  }
+  if (method == "photon") {
+    photonmap::PhotonMapperSettings pm = options.photon;
+    pm.photons.seed = settings.seed;
+    if (options.max_depth > 0) pm.max_depth = pm.photons.max_depth = options.max_depth;
+    {
+      const rc::ThreadLimit limit(settings.threads);
+      mapper.emplace(scene, pm);
+    }
+    result.photon = mapper->stats();
+    result.notes = mapper->stats().skipped;
+    radiance = [&mapper](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper->radiance(ray, ctx); };
+    if (base.time_limit > 0.0) settings.time_limit = remaining();
+  } else if (method == "radiosity") {
+    radiosity::SolverSettings solver = options.solver;
+    solver.seed = settings.seed;
+    solver.threads = settings.threads;
+    solver.progress = settings.progress;
+    if (base.time_limit > 0.0) solver.time_limit = 0.7 * base.time_limit;
+    result.solution.emplace(radiosity::solve(scene, solver));
+    result.notes = result.solution->mesh_report.warnings;
+    view.emplace(scene, *result.solution);
+    radiance = [&view](const rc::Ray& ray, rc::SampleContext& ctx) { return view->radiance(ray, ctx); };
+    if (base.time_limit > 0.0) settings.time_limit = remaining();
+  } else if (method == "path") {
+    rc::PathSettings ps;
+    if (options.max_depth > 0) ps.max_depth = options.max_depth;
+    radiance = [&scene, ps](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, ps); };
+  } else {
+    rc::WhittedSettings ws;
+    if (options.max_depth > 0) ws.max_depth = options.max_depth;
+    radiance = [&scene, ws](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::whitted_radiance(scene, ray, ctx, ws); };
+  }
+  result.film = rc::render_image(scene, camera, settings, radiance, &result.stats);
+  result.stats.seconds = elapsed();
+  return result;
+}
+
+}  // namespace gilt::cli

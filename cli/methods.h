@@ -1,0 +1,46 @@
+#pragma once
+// One image by any of gilt's methods, under a sample count or a time budget that covers the
+// method's preparation (radiosity solve, photon tracing) as well as the image. Shared by
+// `gilt render` and `gilt compare`.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "photonmap/photon_mapper.h"
+#include "photonmap/sppm.h"
+#include "radiosity/solver.h"
+#include "raytrace_core/camera.h"
+#include "raytrace_core/film.h"
+#include "raytrace_core/render.h"
+
+namespace gilt::cli {
+
+/// The methods, in the order reports list them.
+inline const std::vector<std::string> kMethods = {"path", "photon", "sppm", "radiosity", "whitted"};
+
+/// Every method's own settings; `max_depth` 0 keeps each method's default.
+struct MethodOptions {
+  radiosity::SolverSettings solver;
+  photonmap::PhotonMapperSettings photon;
+  photonmap::SppmSettings sppm;
+  int max_depth = 0;
+};
+
+/// What one run produced.
+struct MethodResult {
+  raytrace_core::Film film;
+  raytrace_core::RenderStats stats;  ///< seconds: the whole run, preparation included
+  std::optional<radiosity::Solution> solution;
+  std::optional<photonmap::PhotonMapperStats> photon;
+  std::optional<photonmap::SppmStats> sppm;
+  std::vector<std::string> notes;  ///< warnings and skipped passes
+};
+
+/// Renders with `method` ("path", "whitted", "radiosity", "photon" or "sppm"). With a time
+/// limit, a radiosity solve may use 70 % of it (a partial solution is shown with its ambient
+/// term) and photon tracing runs first; the image takes what is left, at least one pass.
+MethodResult run_method(const raytrace_core::Scene& scene, const raytrace_core::Camera& camera, const std::string& method,
+                        const raytrace_core::RenderSettings& settings, const MethodOptions& options);
+
+}  // namespace gilt::cli

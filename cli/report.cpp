@@ -1,0 +1,229 @@
+#include "cli/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "raytrace_core/staged_file.h"
+
+namespace gilt::cli {
+namespace {
+
+/// Line colours of the methods in the plot and table (distinct, colour-blind-safe Okabe–Ito).
+const char* method_colour(const std::string& method) {
+  static const std::map<std::string, const char*> colours = {
+      {"path", "#0072B2"}, {"photon", "#D55E00"}, {"sppm", "#009E73"}, {"radiosity", "#CC79A7"}, {"whitted", "#E69F00"}};
+  const auto it = colours.find(method);
+  return it == colours.end() ? "#000000" : it->second;
+}
+
+std::string number(double x, const char* format = "%.4g") {
+  char text[64];
+  std::snprintf(text, sizeof text, format, x);
+  return text;
+}
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  raytrace_core::StagedFile file(path, text);
+  file.commit();
+}
+
+/// Log-log plot of relMSE against seconds, one polyline per method.
+std::string plot_svg(const Report& r) {
+  const double w = 640, h = 400, left = 70, right = 130, top = 20, bottom = 50;
+  double tmin = 1e30, tmax = 0, emin = 1e30, emax = 0;
+  for (const ReportEntry& e : r.entries) {
+    if (!(e.relmse > 0.0) || !(e.seconds > 0.0)) continue;
+    tmin = std::min(tmin, e.seconds), tmax = std::max(tmax, e.seconds);
+    emin = std::min(emin, e.relmse), emax = std::max(emax, e.relmse);
+  }
+  if (!(tmax > 0.0)) return "<p>No errors to plot.</p>";
+  // Whole decades around the data.
+  const double lt0 = std::floor(std::log10(tmin)), lt1 = std::max(lt0 + 1, std::ceil(std::log10(tmax)));
+  const double le0 = std::floor(std::log10(emin)), le1 = std::max(le0 + 1, std::ceil(std::log10(emax)));
+  auto x_of = [&](double t) { return left + (std::log10(t) - lt0) / (lt1 - lt0) * (w - left - right); };
+  auto y_of = [&](double e) { return top + (le1 - std::log10(e)) / (le1 - le0) * (h - top - bottom); };
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" id=\"plot\" width=\"" << w << "\" height=\"" << h
+    << "\" viewBox=\"0 0 " << w << ' ' << h << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  s << "<rect x=\"0\" y=\"0\" width=\"" << w << "\" height=\"" << h << "\" fill=\"#ffffff\"/>\n";
+  for (double d = lt0; d <= lt1 + 1e-9; ++d) {
+    const double x = x_of(std::pow(10.0, d));
+    s << "<line x1=\"" << x << "\" y1=\"" << top << "\" x2=\"" << x << "\" y2=\"" << h - bottom
+      << "\" stroke=\"#dddddd\"/>\n<text x=\"" << x << "\" y=\"" << h - bottom + 16 << "\" text-anchor=\"middle\">"
+      << number(std::pow(10.0, d)) << "</text>\n";
+  }
+  for (double d = le0; d <= le1 + 1e-9; ++d) {
+    const double y = y_of(std::pow(10.0, d));
+    s << "<line x1=\"" << left << "\" y1=\"" << y << "\" x2=\"" << w - right << "\" y2=\"" << y
+      << "\" stroke=\"#dddddd\"/>\n<text x=\"" << left - 6 << "\" y=\"" << y + 4 << "\" text-anchor=\"end\">1e"
+      << int(d) << "</text>\n";
+  }
+  s << "<text x=\"" << (left + w - right) / 2 << "\" y=\"" << h - 12
+    << "\" text-anchor=\"middle\">time (s, log scale)</text>\n";
+  s << "<text x=\"16\" y=\"" << (top + h - bottom) / 2 << "\" text-anchor=\"middle\" transform=\"rotate(-90 16 "
+    << (top + h - bottom) / 2 << ")\">relative MSE (log scale)</text>\n";
+  int legend = 0;
+  for (const std::string& m : r.methods) {
+    std::ostringstream points;
+    int n = 0;
+    for (const ReportEntry& e : r.entries)
+      if (e.method == m && e.relmse > 0.0 && e.seconds > 0.0) points << x_of(e.seconds) << ',' << y_of(e.relmse) << ' ', ++n;
+    if (n == 0) continue;
+    s << "<polyline class=\"method-line\" data-method=\"" << m << "\" fill=\"none\" stroke=\"" << method_colour(m)
+      << "\" stroke-width=\"3\" points=\"" << points.str() << "\"/>\n";
+    for (const ReportEntry& e : r.entries)
+      if (e.method == m && e.relmse > 0.0 && e.seconds > 0.0)
+        s << "<circle cx=\"" << x_of(e.seconds) << "\" cy=\"" << y_of(e.relmse) << "\" r=\"4\" fill=\""
+          << method_colour(m) << "\"><title>" << m << ": " << number(e.seconds) << " s, relMSE " << number(e.relmse)
+          << "</title></circle>\n";
+    const double ly = top + 10 + 20 * legend++;
+    s << "<line x1=\"" << w - right + 12 << "\" y1=\"" << ly << "\" x2=\"" << w - right + 40 << "\" y2=\"" << ly
+      << "\" stroke=\"" << method_colour(m) << "\" stroke-width=\"3\"/><text x=\"" << w - right + 46 << "\" y=\""
+      << ly + 4 << "\">" << m << "</text>\n";
+  }
+  s << "</svg>\n";
+  return s.str();
+}
+
+}  // namespace
+
+void error_colour(double relative_error, unsigned char rgb[3]) {
+  // Log scale: 1e-3 → 0, 1 → 1; a ramp dark blue, blue, cyan, yellow, red.
+  const double t = std::clamp((std::log10(std::max(relative_error, 1e-12)) + 3.0) / 3.0, 0.0, 1.0);
+  static const double stops[5][3] = {{10, 10, 60}, {30, 80, 220}, {40, 200, 200}, {240, 220, 40}, {220, 30, 30}};
+  const double x = t * 4.0;
+  const int i = std::min(3, int(x));
+  const double f = x - i;
+  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<unsigned char>(std::lround(stops[i][c] * (1 - f) + stops[i + 1][c] * f));
+}
+
+void write_report(const std::filesystem::path& folder, const Report& r) {
+  // metrics.json and metrics.csv.
+  nlohmann::json j = {{"scene", r.scene},       {"width", r.width},         {"height", r.height},
+                      {"reference", r.reference}, {"reference_noise_mean_relative_error", r.reference_noise_mre},
+                      {"relmse_epsilon", 0.01},  {"entries", nlohmann::json::array()}};
+  std::ostringstream csv;
+  csv << "method,budget_seconds,seconds,spp_or_iterations,photons,shots,rmse,relmse,mae,mean_relative_error,"
+         "object_space_error,image\n";
+  for (const ReportEntry& e : r.entries) {
+    nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
+                         {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
+                         {"rmse", e.rmse}, {"relmse", e.relmse}, {"mae", e.mae}, {"mean_relative_error", e.mre},
+                         {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
+                         {"notes", e.notes}};
+    je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
+    j["entries"].push_back(je);
+    csv << e.method << ',' << e.budget << ',' << number(e.seconds, "%.4f") << ',' << e.spp << ',' << e.photons << ','
+        << e.shots << ',' << number(e.rmse, "%.6g") << ',' << number(e.relmse, "%.6g") << ','
+        << number(e.mae, "%.6g") << ',' << number(e.mre, "%.6g") << ','
+        << (e.object_space_error ? number(*e.object_space_error, "%.6g") : std::string()) << ',' << e.image_exr
+        << '\n';
+  }
+  write_file(folder / "metrics.json", j.dump(2) + "\n");
+  write_file(folder / "metrics.csv", csv.str());
+
+  // index.html. Small images are shown enlarged by a whole factor (pixels stay square and sharp).
+  const int scale = std::max(1, 192 / std::max(1, std::max(r.width, r.height)));
+  const int display_width = r.width * scale, display_height = r.height * scale;
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>gilt compare: "
+    << escape(r.scene) << "</title>\n<style>\n"
+    << "body{font-family:sans-serif;margin:20px;color:#222;background:#fafafa}\n"
+    << "table{border-collapse:collapse;margin:12px 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}\n"
+    << "th{background:#eee}td.m{text-align:left;font-weight:bold}td.best{background:#d8f0d8}\n"
+    << ".grid{display:grid;gap:8px;justify-content:start;grid-template-columns:100px repeat(" << r.budgets.size()
+    << "," << display_width << "px)}.grid img{width:" << display_width << "px;height:" << display_height
+    << "px;image-rendering:pixelated;display:block}\n"
+    << ".cell{font-size:12px}.head{font-weight:bold;align-self:center}\n"
+    << ".legend{height:14px;width:300px;background:linear-gradient(to right,rgb(10,10,60),rgb(30,80,220),"
+       "rgb(40,200,200),rgb(240,220,40),rgb(220,30,30))}\n</style>\n</head>\n<body>\n";
+  h << "<h1>gilt compare: " << escape(r.scene) << "</h1>\n<p>" << r.width << " &times; " << r.height
+    << " pixels, every method on the same camera. Reference: " << escape(r.reference);
+  if (r.reference_noise_mre > 0.0)
+    h << " (its own noise: mean relative error " << number(100 * r.reference_noise_mre, "%.2f")
+      << " %; errors below that cannot be told apart)";
+  h << ".</p>\n";
+
+  // Winners.
+  h << "<h2>Best method at each budget</h2>\n<table id=\"winners\"><tr><th>budget</th>";
+  for (double b : r.budgets) h << "<th>" << number(b) << " s</th>";
+  h << "</tr><tr><td class=\"m\">lowest relMSE</td>";
+  for (double b : r.budgets) {
+    const ReportEntry* best = nullptr;
+    for (const ReportEntry& e : r.entries)
+      if (e.budget == b && (!best || e.relmse < best->relmse)) best = &e;
+    h << "<td style=\"color:" << (best ? method_colour(best->method) : "#000") << ";font-weight:bold\">"
+      << (best ? best->method : "-") << "</td>";
+  }
+  h << "</tr></table>\n";
+
+  h << "<h2>Error against time</h2>\n" << plot_svg(r);
+
+  h << "<h2>Images</h2>\n<p>All at exposure " << number(r.exposure) << " EV. Under each image its per-pixel "
+    << "relative error |I &minus; R| / (R + 0.01), false colour on a log scale:</p>\n"
+    << "<div style=\"display:flex;gap:8px;align-items:center;font-size:12px\">0.001<div class=\"legend\"></div>1</div>\n";
+  h << "<div class=\"grid\">\n<div class=\"head\">reference</div>";
+  h << "<div class=\"cell\"><img class=\"render\" src=\"" << r.reference_png << "\" alt=\"reference\"></div>";
+  for (size_t i = 1; i < r.budgets.size(); ++i) h << "<div></div>";
+  h << "\n<div></div>";
+  for (double b : r.budgets) h << "<div class=\"head\">" << number(b) << " s</div>";
+  h << "\n";
+  for (const std::string& m : r.methods) {
+    h << "<div class=\"head\" style=\"color:" << method_colour(m) << "\">" << m << "</div>";
+    for (double b : r.budgets) {
+      const auto it = std::find_if(r.entries.begin(), r.entries.end(),
+                                   [&](const ReportEntry& e) { return e.method == m && e.budget == b; });
+      if (it == r.entries.end()) {
+        h << "<div></div>";
+        continue;
+      }
+      h << "<div class=\"cell\"><img class=\"render\" src=\"" << it->image_png << "\" alt=\"" << m << " "
+        << number(b) << " s\"><img class=\"error\" src=\"" << it->error_png << "\" alt=\"error of " << m << " "
+        << number(b) << " s\">" << number(it->seconds, "%.2f") << " s, relMSE " << number(it->relmse, "%.3g")
+        << "</div>";
+    }
+    h << "\n";
+  }
+  h << "</div>\n";
+
+  h << "<h2>Metrics</h2>\n<table id=\"metrics\"><tr><th>method</th><th>budget s</th><th>actual s</th>"
+       "<th>spp / iterations</th><th>photons</th><th>shots</th><th>RMSE</th><th>relMSE</th><th>MAE</th>"
+       "<th>mean rel. error</th><th>object-space error</th></tr>\n";
+  for (const ReportEntry& e : r.entries) {
+    double best = 1e300;
+    for (const ReportEntry& o : r.entries)
+      if (o.budget == e.budget) best = std::min(best, o.relmse);
+    h << "<tr><td class=\"m\" style=\"color:" << method_colour(e.method) << "\">" << e.method << "</td><td>"
+      << number(e.budget) << "</td><td>" << number(e.seconds, "%.2f") << "</td><td>" << e.spp << "</td><td>"
+      << e.photons << "</td><td>" << e.shots << "</td><td>" << number(e.rmse, "%.4g") << "</td><td"
+      << (e.relmse == best ? " class=\"best\"" : "") << ">" << number(e.relmse, "%.4g") << "</td><td>"
+      << number(e.mae, "%.4g") << "</td><td>" << number(100 * e.mre, "%.2f") << " %</td><td>"
+      << (e.object_space_error ? number(100 * *e.object_space_error, "%.2f") + " %" : std::string("")) << "</td></tr>\n";
+  }
+  h << "</table>\n<p>relMSE = mean over pixels and channels of (I &minus; R)&sup2; / (R&sup2; + 0.01). Times include "
+       "each method's preparation (radiosity solve, photon tracing). Object-space error: radiosity vertex radiance "
+       "against path-traced estimates at sampled vertices. Files: <a href=\"metrics.json\">metrics.json</a>, "
+       "<a href=\"metrics.csv\">metrics.csv</a>.</p>\n</body>\n</html>\n";
+  write_file(folder / "index.html", h.str());
+}
+
+}  // namespace gilt::cli

@@ -1,0 +1,51 @@
+#pragma once
+// The `gilt compare` report: index.html (images side by side at one exposure, a false-colour
+// error image under each, the metrics table, the best method per budget, and a log-log plot of
+// error against time as inline SVG: no scripts, fonts or anything else from the network),
+// metrics.json and metrics.csv.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace gilt::cli {
+
+/// One method at one budget.
+struct ReportEntry {
+  std::string method;
+  double budget = 0.0;         ///< seconds asked for
+  double seconds = 0.0;        ///< seconds taken, preparation included
+  int spp = 0;                 ///< samples per pixel, or SPPM iterations
+  uint64_t photons = 0;        ///< photon paths traced (photon, sppm)
+  uint64_t shots = 0;          ///< radiosity shots
+  double rmse = 0.0;           ///< √mean (I − R)² over pixels and channels
+  double relmse = 0.0;         ///< mean (I − R)² / (R² + 0.01)
+  double mae = 0.0;            ///< mean |I − R|
+  double mre = 0.0;            ///< mean |I − R| / (R + 0.01), the measure of gilt's benchmarks
+  std::optional<double> object_space_error;  ///< radiosity: vertex radiance against path-traced estimates
+  std::string image_png, image_exr, error_png;  ///< relative to the report folder
+  std::vector<std::string> notes;
+};
+
+/// Everything the report shows.
+struct Report {
+  std::string scene;
+  int width = 0, height = 0;
+  float exposure = 0.0f;
+  std::string reference;            ///< how the reference was made or where it came from
+  double reference_noise_mre = 0.0; ///< the reference's own noise in the mre measure (0: unknown)
+  std::string reference_png;
+  std::vector<std::string> methods;
+  std::vector<double> budgets;
+  std::vector<ReportEntry> entries;
+};
+
+/// Writes index.html, metrics.json and metrics.csv into `folder` (each file atomically).
+void write_report(const std::filesystem::path& folder, const Report& report);
+
+/// Colour of a relative error in the false-colour images and the legend (log scale from 1e-3,
+/// dark blue, to 1, red), as 8-bit sRGB.
+void error_colour(double relative_error, unsigned char rgb[3]);
+
+}  // namespace gilt::cli

@@ -1,0 +1,176 @@
+// `gilt compare` end to end: the report's files and metrics, the reference cache, bad input, and
+// the page itself in headless Chromium (a screenshot in which the test finds the reference image
+// pixel for pixel and every method's line in the plot).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "raytrace_core/image_io.h"
+
+namespace fs = std::filesystem;
+namespace rc = gilt::raytrace_core;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+class Compare : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("gilt-compare-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& command) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = "GILT_CACHE_DIR='" + (dir_ / "cache").string() + "' " + command + " >'" + out.string() +
+                            "' 2>'" + err.string() + "' </dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+  Result gilt(const std::string& args) { return run(std::string("'") + GILT_BINARY_PATH + "' " + args); }
+
+  /// A small report: two methods, two budgets, 32 × 32.
+  fs::path small_report(const std::string& name) {
+    const fs::path report = dir_ / name;
+    const Result r = gilt("compare cornell --methods path,radiosity --budgets 0.3,0.6 --reference-time 1 --width 32 "
+                          "--height 32 -q -o '" + report.string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return report;
+  }
+
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(Compare, WritesReportMetricsAndImages) {
+  const fs::path report = small_report("report");
+  ASSERT_TRUE(fs::exists(report / "index.html"));
+  const nlohmann::json j = nlohmann::json::parse(slurp(report / "metrics.json"));
+  ASSERT_EQ(j["entries"].size(), 4u);
+  for (const auto& e : j["entries"]) {
+    for (const char* key : {"image_exr", "image_png", "error_png"})
+      EXPECT_TRUE(fs::exists(report / e[key].get<std::string>())) << e[key];
+    EXPECT_GT(e["seconds"].get<double>(), 0.0);
+    EXPECT_GE(e["relmse"].get<double>(), 0.0);
+    EXPECT_GE(e["rmse"].get<double>(), 0.0);
+    if (e["method"] == "radiosity") {
+      EXPECT_TRUE(e["object_space_error"].is_number());
+      EXPECT_GT(e["shots"].get<int>(), 0);
+    } else {
+      EXPECT_TRUE(e["object_space_error"].is_null());
+      EXPECT_GT(e["spp_or_iterations"].get<int>(), 0);
+    }
+  }
+  const std::string csv = slurp(report / "metrics.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
+  const std::string html = slurp(report / "index.html");
+  EXPECT_NE(html.find("data-method=\"path\""), std::string::npos);
+  EXPECT_NE(html.find("data-method=\"radiosity\""), std::string::npos);
+  // Offline: nothing is fetched from elsewhere.
+  EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org/2000/svg"));
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+}
+
+TEST_F(Compare, SecondRunReusesTheCachedReference) {
+  small_report("first");
+  const std::string first = nlohmann::json::parse(slurp(dir_ / "first/metrics.json"))["reference"];
+  EXPECT_EQ(first.find("cached"), std::string::npos) << first;
+  small_report("second");
+  const std::string second = nlohmann::json::parse(slurp(dir_ / "second/metrics.json"))["reference"];
+  EXPECT_NE(second.find("cached"), std::string::npos) << second;
+  EXPECT_EQ(slurp(dir_ / "first/images/reference.exr"), slurp(dir_ / "second/images/reference.exr"));
+}
+
+TEST_F(Compare, BadInputExitsTwo) {
+  const std::string out = (dir_ / "r").string();
+  const fs::path small = dir_ / "small.exr";
+  rc::write_image(small.string(), rc::Image{4, 4, std::vector<rc::Rgb>(16, rc::Rgb(0.5f))});
+  const std::pair<std::string, std::string> cases[] = {
+      {"compare cornell --methods path,magic -o " + out, "magic"},
+      {"compare cornell --budgets 1,-2 -o " + out, "--budgets"},
+      {"compare cornell --budgets 1,x -o " + out, "--budgets"},
+      {"compare cornell --reference " + (dir_ / "none.exr").string() + " -o " + out, "none.exr"},
+      {"compare cornell --reference " + small.string() + " --width 8 --height 8 -o " + out, "does not match"},
+      {"compare cornell -o " + (dir_ / "no/such/folder").string(), "does not exist"},
+  };
+  for (const auto& [args, message] : cases) {
+    const Result r = gilt(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
+}
+
+// The page in a real browser. Chromium from Debian renders index.html headless to a PNG; the test
+// then finds (1) the reference image, shown enlarged by a whole factor with pixelated scaling, as
+// an exact block of the screenshot, and (2) each method's line colour in the plot. Without
+// Chromium the test is skipped, unless GILT_REQUIRE_CHROMIUM is set (CI sets it).
+TEST_F(Compare, PageShowsImagesAndPlotInChromium) {
+  if (std::system("command -v chromium >/dev/null 2>&1") != 0) {
+    if (std::getenv("GILT_REQUIRE_CHROMIUM")) FAIL() << "chromium is not installed";
+    GTEST_SKIP() << "chromium is not installed";
+  }
+  const fs::path report = small_report("report");
+  const fs::path shot = dir_ / "shot.png";
+  const Result r = run("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --force-device-scale-factor=1 "
+                       "--user-data-dir='" + (dir_ / "profile").string() + "' --window-size=1200,1600 --screenshot='" +
+                       shot.string() + "' 'file://" + (report / "index.html").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const rc::Image page = rc::read_image(shot.string());
+  const rc::Image ref = rc::read_image((report / "images/reference.png").string());
+  ASSERT_EQ(ref.width, 32);
+  const int scale = 192 / 32;  // report.cpp: enlarged to about 192 pixels by a whole factor
+
+  // (1) The reference image: a block where every screenshot pixel equals its source pixel.
+  auto at = [&](int x, int y) { return page.pixels[size_t(y) * page.width + x]; };
+  bool found = false;
+  for (int y = 0; y + 32 * scale <= page.height && !found; ++y)
+    for (int x = 0; x + 32 * scale <= page.width && !found; ++x) {
+      if (!(at(x, y) == ref.pixels[0])) continue;
+      bool all = true;
+      for (int j = 0; j < 32 && all; ++j)
+        for (int i = 0; i < 32 && all; ++i) all = at(x + i * scale + scale / 2, y + j * scale + scale / 2) == ref.pixels[size_t(j) * 32 + i];
+      found = all;
+    }
+  EXPECT_TRUE(found) << "the reference image was not found in the screenshot";
+
+  // (2) The plot: pixels of each method's line colour (path #0072B2, radiosity #CC79A7).
+  const rc::Image swatch = [&] {
+    // The same colours through the same PNG decoding as the screenshot.
+    const fs::path file = dir_ / "swatch.png";
+    auto linear = [](float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); };
+    rc::write_image(file.string(), rc::Image{2, 1, {rc::Rgb(linear(0 / 255.f), linear(114 / 255.f), linear(178 / 255.f)),
+                                                    rc::Rgb(linear(204 / 255.f), linear(121 / 255.f), linear(167 / 255.f))}});
+    return rc::read_image(file.string());
+  }();
+  for (int m = 0; m < 2; ++m) {
+    size_t count = 0;
+    for (const rc::Rgb& p : page.pixels) count += p == swatch.pixels[size_t(m)];
+    EXPECT_GT(count, 100u) << (m == 0 ? "path" : "radiosity") << " line not found in the plot";
+  }
+}
