@@ -10,7 +10,10 @@
 # Exits 1 when the core keeps less than MIN_RATIO of raw Embree's single-thread throughput for
 # any ray kind. Environment: BUILD_DIR (default build), OUT_DIR (default out/bench),
 # REPETITIONS (default 5), MIN_RATIO (default 0.90), JOBS (default: number of cores),
-# RADIOSITY (default 1; 0 skips bench_radiosity, which takes two to three minutes on two cores).
+# RADIOSITY (default 1; 0 skips bench_radiosity, which takes two to three minutes on two cores),
+# PHOTON (default 1; 0 skips bench_photon_index and bench_photon: the index at one million
+# photons, photon tracing rate, kd-tree against hash grid, and the race of photon, sppm and path
+# on cornell-caustics, about three minutes plus a minute for its reference the first time).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -20,6 +23,7 @@ repetitions=${REPETITIONS:-5}
 min_ratio=${MIN_RATIO:-0.90}
 jobs=${JOBS:-$(nproc)}
 radiosity=${RADIOSITY:-1}
+photon=${PHOTON:-1}
 
 # Timings only mean something in an optimised build.
 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DGILT_BUILD_BENCH=ON
@@ -42,6 +46,14 @@ if [[ $radiosity != 0 ]]; then
   # the path-traced references are cached too) and ignore the repetitions.
   "$build_dir/bench/bench_radiosity" "${flags[@]}" --benchmark_out="$out_dir/radiosity.json" \
     --out-dir="$out_dir" "$@"
+  echo
+fi
+
+if [[ $photon != 0 ]]; then
+  "$build_dir/bench/bench_photon_index" "${flags[@]}" --benchmark_out="$out_dir/photon_index.json" "$@"
+  echo
+  # Not Google Benchmarks: prints its figures and writes photon_race.csv to out_dir.
+  "$build_dir/bench/bench_photon" --out-dir="$out_dir"
   echo
 fi
 
