@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace gilt::radiosity {
 namespace {
@@ -65,6 +66,57 @@ SourceTriangle::SourceTriangle(const Vec3& a, const Vec3& b, const Vec3& c)
   rule_points_[0] = m + 0.5f * a;
   rule_points_[1] = m + 0.5f * b;
   rule_points_[2] = m + 0.5f * c;
+}
+
+void SourceBatch::assign(std::span<const SourceTriangle> triangles) {
+  if (triangles.size() > kMaxBatch) throw std::length_error("SourceBatch: more than kMaxBatch triangles");
+  triangles_.assign(triangles.begin(), triangles.end());
+  const size_t m = triangles.size();
+  for (auto* v : {&tx_, &ty_, &tz_, &cx_, &cy_, &cz_, &far2_, &radius_, &nx_, &ny_, &nz_, &offset_}) v->resize(m);
+  for (int j = 0; j < 3; ++j) qx_[j].resize(m), qy_[j].resize(m), qz_[j].resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    const SourceTriangle& t = triangles[k];
+    for (int j = 0; j < 3; ++j) qx_[j][k] = t.rule_points_[j].x, qy_[j][k] = t.rule_points_[j].y, qz_[j][k] = t.rule_points_[j].z;
+    tx_[k] = t.twice_area_normal_.x, ty_[k] = t.twice_area_normal_.y, tz_[k] = t.twice_area_normal_.z;
+    cx_[k] = t.centroid_.x, cy_[k] = t.centroid_.y, cz_[k] = t.centroid_.z;
+    far2_[k] = t.far_distance2_, radius_[k] = t.radius_;
+    nx_[k] = t.normal_.x, ny_[k] = t.normal_.y, nz_[k] = t.normal_.z, offset_[k] = t.plane_offset_;
+  }
+}
+
+void SourceBatch::form_factors(const Vec3& p, const Vec3& n, float* out) const {
+  const size_t m = triangles_.size();
+  // Local copies of the array pointers and results on the stack: nothing aliases, so the loop
+  // below vectorises. kind: 0 far rule applies, 1 near or straddling (exact formula), 2 the
+  // receiver is behind the source.
+  const float* __restrict q[9] = {qx_[0].data(), qy_[0].data(), qz_[0].data(), qx_[1].data(), qy_[1].data(),
+                                  qz_[1].data(), qx_[2].data(), qy_[2].data(), qz_[2].data()};
+  const float *__restrict tx = tx_.data(), *__restrict ty = ty_.data(), *__restrict tz = tz_.data();
+  const float *__restrict cx = cx_.data(), *__restrict cy = cy_.data(), *__restrict cz = cz_.data();
+  const float *__restrict far2 = far2_.data(), *__restrict radius = radius_.data();
+  const float *__restrict snx = nx_.data(), *__restrict sny = ny_.data(), *__restrict snz = nz_.data();
+  const float* __restrict offset = offset_.data();
+  float value[kMaxBatch];
+  int kind[kMaxBatch];
+  const float px = p.x, py = p.y, pz = p.z, nx = n.x, ny = n.y, nz = n.z;
+  constexpr float kScale = float(1.0 / (6.0 * 3.14159265358979323846));
+  for (size_t k = 0; k < m; ++k) {
+    float sum = 0.0f;
+    for (int j = 0; j < 3; ++j) {
+      const float dx = q[3 * j][k] - px, dy = q[3 * j + 1][k] - py, dz = q[3 * j + 2][k] - pz;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      const float cos_receiver = nx * dx + ny * dy + nz * dz;
+      const float cos_source_scaled = -(tx[k] * dx + ty[k] * dy + tz[k] * dz);
+      sum += std::max(cos_receiver, 0.0f) * std::max(cos_source_scaled, 0.0f) / (r2 * r2);
+    }
+    value[k] = std::min(sum * kScale, 1.0f);
+    const float ex = cx[k] - px, ey = cy[k] - py, ez = cz[k] - pz;
+    const int near = int(ex * ex + ey * ey + ez * ez < far2[k]) | int(nx * ex + ny * ey + nz * ez <= radius[k]);
+    const int behind = int(snx[k] * px + sny[k] * py + snz[k] * pz <= offset[k]);
+    kind[k] = near | (behind << 1);
+  }
+  for (size_t k = 0; k < m; ++k)
+    out[k] = kind[k] == 0 ? value[k] : (kind[k] & 2) ? 0.0f : float(triangles_[k].form_factor(p, n));
 }
 
 }  // namespace gilt::radiosity

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <span>
+#include <vector>
 
 #include "raytrace_core/math.h"
 
@@ -63,6 +64,7 @@ class SourceTriangle {
   }
 
  private:
+  friend class SourceBatch;
   Vec3 a_{0.0f}, b_{0.0f}, c_{0.0f};
   Vec3 normal_{0.0f};             ///< unit
   float plane_offset_ = 0.0f;     ///< normal · a
@@ -71,6 +73,27 @@ class SourceTriangle {
   float far_distance2_ = 0.0f;    ///< (kFarFieldRatio · radius)²
   Vec3 twice_area_normal_{0.0f};  ///< (b − a) × (c − a)
   Vec3 rule_points_[3];           ///< barycentric (2/3, 1/6, 1/6) and permutations
+};
+
+/// Source triangles laid out to be evaluated together for one receiver at a time: the far-field
+/// rule runs branch-free over all of them (the compiler vectorises it), and only the triangles
+/// near the receiver or behind its tangent plane go through SourceTriangle::form_factor. The
+/// results equal SourceTriangle::form_factor's up to float rounding of the far rule.
+class SourceBatch {
+ public:
+  /// Prepares the triangles; at most kMaxBatch.
+  void assign(std::span<const SourceTriangle> triangles);
+  size_t size() const { return triangles_.size(); }
+  /// F(dA → triangle k) for every k into out[k], for a receiver at p with unit normal n.
+  void form_factors(const Vec3& p, const Vec3& n, float* out) const;
+
+  static constexpr size_t kMaxBatch = 64;
+
+ private:
+  std::vector<SourceTriangle> triangles_;
+  // One array per coordinate, each of size() floats: rule points, the doubled-area normal,
+  // centroid, far-field distance², radius, unit normal and plane offset.
+  std::vector<float> qx_[3], qy_[3], qz_[3], tx_, ty_, tz_, cx_, cy_, cz_, far2_, radius_, nx_, ny_, nz_, offset_;
 };
 
 }  // namespace gilt::radiosity

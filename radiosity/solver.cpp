@@ -138,7 +138,7 @@ bool tetrahedron_may_meet_box(const Vec3& p, const Vec3& a, const Vec3& b, const
 }
 
 /// Largest shooting patch: the per-vertex scratch arrays live on the stack.
-constexpr size_t kMaxPatchElements = 64;
+constexpr size_t kMaxPatchElements = SourceBatch::kMaxBatch;
 
 /// Shooting patches: groups of adjacent elements of one surface and material, all facing about
 /// the same way, grown breadth-first from a seed so they come out compact. Shooting a patch
@@ -229,6 +229,7 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc
 struct ShootingPatch {
   std::vector<uint32_t> elements;
   std::vector<SourceTriangle> triangles;
+  SourceBatch batch;
   std::vector<Rgb> radiosity;
   rc::Bounds3 box;
   bool emitter = false;  ///< sharp shadows: the per-element occluder test and the adaptive probe
@@ -247,6 +248,7 @@ struct ShootingPatch {
       triangles[k] = SourceTriangle(mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]]);
       for (uint32_t v : el) box.extend(mesh.positions[v]);
     }
+    batch.assign(triangles);
   }
 };
 
@@ -283,11 +285,13 @@ struct Receivers {
     Rgb gathered(0.0f);
     float total = 0.0f;
     size_t count = 0;
+    std::array<float, SourceBatch::kMaxBatch> factor;
+    src.batch.form_factors(p, n, factor.data());
+    counts.form_factors += src.elements.size();
     for (size_t k = 0; k < src.elements.size(); ++k) {
-      const double f = src.triangles[k].form_factor(p, n);
-      ++counts.form_factors;
+      const float f = factor[k];
       if (!(f > 0.0)) continue;
-      const Rgb share = src.radiosity[k] * float(f);
+      const Rgb share = src.radiosity[k] * f;
       if (share.is_black()) continue;
       gathered += share;
       total += share.average();

@@ -753,4 +753,34 @@ TEST(FormFactorFarField, WithinStatedBoundAtTheSwitchDistance) {
   EXPECT_LT(worst, kStatedBound);
 }
 
+// The batched evaluation the solver uses gives SourceTriangle::form_factor's values exactly
+// (same operations in the same order), near and far, in front and behind.
+TEST(FormFactorFarField, BatchEqualsOneByOne) {
+  using gilt::radiosity::SourceBatch;
+  using gilt::radiosity::SourceTriangle;
+  using gilt::radiosity::Vec3;
+  gilt::raytrace_core::Rng rng = gilt::raytrace_core::Rng::for_item(12, 0, 0);
+  auto u = [&] { return 2.0f * rng.uniform() - 1.0f; };
+  std::vector<SourceTriangle> triangles;
+  for (size_t k = 0; k < SourceBatch::kMaxBatch; ++k) {
+    const Vec3 c(u(), u(), u());
+    triangles.emplace_back(c, c + 0.2f * Vec3(u(), u(), u()), c + 0.2f * Vec3(u(), u(), u()));
+  }
+  SourceBatch batch;
+  batch.assign(triangles);
+  std::vector<float> out(batch.size());
+  int positive = 0, zero = 0;  // both kinds of answer occur
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 p = Vec3(u(), u(), u()) * (i % 2 ? 10.0f : 1.5f);
+    const Vec3 n = glm::normalize(Vec3(u(), u(), u()));
+    batch.form_factors(p, n, out.data());
+    for (size_t k = 0; k < triangles.size(); ++k) {
+      ASSERT_EQ(out[k], float(triangles[k].form_factor(p, n))) << "triangle " << k << ", receiver " << i;
+      (out[k] > 0.0f ? positive : zero) += 1;
+    }
+  }
+  EXPECT_GT(positive, 1000);
+  EXPECT_GT(zero, 1000);
+}
+
 }  // namespace
