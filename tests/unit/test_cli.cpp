@@ -113,6 +113,27 @@ TEST_F(Cli, PhotonAndSppmRenderAndReport) {
   EXPECT_NE(c.out.find("no specular surface"), std::string::npos) << c.out;
 }
 
+TEST_F(Cli, InfoSaysWhatEachMethodRunsAndSkips) {
+  const Result r = run("info cornell --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["triangles"], 38);
+  EXPECT_EQ(j["lights"]["area triangles"], 2);
+  EXPECT_GT(j["memory_estimate_bytes"].get<double>(), 0.0);
+  const std::string photon_skipped = j["methods"]["photon"]["skipped"].dump();
+  EXPECT_NE(photon_skipped.find("no specular surface"), std::string::npos) << photon_skipped;
+  // The furnace is one closed box: radiosity needs no visibility rays.
+  const Result f = run("info furnace --json");
+  ASSERT_EQ(f.code, 0) << f.err;
+  const std::string skipped = nlohmann::json::parse(f.out)["methods"]["radiosity"]["skipped"].dump();
+  EXPECT_NE(skipped.find("convex enclosure"), std::string::npos) << skipped;
+  // cornell-caustics has glass: the caustic map runs.
+  const Result c = run("info cornell-caustics");
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(c.out.find("runs:    caustic map"), std::string::npos) << c.out;
+  EXPECT_EQ(run("info " + (dir_ / "missing.obj").string()).code, 2);
+}
+
 struct BadCase {
   const char* name;
   std::string args;     // after "render"
