@@ -2,7 +2,11 @@
 // Subcommands of the gilt tool. Each registers its options on the app and returns the action to
 // run once parsing succeeded.
 
+#include <charconv>
+#include <cmath>
+#include <cstdint>
 #include <functional>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -25,5 +29,32 @@ std::function<void()> add_info_command(CLI::App& app);
 /// Registers the radiosity meshing and solver options (--max-edge, --elements, --tolerance) on
 /// a subcommand; both `render --method radiosity` and `radiosity` use them.
 void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& settings);
+
+/// Check for floating-point options: the value must be a finite number. CLI::Range and
+/// CLI::PositiveNumber let NaN through (it fails every comparison), so every float option has it.
+inline const CLI::Validator& finite_number() {
+  static const CLI::Validator check(
+      [](std::string& text) {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value)) return std::string();
+        return "Value " + text + " is not a finite number";
+      },
+      "", "FINITE");
+  return check;
+}
+
+/// Check for unsigned 64-bit options: a whole number in [0, 2^64). CLI11 itself reads "-1" and
+/// numbers past the range as 2^64 − 1.
+inline const CLI::Validator& unsigned_integer() {
+  static const CLI::Validator check(
+      [](std::string& text) {
+        uint64_t value = 0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (error == std::errc() && end == text.data() + text.size()) return std::string();
+        return "Value " + text + " is not a whole number from 0 to 18446744073709551615";
+      },
+      "", "UINT64");
+  return check;
+}
 
 }  // namespace gilt::cli

@@ -333,13 +333,16 @@ std::function<void()> add_compare_command(CLI::App& app) {
   auto* ref = cmd->add_option("--reference", o->reference, "Reference image (.exr) instead of a path-traced one");
   cmd->add_option("--reference-time", o->reference_time,
                   "Seconds for the path-traced reference (default 60; cached by scene content and camera)")
+      ->check(finite_number())
       ->check(CLI::Range(0.1, 1e6))
       ->excludes(ref);
   cmd->add_option("--width", o->width, "Image width (default 256)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", o->height, "Image height (default 256)")->check(CLI::Range(1, 16384));
-  cmd->add_option("--seed", o->seed, "Random seed");
+  cmd->add_option("--seed", o->seed, "Random seed")->check(unsigned_integer());
   cmd->add_option("--threads", o->threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
-  cmd->add_option("--exposure", o->exposure, "Exposure of the PNG images (EV)")->check(CLI::Range(-64.0f, 64.0f));
+  cmd->add_option("--exposure", o->exposure, "Exposure of the PNG images (EV)")
+      ->check(finite_number())
+      ->check(CLI::Range(-64.0f, 64.0f));
   cmd->add_flag("-q,--quiet", o->quiet, "No progress or table");
   return [o] { run_compare(*o); };
 }

@@ -89,19 +89,22 @@ void run_radiosity(RadiosityOptions& o) {
 
 void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
   auto* edge = cmd.add_option("--max-edge", s.mesh.max_edge, "Radiosity: target element edge length (scene units)")
-                   ->check(CLI::PositiveNumber);
+                   ->check(CLI::PositiveNumber)
+                   ->check(finite_number());
   cmd.add_option("--elements", s.mesh.elements, "Radiosity: approximate element count (default " +
                                                     std::to_string(radiosity::kDefaultElements) + ")")
       ->check(CLI::Range(1, 50000000))
       ->excludes(edge);
   cmd.add_option("--tolerance", s.tolerance, "Radiosity: stop when unshot power < T x emitted power (default 1e-3)")
-      ->check(CLI::Range(1e-12, 1.0));
+      ->check(CLI::Range(1e-12, 1.0))
+      ->check(finite_number());
   cmd.add_option("--subdivision-levels", s.subdivision_levels,
                  "Radiosity: adaptive subdivision may halve the edge length this many times (default 2; 0 = off)")
       ->check(CLI::Range(0, 8));
   cmd.add_option("--subdivision-threshold", s.subdivision_threshold,
                  "Radiosity: bisect elements whose direct light spreads by more than this fraction (default 0.6)")
-      ->check(CLI::Range(1e-3, 1.0));
+      ->check(CLI::Range(1e-3, 1.0))
+      ->check(finite_number());
 }
 
 std::function<void()> add_radiosity_command(CLI::App& app) {
@@ -110,13 +113,18 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
   cmd->add_option("-o,--output", o->output, "Output mesh (.ply, .obj, .gltf, .glb)")->required();
   add_solver_options(*cmd, o->solver);
-  cmd->add_option("--time", o->solver.time_limit, "Stop after this many seconds")->check(CLI::PositiveNumber);
+  cmd->add_option("--time", o->solver.time_limit, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber)
+      ->check(finite_number());
   cmd->add_option("--quantity", o->quantity, "Vertex colour: radiance (default), irradiance or radiosity")
       ->check(CLI::IsMember({"radiance", "irradiance", "radiosity"}));
   cmd->add_flag("--srgb8", o->srgb8, "PLY: 8-bit sRGB colours instead of linear float");
-  cmd->add_option("--exposure", o->exposure, "With --srgb8: scale by 2^exposure")->check(CLI::Range(-64.0f, 64.0f));
+  cmd->add_option("--exposure", o->exposure, "With --srgb8: scale by 2^exposure")
+      ->check(CLI::Range(-64.0f, 64.0f))
+      ->check(finite_number());
   cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
-  cmd->add_option("--seed", o->solver.seed, "Random seed for the visibility samples");
+  cmd->add_option("--seed", o->solver.seed, "Random seed for the visibility samples")
+      ->check(unsigned_integer());
   cmd->add_flag("--json", o->json, "Print the statistics as one JSON object");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
   return [o] { run_radiosity(*o); };

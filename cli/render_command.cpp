@@ -209,32 +209,41 @@ std::function<void()> add_render_command(CLI::App& app) {
   cmd->add_option("--radius", o->radius,
                   "Photon: largest estimate radius; sppm: initial radius (scene units; default 5 % / 1 % of the "
                   "scene's bounding radius)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->check(finite_number());
   cmd->add_option("--gather-rays", o->gather_rays, "Photon: final-gather rays per sample (default 16; 0 = none)")
       ->check(CLI::Range(0, 65536));
   cmd->add_option("--alpha", o->alpha, "Sppm: fraction of new photons kept per iteration (default 2/3)")
-      ->check(CLI::Range(1e-3f, 0.999f));
+      ->check(CLI::Range(1e-3f, 0.999f))
+      ->check(finite_number());
   add_solver_options(*cmd, o->solver);
   auto* spp = cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's, 64)")
                   ->check(CLI::PositiveNumber);
   cmd->add_option("--time", o->time_limit, "Render whole passes until this many seconds are spent")
       ->check(CLI::PositiveNumber)
+      ->check(finite_number())
       ->excludes(spp);
   cmd->add_option("--width", o->width, "Image width in pixels")->check(CLI::Range(1, 65536));
   cmd->add_option("--height", o->height, "Image height in pixels")->check(CLI::Range(1, 65536));
   cmd->add_option("--threads", o->threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
-  cmd->add_option("--seed", o->seed, "Random seed; the image is a function of the seed, not of --threads");
+  cmd->add_option("--seed", o->seed, "Random seed; the image is a function of the seed, not of --threads")
+      ->check(unsigned_integer());
   cmd->add_option("--lookfrom", o->look_from, "Camera position x,y,z");
   cmd->add_option("--lookat", o->look_at, "Point the camera looks at x,y,z");
   cmd->add_option("--up", o->up, "Camera up vector x,y,z");
-  cmd->add_option("--fov", o->fov, "Vertical field of view in degrees");
-  cmd->add_option("--aperture", o->aperture, "Thin-lens aperture radius in scene units (0 = pinhole)");
-  cmd->add_option("--focus-distance", o->focus_distance, "Distance to the plane in focus (default: to --lookat)");
+  cmd->add_option("--fov", o->fov, "Vertical field of view in degrees")->check(finite_number());
+  cmd->add_option("--aperture", o->aperture, "Thin-lens aperture radius in scene units (0 = pinhole)")
+      ->check(finite_number());
+  cmd->add_option("--focus-distance", o->focus_distance, "Distance to the plane in focus (default: to --lookat)")
+      ->check(finite_number());
   cmd->add_option("--filter", o->filter, "Pixel filter: box, tent or gaussian")
       ->check(CLI::IsMember({"box", "tent", "gaussian"}));
-  cmd->add_option("--filter-radius", o->filter_radius, "Pixel filter radius in pixels")->check(CLI::Range(0.5f, 8.0f));
+  cmd->add_option("--filter-radius", o->filter_radius, "Pixel filter radius in pixels")
+      ->check(CLI::Range(0.5f, 8.0f))
+      ->check(finite_number());
   cmd->add_option("--exposure", o->exposure, "PNG only: scale by 2^exposure before sRGB encoding")
-      ->check(CLI::Range(-64.0f, 64.0f));
+      ->check(CLI::Range(-64.0f, 64.0f))
+      ->check(finite_number());
   cmd->add_option("--max-depth", o->max_depth, "Bounce limit (path: default unlimited with Russian roulette; "
                                                "whitted: 16)")
       ->check(CLI::Range(1, 1 << 20));

@@ -371,6 +371,8 @@ void load_json(const fs::path& path, Scene& scene) {
     if (colon != std::string::npos) detail = detail.substr(colon + 2);
     throw InputError(file + ":" + std::to_string(line) + ":" + std::to_string(column) +
                      ": malformed JSON: " + detail);
+  } catch (const Json::exception& e) {  // the parser's other errors, e.g. a number past double's range
+    throw InputError(file + ": malformed JSON: " + e.what());
   }
   try {
     JsonSceneReader(path, scene).read(root);
