@@ -23,7 +23,8 @@ namespace gilt::photonmap {
 struct PhotonSettings {
   uint64_t global_photons = 200'000;   ///< emitted for the global map (0: no global map)
   uint64_t caustic_photons = 200'000;  ///< emitted for the caustic map (0: no caustic map)
-  int max_depth = 32;                  ///< bounces per photon path at most
+  int max_depth = 1 << 16;             ///< bounces per photon path at most; Russian roulette ends
+                                       ///< paths long before (a low cap would bias albedo near 1)
   uint64_t seed = 0;
   IndexKind index = IndexKind::hash_grid;  ///< search structure over the stored photons (bench_photon --index)
 };

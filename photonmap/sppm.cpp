@@ -101,7 +101,8 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
         const rc::Vec2 film_pos((x + 0.5f + offset.x) / width, (y + 0.5f + offset.y) / height);
         rc::Ray ray = camera.generate_ray(film_pos, rng.uniform2(), aspect);
         rc::Rgb beta(1.0f), direct(0.0f);
-        for (int depth = 0; depth < sppm.max_depth; ++depth) {
+        // Mirrors and glass only, without Russian roulette: 64 bounces at most.
+        for (int depth = 0; depth < std::min(sppm.max_depth, 64); ++depth) {
           ++local_rays;
           const std::optional<rc::Hit> hit = scene.intersect(ray);
           if (!hit) {

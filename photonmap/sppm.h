@@ -22,7 +22,8 @@ struct SppmSettings {
   uint64_t photons_per_iteration = 100'000;
   float initial_radius = 0.0f;  ///< scene units; 0: 1 % of the scene's bounding radius
   float alpha = 2.0f / 3.0f;    ///< fraction of new photons kept per iteration, in (0, 1)
-  int max_depth = 32;           ///< bounces per camera or photon path
+  int max_depth = 1 << 16;      ///< bounces per camera or photon path at most; Russian roulette ends
+                                ///< photon paths; camera paths follow at most 64 mirror/glass bounces
   IndexKind index = IndexKind::hash_grid;  ///< over each iteration's photons (bench_photon --index)
 };
 
