@@ -15,3 +15,13 @@ if(GILT_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer)
   add_link_options(-fsanitize=address,undefined)
 endif()
+
+# Fuzzing (clang only): every target gets libFuzzer's coverage instrumentation and the sanitizers,
+# so the loaders inside raytrace_core are what the fuzzer explores; the fuzz targets themselves
+# link libFuzzer's main (tests/fuzz/CMakeLists.txt). Undefined behaviour aborts, so the fuzzer
+# reports it as a crash.
+if(GILT_FUZZ)
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined
+                      -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()

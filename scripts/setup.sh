@@ -4,7 +4,9 @@
 #                                scene: the report is out/compare/index.html (about 4 minutes)
 #   bash scripts/setup.sh test   install, build with warnings as errors, run the whole test suite,
 #                                then build the unit tests with AddressSanitizer + UBSan and run them
-#                                (what CI runs; SANITIZE=0 skips the sanitizer stage)
+#                                (what CI runs; SANITIZE=0 skips the sanitizer stage), then
+#                                fuzzes every scene loader for 10 s with clang's libFuzzer
+#                                (scripts/fuzz.sh; FUZZ=0 skips it)
 #   bash scripts/setup.sh build  install and build only
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -euo pipefail
@@ -59,6 +61,10 @@ case "$job" in
       UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
         LSAN_OPTIONS=suppressions=$root/tests/lsan.supp \
         ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -L unit
+    fi
+    if [ "${FUZZ:-1}" != 0 ]; then
+      # A short libFuzzer run of every scene loader (longer runs: bash scripts/fuzz.sh 600).
+      JOBS=$jobs bash "$root/scripts/fuzz.sh" 10
     fi
     ;;
   build) ;;
