@@ -51,8 +51,45 @@ std::vector<std::string_view> split_whitespace(std::string_view line) {
   return tokens;
 }
 
-/// Checks what tinyobjloader would silently repair: non-finite numbers and face indices that do
-/// not refer to an existing v / vt / vn. Throws InputError "file:line: ...".
+/// Parses a whole token as a finite number (a leading '+' allowed).
+bool finite_number(std::string_view token, double& x) {
+  const char* first = token.data() + (!token.empty() && token.front() == '+' ? 1 : 0);
+  const char* last = token.data() + token.size();
+  const auto [end, err] = std::from_chars(first, last, x);
+  return err == std::errc() && end == last && std::isfinite(static_cast<float>(x));
+}
+
+/// Checks an MTL file's numbers, which tinyobjloader reads as 0 when it cannot parse them:
+/// colours (Ka, Kd, Ks, Ke, Tf) need three finite, non-negative numbers, scalars (Ns, Ni, d, Tr)
+/// one finite number. Throws InputError "file:line: ...". A missing file is left to the loader.
+void check_mtl_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return;
+  std::string line;
+  for (size_t line_no = 1; std::getline(in, line); ++line_no) {
+    const std::vector<std::string_view> tokens = split_whitespace(line);
+    if (tokens.empty()) continue;
+    const std::string_view tag = tokens[0];
+    const bool colour = tag == "Ka" || tag == "Kd" || tag == "Ks" || tag == "Ke" || tag == "Tf";
+    const bool scalar = tag == "Ns" || tag == "Ni" || tag == "d" || tag == "Tr";
+    if (!colour && !scalar) continue;
+    const size_t needed = colour ? 3 : 1;
+    auto fail = [&](const std::string& what) {
+      throw InputError(path.string() + ":" + std::to_string(line_no) + ": " + std::string(tag) + " " + what);
+    };
+    if (tokens.size() != needed + 1)
+      fail(colour ? "needs three numbers r g b (spectral and xyz forms are not supported)" : "needs one number");
+    for (size_t k = 1; k <= needed; ++k) {
+      double x = 0.0;
+      if (!finite_number(tokens[k], x)) fail("value '" + std::string(tokens[k]) + "' is not a finite number");
+      if (colour && x < 0.0) fail("value '" + std::string(tokens[k]) + "' is negative");
+    }
+  }
+}
+
+/// Checks what tinyobjloader would silently repair: non-finite numbers, face indices that do
+/// not refer to an existing v / vt / vn, and the numbers of the MTL files it names. Throws
+/// InputError "file:line: ...".
 void check_obj_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open file");
@@ -77,7 +114,9 @@ void check_obj_text(const fs::path& path) {
     const std::vector<std::string_view> tokens = split_whitespace(line);
     if (tokens.empty()) continue;
     const std::string_view tag = tokens[0];
-    if (tag == "v" || tag == "vt" || tag == "vn") {
+    if (tag == "mtllib") {
+      for (size_t k = 1; k < tokens.size(); ++k) check_mtl_text(path.parent_path() / std::string(tokens[k]));
+    } else if (tag == "v" || tag == "vt" || tag == "vn") {
       const size_t needed = tag == "vt" ? 1 : 3;
       if (tokens.size() < needed + 1)
         fail(line_no, std::string(tag) + " needs " + std::to_string(needed) + " number(s)");

@@ -248,20 +248,18 @@ TEST_F(CliBadInput, RadiosityRejectsCorruptFiles) {
   }
 }
 
-// MTL values out of range: the material is named, the file is the OBJ that loads it.
+// MTL values out of float's range: the MTL file and line are named.
 TEST_F(CliBadInput, MtlWithOverflowingValueExitsTwo) {
   const std::string out = (dir_ / "out.png").string();
   write("huge.mtl", "newmtl lamp\nKe 1e40 1 1\n");
   const fs::path obj = write("huge.obj", "mtllib huge.mtl\n" + kTriangle + "usemtl lamp\nf 1 2 3\n");
   expect_rejected("Ke 1e40", "render '" + obj.string() + "' --spp 1 --width 8 --height 8 -q -o '" + out + "'",
-                  {"lamp"});
+                  {"huge.mtl:2"});
 }
 
-// KNOWN FAILURE (reported): tinyobjloader reads a number it cannot parse as 0 without saying so,
-// so "Kd nan 0 0", "Ke inf 1 1" and "Kd 0.5" (one number where three belong) load silently
-// (Kd (0, 0, 0), Ke (0, 1, 1), ...), where the OBJ side rejects "v nan 0 0" with its line.
-// Negative Kd and Ke are also taken without a warning. Enable once the MTL text is checked.
-TEST_F(CliBadInput, DISABLED_MtlWithNonNumbersExitsTwo) {
+// tinyobjloader reads a number it cannot parse as 0 without saying so ("Kd nan 0 0" would load
+// as black, "Kd 0.5" as (0.5, 0, 0)): the loader checks the MTL text first, as it does the OBJ's.
+TEST_F(CliBadInput, MtlWithNonNumbersExitsTwo) {
   const std::string out = (dir_ / "out.png").string();
   const std::vector<std::pair<std::string, std::string>> mtls = {{"nan_kd", "newmtl a\nKd nan 0 0\n"},
                                                                  {"inf_ke", "newmtl a\nKe inf 1 1\n"},
