@@ -27,6 +27,7 @@
 
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
+#include "raytrace_core/image_error.h"
 #include "raytrace_core/image_io.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/path_tracer.h"
@@ -59,13 +60,6 @@ rc::RenderSettings settings(int spp, uint64_t seed, double time_limit = 0.0) {
   s.time_limit = time_limit;
   s.progress = false;
   return s;
-}
-
-double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
-  double sum = 0.0;
-  for (size_t i = 0; i < image.size(); ++i)
-    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
-  return sum / (3.0 * double(image.size()));
 }
 
 std::vector<rc::Rgb> path_half(const rc::Scene& scene, int spp, uint64_t seed, const fs::path& dir, bool fresh) {
@@ -171,7 +165,7 @@ void run_race(const fs::path& out_dir, int half_spp, bool fresh) {
   const std::vector<rc::Rgb> b = path_half(scene, half_spp, 1002, out_dir, fresh);
   std::vector<rc::Rgb> reference(a.size());
   for (size_t i = 0; i < a.size(); ++i) reference[i] = (a[i] + b[i]) * 0.5f;
-  const double noise = 0.5 * mean_relative_error(a, b);
+  const double noise = 0.5 * rc::mean_relative_error(a, b);
   std::printf("reference: path tracer, 2 x %d spp at %dx%d (%.1f s, cached when fast); its noise: %.2f %%\n", half_spp,
               kSize, kSize, seconds_since(ref_start), 100 * noise);
 
@@ -205,7 +199,7 @@ void run_race(const fs::path& out_dir, int half_spp, bool fresh) {
       }
       const double seconds = seconds_since(start);
       if (film.non_finite_count() != 0) fail(m + " produced non-finite pixels");
-      const Point p{m, budget, seconds, mean_relative_error(film.pixels(), reference), spp};
+      const Point p{m, budget, seconds, rc::mean_relative_error(film.pixels(), reference), spp};
       points.push_back(p);
       std::printf("  %-6s  %8.0f  %8.2f  %4d  %8.2f\n", method, budget, seconds, spp, 100 * p.error);
       std::fflush(stdout);

@@ -38,6 +38,7 @@
 #include "radiosity/mesh.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
+#include "raytrace_core/image_error.h"
 #include "raytrace_core/image_io.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
@@ -101,14 +102,6 @@ rc::RenderSettings render_settings(Pixels pixels, int spp, uint64_t seed) {
   s.progress = false;
   if (pixels == Pixels::centres) s.filter.radius = 0.0f;
   return s;
-}
-
-/// Mean over pixels and channels of |image − reference| / (reference + 0.01).
-double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
-  double sum = 0.0;
-  for (size_t i = 0; i < image.size(); ++i)
-    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
-  return sum / (3.0 * double(image.size()));
 }
 
 /// The path-traced reference: the mean of two independent halves, and its own noise, measured as
@@ -298,7 +291,7 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
   const rad::Solution warm = rad::solve(scene, solver_settings(1000));
   const rad::RadiosityView warm_view(scene, warm);
   const double display_noise =
-      mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
+      rc::mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
                           radiosity_render(scene, warm_view, Pixels::filtered, kDisplaySpp));
   std::printf(
       "display noise of a %d-spp filtered radiosity render: %.3f %% (1000 elements, against %d spp)\n",
@@ -343,9 +336,9 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
     p.form_factors = sol.form_factors;
     p.shadow_rays = sol.shadow_rays;
     p.residual = sol.residual;
-    p.error[kFiltered] = mean_relative_error(image, refs[int(Pixels::filtered)].image);
+    p.error[kFiltered] = rc::mean_relative_error(image, refs[int(Pixels::filtered)].image);
     const std::vector<rc::Rgb> centres = radiosity_render(scene, view, Pixels::centres, 1);
-    p.error[kCentres] = mean_relative_error(centres, refs[int(Pixels::centres)].image);
+    p.error[kCentres] = rc::mean_relative_error(centres, refs[int(Pixels::centres)].image);
     write_error_image(out_dir / ("radiosity_error_" + std::to_string(requested) + ".png"), centres,
                       refs[int(Pixels::centres)].image);
     const double noise = refs[int(Pixels::centres)].noise;

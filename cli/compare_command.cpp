@@ -18,6 +18,7 @@
 #include "cli/methods.h"
 #include "cli/report.h"
 #include "raytrace_core/error.h"
+#include "raytrace_core/image_error.h"
 #include "raytrace_core/image_io.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/scene_io.h"
@@ -88,13 +89,6 @@ fs::path cache_folder() {
   return {};
 }
 
-double mean_relative_error(const std::vector<rc::Rgb>& a, const std::vector<rc::Rgb>& r) {
-  double sum = 0.0;
-  for (size_t i = 0; i < a.size(); ++i)
-    for (int c = 0; c < 3; ++c) sum += std::abs(a[i][c] - r[i][c]) / (r[i][c] + 0.01);
-  return sum / (3.0 * double(a.size()));
-}
-
 struct Reference {
   std::vector<rc::Rgb> pixels;
   std::string description;
@@ -151,7 +145,7 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   ref.pixels.resize(a.size());
   for (size_t i = 0; i < a.size(); ++i) ref.pixels[i] = a[i] * wa + b[i] * (1.0f - wa);
   // Each half carries about √2 times the noise of the mean: halve their mutual error.
-  ref.noise = 0.5 * mean_relative_error(a, b);
+  ref.noise = 0.5 * rc::mean_relative_error(a, b);
   ref.description = "path tracer, " + std::to_string(sa.spp + sb.spp) + " spp in " +
                     std::to_string(int(std::lround(sa.seconds + sb.seconds))) + " s";
   if (!folder.empty()) {
@@ -169,17 +163,8 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
 }
 
 void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& ref) {
-  double se = 0, rel = 0, ae = 0, mre = 0;
-  for (size_t i = 0; i < image.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double d = double(image[i][c]) - ref[i][c];
-      se += d * d;
-      rel += d * d / (double(ref[i][c]) * ref[i][c] + 0.01);
-      ae += std::abs(d);
-      mre += std::abs(d) / (ref[i][c] + 0.01);
-    }
-  const double n = 3.0 * double(image.size());
-  e.rmse = std::sqrt(se / n), e.relmse = rel / n, e.mae = ae / n, e.mre = mre / n;
+  const rc::ImageError error = rc::image_error(image, ref);
+  e.rmse = error.rmse, e.relmse = error.relmse, e.mae = error.mae, e.mre = error.mean_relative;
 }
 
 /// Radiosity against the path tracer in object space: at up to 64 element centroids (where the

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "raytrace_core/image_error.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
 #include "raytrace_core/path_tracer.h"
@@ -57,21 +58,14 @@ std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, int elements) {
       .pixels();
 }
 
-double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
-  double sum = 0.0;
-  for (size_t i = 0; i < image.size(); ++i)
-    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
-  return sum / (3.0 * image.size());
-}
-
 }  // namespace
 
 TEST(RadiosityVsPath, CornellErrorFallsWithTheMesh) {
   rc::Scene scene = rc::load_scene("cornell");
   const std::vector<rc::Rgb> reference = path_render(scene, 2048, 1);
-  const double noise = 0.5 * mean_relative_error(path_render(scene, 2048, 2), reference);
-  const double coarse = mean_relative_error(radiosity_render(scene, 400), reference);
-  const double fine = mean_relative_error(radiosity_render(scene, 1600), reference);
+  const double noise = 0.5 * rc::mean_relative_error(path_render(scene, 2048, 2), reference);
+  const double coarse = rc::mean_relative_error(radiosity_render(scene, 400), reference);
+  const double fine = rc::mean_relative_error(radiosity_render(scene, 1600), reference);
   std::printf("mean relative error: 400 elements %.4f, 1600 elements %.4f; reference noise %.4f\n", coarse, fine, noise);
   ::testing::Test::RecordProperty("error_400", std::to_string(coarse));
   ::testing::Test::RecordProperty("error_1600", std::to_string(fine));

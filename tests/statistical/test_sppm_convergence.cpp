@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "raytrace_core/image_error.h"
 #include "photonmap/sppm.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
@@ -35,13 +36,6 @@ rc::RenderSettings settings(int spp, uint64_t seed) {
   return s;
 }
 
-double mean_relative_error(const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& reference) {
-  double sum = 0.0;
-  for (size_t i = 0; i < image.size(); ++i)
-    for (int k = 0; k < 3; ++k) sum += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01);
-  return sum / (3.0 * double(image.size()));
-}
-
 }  // namespace
 
 TEST(Sppm, ApproachesThePathTracedReference) {
@@ -56,7 +50,7 @@ TEST(Sppm, ApproachesThePathTracedReference) {
   const std::vector<rc::Rgb> a = path_render(101), b = path_render(102);
   std::vector<rc::Rgb> reference(a.size());
   for (size_t i = 0; i < a.size(); ++i) reference[i] = (a[i] + b[i]) * 0.5f;
-  const double noise = 0.5 * mean_relative_error(a, b);
+  const double noise = 0.5 * rc::mean_relative_error(a, b);
 
   pm::SppmSettings sppm;
   sppm.photons_per_iteration = 20000;
@@ -67,7 +61,7 @@ TEST(Sppm, ApproachesThePathTracedReference) {
     const rc::Film film = pm::render_sppm(scene, camera, settings(iterations[i], 7), sppm, &stats);
     ASSERT_EQ(stats.iterations, iterations[i]);
     ASSERT_EQ(film.non_finite_count(), 0u);
-    error[i] = mean_relative_error(film.pixels(), reference);
+    error[i] = rc::mean_relative_error(film.pixels(), reference);
     std::printf("sppm %2d iterations: mean relative error %.4f (reference noise %.4f), mean radius %.3g\n",
                 iterations[i], error[i], noise, stats.mean_final_radius);
   }
