@@ -12,8 +12,9 @@
 //                   20 s of shooting: shots, form factors and shadow rays per second, residual.
 //
 // Other options: --out-dir=DIR (default out/bench) for the CSV files and the cached references,
-// --reference-spp=N (default 4096) for the references' samples per pixel, --fresh-reference to
-// render them again, --subdivision-levels=N to override the solver's adaptive subdivision (0:
+// --reference-spp=N (default 32768) for the references' samples per pixel, --fresh-reference to
+// render them again, --repeats=N (default 3) timed runs of each sweep point, of which the median
+// time is reported, --subdivision-levels=N to override the solver's adaptive subdivision (0:
 // none). The sweep also writes radiosity_error_<elements>.png: per-pixel relative error against
 // the centre reference, 10 % white. Google Benchmark flags apply to the form-factor part. Every part checks its
 // results before it reports a time, and stops with a message when they are wrong.
@@ -29,6 +30,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -70,7 +72,7 @@ bool all_finite(const std::vector<rc::Rgb>& pixels) {
 // Part 1: error against time.
 
 constexpr int kImageSize = 64;          // reference and radiosity renders: 64 × 64 pixels
-constexpr int kHalfSpp = 2048;          // default spp of each of the reference's two halves
+constexpr int kHalfSpp = 16384;         // default spp of each of the reference's two halves
 constexpr uint64_t kSeeds[2] = {1, 2};  // seeds of the two halves; radiosity renders use the first
 constexpr int kRadiositySpp = 16;
 constexpr int kDisplaySpp = 1024;  // for the display-noise floor (below)
@@ -190,6 +192,15 @@ void write_error_image(const fs::path& file, const std::vector<rc::Rgb>& image, 
     error[i] = rc::Rgb(e / 3.0f * 10.0f);
   }
   rc::write_image(file.string(), rc::Image{kImageSize, kImageSize, error});
+}
+
+/// Timed repeats of each sweep point (--repeats=N); the median time is reported.
+int g_repeats = 3;
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 /// Adaptive subdivision levels for every solve (--subdivision-levels=N; default: the solver's).
@@ -321,23 +332,34 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
     }
     SweepPoint p;
     p.requested = requested;
-    const auto start = std::chrono::steady_clock::now();
-    const rad::Solution sol = rad::solve(scene, solver_settings(requested));
-    p.solve_seconds = seconds_since(start);
-    const auto render_start = std::chrono::steady_clock::now();
-    const rad::RadiosityView view(scene, sol);
-    const std::vector<rc::Rgb> image = radiosity_render(scene, view, Pixels::filtered, kRadiositySpp);
-    p.render_seconds = seconds_since(render_start);
-    if (!(sol.residual < kTolerance))
+    // The solve and render are deterministic, so the repeats give the same solution and image;
+    // only their times differ, and the median of each is reported.
+    std::vector<double> solve_times, render_times;
+    std::optional<rad::Solution> sol;
+    std::optional<rad::RadiosityView> view;
+    std::vector<rc::Rgb> image;
+    for (int r = 0; r < g_repeats; ++r) {
+      view.reset();
+      const auto start = std::chrono::steady_clock::now();
+      sol = rad::solve(scene, solver_settings(requested));
+      solve_times.push_back(seconds_since(start));
+      const auto render_start = std::chrono::steady_clock::now();
+      view.emplace(scene, *sol);
+      image = radiosity_render(scene, *view, Pixels::filtered, kRadiositySpp);
+      render_times.push_back(seconds_since(render_start));
+    }
+    p.solve_seconds = median(solve_times);
+    p.render_seconds = median(render_times);
+    if (!(sol->residual < kTolerance))
       fail("the solve of " + std::to_string(requested) + " elements did not converge");
-    p.elements = sol.mesh.element_count();
-    p.vertices = sol.mesh.vertex_count();
-    p.shots = sol.shots;
-    p.form_factors = sol.form_factors;
-    p.shadow_rays = sol.shadow_rays;
-    p.residual = sol.residual;
+    p.elements = sol->mesh.element_count();
+    p.vertices = sol->mesh.vertex_count();
+    p.shots = sol->shots;
+    p.form_factors = sol->form_factors;
+    p.shadow_rays = sol->shadow_rays;
+    p.residual = sol->residual;
     p.error[kFiltered] = rc::mean_relative_error(image, refs[int(Pixels::filtered)].image);
-    const std::vector<rc::Rgb> centres = radiosity_render(scene, view, Pixels::centres, 1);
+    const std::vector<rc::Rgb> centres = radiosity_render(scene, *view, Pixels::centres, 1);
     p.error[kCentres] = rc::mean_relative_error(centres, refs[int(Pixels::centres)].image);
     write_error_image(out_dir / ("radiosity_error_" + std::to_string(requested) + ".png"), centres,
                       refs[int(Pixels::centres)].image);
@@ -578,6 +600,8 @@ int main(int argc, char** argv) {
       scaling = true;
     else if (arg.starts_with("--subdivision-levels="))
       g_subdivision_levels = std::max(0, std::atoi(argv[i] + 21));
+    else if (arg.starts_with("--repeats="))
+      g_repeats = std::max(1, std::atoi(argv[i] + 10));
     else if (arg == "--fresh-reference")
       fresh_reference = true;
     else if (arg.starts_with("--out-dir="))

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -266,6 +267,7 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.reoriented, "faces reoriented to agree with their neighbours");
   warn(c.duplicated_vertices, "vertices duplicated to make the surface manifold");
   warn(c.self_intersecting, "pairs of faces intersect each other (meshed as they are)");
+  warn(c.contacts_failed, "touching surfaces whose contact lines could not be imprinted");
 }
 
 double meshed_area(const rc::Scene& scene) {
@@ -285,6 +287,94 @@ double meshed_area(const rc::Scene& scene) {
     area += 4.0 * 3.14159265358979323846 * double(sphere.radius) * double(sphere.radius);
   }
   return area;
+}
+
+/// The meshes whose bounding boxes meet mesh `m`'s (grown by a millionth of the scene's size):
+/// the only ones that can touch it.
+std::vector<const rc::TriangleMesh*> touching_meshes(const rc::Scene& scene, size_t m) {
+  const auto box_of = [](const rc::TriangleMesh& mesh) {
+    rc::Bounds3 b;
+    for (uint32_t i : mesh.indices) b.extend(mesh.positions.at(i));
+    return b;
+  };
+  rc::Bounds3 box = box_of(scene.meshes[m]);
+  if (box.empty()) return {};
+  float scale = 0.0f;
+  for (const rc::TriangleMesh& other : scene.meshes)
+    for (const Vec3& p : other.positions) scale = std::max(scale, glm::length(p - box.lo));
+  box.lo -= Vec3(1e-6f * scale);
+  box.hi += Vec3(1e-6f * scale);
+  std::vector<const rc::TriangleMesh*> out;
+  for (size_t o = 0; o < scene.meshes.size(); ++o)
+    if (o != m && box.overlaps(box_of(scene.meshes[o]))) out.push_back(&scene.meshes[o]);
+  return out;
+}
+
+/// Directions, in a frame around the normal, along which burial is tested: the normal and two
+/// rings of six (polar angles 45° and 75°, the second turned by 30°).
+std::vector<DVec3> burial_directions() {
+  std::vector<DVec3> dirs{{0.0, 0.0, 1.0}};
+  for (int ring = 0; ring < 2; ++ring) {
+    const double polar = (ring == 0 ? 45.0 : 75.0) * (3.14159265358979323846 / 180.0);
+    for (int k = 0; k < 6; ++k) {
+      const double azimuth = (60.0 * k + 30.0 * ring) * (3.14159265358979323846 / 180.0);
+      dirs.emplace_back(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+    }
+  }
+  return dirs;
+}
+
+/// Removes the triangles of `surface` that are buried: every test ray from their centroid
+/// (along the front hemisphere, see burial_directions) hits the back of some other surface, so
+/// they lie inside a closed solid or under an object standing on them and can neither receive
+/// nor send light. A surface inside-out with respect to its neighbours is never buried (its
+/// rays leave the scene). A face lying flat on another and facing it (a closed box's base on the
+/// floor) is not found by this test and is kept: it receives nothing and costs only its own
+/// elements. Unused vertices are removed with them. Returns the number removed.
+size_t drop_buried(const rc::Scene& scene, uint32_t surface_id, SplitSurface& surface) {
+  static const std::vector<DVec3> dirs = burial_directions();
+  std::vector<bool> keep(surface.corners.size(), true);
+  size_t dropped = 0;
+  for (size_t t = 0; t < surface.corners.size(); ++t) {
+    const auto& c = surface.corners[t];
+    const DVec3 a = surface.positions[c[0]], b = surface.positions[c[1]], d = surface.positions[c[2]];
+    const DVec3 cross = glm::cross(b - a, d - a);
+    if (!(glm::dot(cross, cross) > 0.0)) continue;
+    rc::SurfacePoint sp;
+    sp.p = Vec3((a + b + d) / 3.0);
+    sp.p_error = rc::error_gamma(16) * rc::abs(sp.p);
+    sp.ng = Vec3(glm::normalize(cross));
+    const rc::Frame frame = rc::Frame::from_normal(sp.ng);
+    bool buried = true;
+    for (const DVec3& dir : dirs) {
+      const rc::Ray ray = rc::spawn_ray(sp, frame.to_world(Vec3(dir)));
+      const std::optional<rc::Hit> hit = scene.intersect(ray);
+      if (!hit || hit->geom_id == surface_id || scene.surface(ray, *hit).front_face) {
+        buried = false;
+        break;
+      }
+    }
+    if (buried) keep[t] = false, ++dropped;
+  }
+  if (dropped == 0) return 0;
+  SplitSurface kept;
+  std::vector<uint32_t> renumber(surface.positions.size(), UINT32_MAX);
+  for (size_t t = 0; t < surface.corners.size(); ++t) {
+    if (!keep[t]) continue;
+    std::array<uint32_t, 3> corners{};
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& v = renumber[surface.corners[t][k]];
+      if (v == UINT32_MAX) {
+        v = static_cast<uint32_t>(kept.positions.size());
+        kept.positions.push_back(surface.positions[surface.corners[t][k]]);
+        kept.normals.push_back(surface.normals[surface.corners[t][k]]);
+      }
+      corners[k] = v;
+    }
+    kept.corners.push_back(corners);
+  }
+  surface = std::move(kept);
+  return dropped;
 }
 
 }  // namespace
@@ -329,15 +419,17 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   const size_t surface_count = mesh_count + scene.spheres.size();
   std::vector<SplitSurface> surfaces(surface_count);
   std::vector<RepairCounts> counts(mesh_count);
+  std::vector<size_t> buried(mesh_count, 0);
   const RemeshParams params{kRemeshTargetScale * edge_length, settings.sharp_angle_degrees,
                             settings.remesh_iterations};
   rc::parallel_for(surface_count, [&](size_t s) {
     if (s < mesh_count) {
       const rc::TriangleMesh& mesh = scene.meshes[s];
       if (!is_meshed(scene.materials[mesh.material])) return;
-      TriangleSoup soup = repair_and_remesh(mesh, params, &counts[s]);
+      TriangleSoup soup = repair_and_remesh(mesh, touching_meshes(scene, s), params, &counts[s]);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
+      if (scene.committed()) buried[s] = drop_buried(scene, static_cast<uint32_t>(s), surfaces[s]);
     } else {
       const rc::Sphere& sphere = scene.spheres[s - mesh_count];
       if (!is_meshed(scene.materials[sphere.material])) return;
@@ -362,6 +454,8 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     rep.removed_degenerate += c.removed_degenerate;
     rep.reoriented += c.reoriented;
     rep.self_intersecting += c.self_intersecting;
+    rep.contact_edges += c.contact_edges;
+    rep.buried_elements += buried[s];
     warn_counts(rep, mesh_label(scene.meshes[s], s), c);
   }
   return out;

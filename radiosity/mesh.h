@@ -45,14 +45,19 @@ struct RadiosityMesh {
 struct MeshReport {
   float max_edge = 0.0f;
   size_t merged_vertices = 0, removed_degenerate = 0, reoriented = 0, self_intersecting = 0;
+  size_t contact_edges = 0;    ///< input edges imprinted where surfaces touch (before remeshing)
+  size_t buried_elements = 0;  ///< elements removed because they lie inside or under other surfaces
   std::vector<std::string> warnings;
 };
 
 /// Meshes every diffuse or glossy surface of the committed scene (mirrors and dielectrics are
 /// left to ray tracing). Input meshes are checked and mended first (duplicate vertices merged,
 /// degenerate faces removed, orientation made consistent where possible, self-intersections
-/// reported), then remeshed isotropically with boundaries and sharp edges protected. Spheres
-/// are tessellated to the same edge length.
+/// reported). Where another surface touches or crosses one (a block standing on the floor),
+/// the contact line is imprinted; the surface is then remeshed isotropically with boundaries,
+/// sharp edges and contact lines protected. Spheres are tessellated to the same edge length.
+/// Elements buried inside or under other surfaces (the floor under a block) are removed; that
+/// test casts rays, so it runs only when the scene is committed.
 RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report = nullptr);
 
 /// Splits the longest edge of each listed element at its midpoint (at most once per element per

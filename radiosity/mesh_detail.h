@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,8 @@ struct RepairCounts {
   size_t reoriented = 0;           ///< faces whose winding was reversed to agree with their neighbours
   size_t duplicated_vertices = 0;  ///< vertices copied to make the surface manifold
   size_t self_intersecting = 0;    ///< pairs of faces that intersect away from a shared vertex or edge
+  size_t contact_edges = 0;        ///< edges imprinted where another surface touches or crosses this one
+  size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
 };
 
 /// Remeshing parameters for one surface.
@@ -40,11 +43,11 @@ struct RemeshParams {
 
 /// Mends one input mesh with CGAL Polygon Mesh Processing (merge duplicate points and faces,
 /// drop degenerate faces, orient consistently while keeping the input's front where the input
-/// agreed, count self-intersections) and remeshes it isotropically to `params.edge_length` with
-/// its border and sharp edges protected. Returns the remeshed surface (empty when nothing is
-/// left) and fills `counts`.
-TriangleSoup repair_and_remesh(const rc::TriangleMesh& mesh, const RemeshParams& params,
-                               RepairCounts* counts);
+/// agreed, count self-intersections), imprints the lines where the `touching` meshes meet it,
+/// and remeshes it isotropically to `params.edge_length` with its border, sharp and contact
+/// edges protected. Returns the remeshed surface (empty when nothing is left) and fills `counts`.
+TriangleSoup repair_and_remesh(const rc::TriangleMesh& mesh, std::span<const rc::TriangleMesh* const> touching,
+                               const RemeshParams& params, RepairCounts* counts);
 
 /// Geodesic sphere: an icosahedron whose edges are cut into `frequency` parts, projected onto the
 /// sphere; 20·frequency² triangles, counter-clockwise seen from outside.
