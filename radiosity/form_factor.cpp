@@ -73,10 +73,15 @@ void SourceBatch::assign(std::span<const SourceTriangle> triangles) {
   triangles_.assign(triangles.begin(), triangles.end());
   const size_t m = triangles.size();
   for (auto* v : {&tx_, &ty_, &tz_, &cx_, &cy_, &cz_, &far2_, &radius_, &nx_, &ny_, &nz_, &offset_}) v->resize(m);
-  for (int j = 0; j < 3; ++j) qx_[j].resize(m), qy_[j].resize(m), qz_[j].resize(m);
+  for (int j = 0; j < 3; ++j) {
+    qx_[j].resize(m), qy_[j].resize(m), qz_[j].resize(m);
+    vx_[j].resize(m), vy_[j].resize(m), vz_[j].resize(m);
+  }
   for (size_t k = 0; k < m; ++k) {
     const SourceTriangle& t = triangles[k];
     for (int j = 0; j < 3; ++j) qx_[j][k] = t.rule_points_[j].x, qy_[j][k] = t.rule_points_[j].y, qz_[j][k] = t.rule_points_[j].z;
+    const Vec3* corners[3] = {&t.a_, &t.b_, &t.c_};
+    for (int j = 0; j < 3; ++j) vx_[j][k] = corners[j]->x, vy_[j][k] = corners[j]->y, vz_[j][k] = corners[j]->z;
     tx_[k] = t.twice_area_normal_.x, ty_[k] = t.twice_area_normal_.y, tz_[k] = t.twice_area_normal_.z;
     cx_[k] = t.centroid_.x, cy_[k] = t.centroid_.y, cz_[k] = t.centroid_.z;
     far2_[k] = t.far_distance2_, radius_[k] = t.radius_;
@@ -96,6 +101,8 @@ void SourceBatch::form_factors(const Vec3& p, const Vec3& n, float* out) const {
   const float *__restrict far2 = far2_.data(), *__restrict radius = radius_.data();
   const float *__restrict snx = nx_.data(), *__restrict sny = ny_.data(), *__restrict snz = nz_.data();
   const float* __restrict offset = offset_.data();
+  const float* __restrict v[9] = {vx_[0].data(), vy_[0].data(), vz_[0].data(), vx_[1].data(), vy_[1].data(),
+                                  vz_[1].data(), vx_[2].data(), vy_[2].data(), vz_[2].data()};
   float value[kMaxBatch];
   int kind[kMaxBatch];
   const float px = p.x, py = p.y, pz = p.z, nx = n.x, ny = n.y, nz = n.z;
@@ -112,7 +119,15 @@ void SourceBatch::form_factors(const Vec3& p, const Vec3& n, float* out) const {
     value[k] = std::min(sum * kScale, 1.0f);
     const float ex = cx[k] - px, ey = cy[k] - py, ez = cz[k] - pz;
     const int near = int(ex * ex + ey * ey + ez * ez < far2[k]) | int(nx * ex + ny * ey + nz * ez <= radius[k]);
-    const int behind = int(snx[k] * px + sny[k] * py + snz[k] * pz <= offset[k]);
+    // Behind the source, or the source in or behind the receiver's tangent plane (as
+    // in_or_behind_tangent_plane, corner by corner).
+    int flat = 1;
+    for (int j = 0; j < 3; ++j) {
+      const float dx = v[3 * j][k] - px, dy = v[3 * j + 1][k] - py, dz = v[3 * j + 2][k] - pz;
+      const float s = nx * dx + ny * dy + nz * dz;
+      flat &= int(s <= 0.0f) | int(s * s <= kTangentSlope * kTangentSlope * (dx * dx + dy * dy + dz * dz));
+    }
+    const int behind = int(snx[k] * px + sny[k] * py + snz[k] * pz <= offset[k]) | flat;
     kind[k] = near | (behind << 1);
   }
   for (size_t k = 0; k < m; ++k)

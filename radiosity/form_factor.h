@@ -31,6 +31,19 @@ double point_to_triangle_form_factor(const DVec3& p, const DVec3& n, const DVec3
 /// grazing; the mean is 0.014 %), see tests/unit/test_form_factor.cpp.
 inline constexpr float kFarFieldRatio = 6.0f;
 
+/// A source point at offset d from a receiver with unit normal n counts as in or behind the
+/// receiver's tangent plane when n·d ≤ kTangentSlope·|d|: a source within 10⁻⁴ rad of the plane
+/// sends at most cos θ ≤ 10⁻⁴ of its light there, so its factor is below 2·10⁻⁴ (the whole
+/// hemisphere at that slope) and in practice zero: it is a source coplanar with the receiver,
+/// where rounding decides the sign of n·d and Lambert's formula would spend three arctangents
+/// to add up nothing.
+inline constexpr float kTangentSlope = 1e-4f;
+
+inline bool in_or_behind_tangent_plane(const Vec3& d, const Vec3& n) {
+  const float s = glm::dot(n, d);
+  return s <= 0.0f || s * s <= kTangentSlope * kTangentSlope * glm::dot(d, d);
+}
+
 /// A source triangle prepared for form factors to many receivers: Lambert's formula near it,
 /// and beyond kFarFieldRatio circumradii (with the triangle wholly in front of the receiver's
 /// tangent plane) the cos·cos/(π r²) kernel integrated by the symmetric three-point rule,
@@ -41,9 +54,14 @@ class SourceTriangle {
   SourceTriangle() = default;
   SourceTriangle(const Vec3& a, const Vec3& b, const Vec3& c);
 
-  /// F(dA → triangle) for a receiver at p with unit normal n; 0 behind the triangle's plane.
+  /// F(dA → triangle) for a receiver at p with unit normal n; 0 behind the triangle's plane,
+  /// and 0 when the triangle lies behind the receiver's tangent plane or in it (see
+  /// kTangentSlope): a receiver on the same wall as the source, the commonest case.
   double form_factor(const Vec3& p, const Vec3& n) const {
     if (glm::dot(normal_, p) <= plane_offset_) return 0.0;
+    if (in_or_behind_tangent_plane(a_ - p, n) && in_or_behind_tangent_plane(b_ - p, n) &&
+        in_or_behind_tangent_plane(c_ - p, n))
+      return 0.0;
     const Vec3 to_centroid = centroid_ - p;
     if (glm::dot(to_centroid, to_centroid) >= far_distance2_ && glm::dot(n, to_centroid) > radius_)
       return far_form_factor(p, n);
@@ -92,8 +110,10 @@ class SourceBatch {
  private:
   std::vector<SourceTriangle> triangles_;
   // One array per coordinate, each of size() floats: rule points, the doubled-area normal,
-  // centroid, far-field distance², radius, unit normal and plane offset.
+  // centroid, far-field distance², radius, unit normal and plane offset, corners.
   std::vector<float> qx_[3], qy_[3], qz_[3], tx_, ty_, tz_, cx_, cy_, cz_, far2_, radius_, nx_, ny_, nz_, offset_;
+  std::vector<float> vx_[3], vy_[3], vz_[3];  ///< the corners
+
 };
 
 }  // namespace gilt::radiosity
