@@ -232,6 +232,11 @@ struct ShootingPatch {
   SourceBatch batch;
   std::vector<Rgb> radiosity;
   rc::Bounds3 box;
+  Vec3 center{0.0f};        ///< of the box
+  float bound = 0.0f;       ///< radius of a sphere about `center` that holds the patch
+  bool flat = false;        ///< every element faces `normal` (within float rounding)
+  Vec3 normal{0.0f};        ///< the first element's
+  float low_offset = 0.0f;  ///< the least normal · x over the patch's corners
   bool emitter = false;  ///< sharp shadows: the per-element occluder test and the adaptive probe
   int probe = 2;         ///< side of the first stratified visibility probe (rays = probe²)
   int strata = 4;        ///< side of the full set used in a penumbra (emitters only)
@@ -249,7 +254,30 @@ struct ShootingPatch {
       for (uint32_t v : el) box.extend(mesh.positions[v]);
     }
     batch.assign(triangles);
+    center = 0.5f * (box.lo + box.hi);
+    bound = 0.5f * glm::length(box.hi - box.lo);
+    normal = mesh.element_normal[source[0]];
+    flat = true;
+    low_offset = std::numeric_limits<float>::max();
+    for (uint32_t e : source) {
+      flat &= glm::dot(mesh.element_normal[e], normal) >= kParallel;
+      for (uint32_t v : mesh.elements[e]) low_offset = std::min(low_offset, glm::dot(normal, mesh.positions[v]));
+    }
   }
+
+  /// Whether the whole patch sends nothing to a receiver at p with normal n, by three bounds:
+  /// the patch lies behind the receiver's tangent plane; the receiver lies behind the plane of a
+  /// flat patch; or the two face the same way in parallel planes, where cos θ at the receiver
+  /// and at the source cannot both be positive (this takes in every receiver on the patch's own
+  /// wall). Exact except for the last, whose "parallel" allows float rounding of unit normals:
+  /// within kParallel the planes meet at 6·10⁻⁴ rad at most, and a source at that slope sends
+  /// at most 6·10⁻⁴ of its light.
+  bool sends_nothing_to(const Vec3& p, const Vec3& n) const {
+    if (glm::dot(n, center - p) <= -bound) return true;
+    return flat && (glm::dot(normal, p) <= low_offset || glm::dot(n, normal) >= kParallel);
+  }
+
+  static constexpr float kParallel = 1.0f - 2e-7f;
 };
 
 /// Counters of one worker.
@@ -279,6 +307,8 @@ struct Receivers {
   Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts) const {
     const Vec3& p = origin[v];
     const Vec3& n = mesh.normals[v];
+    counts.form_factors += src.elements.size();
+    if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
     // Per source element: its share of what v receives, as a running sum for sampling.
     std::array<float, kMaxPatchElements> cdf;
     std::array<uint32_t, kMaxPatchElements> which;
@@ -287,7 +317,6 @@ struct Receivers {
     size_t count = 0;
     std::array<float, SourceBatch::kMaxBatch> factor;
     src.batch.form_factors(p, n, factor.data());
-    counts.form_factors += src.elements.size();
     for (size_t k = 0; k < src.elements.size(); ++k) {
       const float f = factor[k];
       if (!(f > 0.0)) continue;
