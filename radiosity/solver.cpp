@@ -231,6 +231,7 @@ struct ShootingPatch {
   std::vector<SourceTriangle> triangles;
   SourceBatch batch;
   std::vector<Rgb> radiosity;
+  std::array<std::array<float, kMaxPatchElements>, 4> channels;  ///< radiosity r, g, b and their mean
   rc::Bounds3 box;
   Vec3 center{0.0f};        ///< of the box
   float bound = 0.0f;       ///< radius of a sphere about `center` that holds the patch
@@ -249,6 +250,8 @@ struct ShootingPatch {
     for (size_t k = 0; k < source.size(); ++k) {
       radiosity[k] = unshot[source[k]];
       unshot[source[k]] = Rgb(0.0f);
+      for (int c = 0; c < 3; ++c) channels[c][k] = radiosity[k][c];
+      channels[3][k] = radiosity[k].average();
       const auto& el = mesh.elements[source[k]];
       triangles[k] = SourceTriangle(mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]]);
       for (uint32_t v : el) box.extend(mesh.positions[v]);
@@ -309,25 +312,26 @@ struct Receivers {
     const Vec3& n = mesh.normals[v];
     counts.form_factors += src.elements.size();
     if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
-    // Per source element: its share of what v receives, as a running sum for sampling.
-    std::array<float, kMaxPatchElements> cdf;
-    std::array<uint32_t, kMaxPatchElements> which;
-    Rgb gathered(0.0f);
-    float total = 0.0f;
-    size_t count = 0;
+    // Per source element: its share of what v receives, as a running sum for sampling. Elements
+    // that send nothing get empty intervals, which sampling never picks.
+    const size_t m = src.elements.size();
     std::array<float, SourceBatch::kMaxBatch> factor;
     src.batch.form_factors(p, n, factor.data());
-    for (size_t k = 0; k < src.elements.size(); ++k) {
+    std::array<float, kMaxPatchElements> cdf;
+    float r = 0.0f, g = 0.0f, b = 0.0f, total = 0.0f;
+    for (size_t k = 0; k < m; ++k) {
       const float f = factor[k];
-      if (!(f > 0.0)) continue;
-      const Rgb share = src.radiosity[k] * f;
-      if (share.is_black()) continue;
-      gathered += share;
-      total += share.average();
-      cdf[count] = total;
-      which[count++] = src.elements[k];
+      r += f * src.channels[0][k];
+      g += f * src.channels[1][k];
+      b += f * src.channels[2][k];
+      total += f * src.channels[3][k];
+      cdf[k] = total;
     }
-    if (count == 0 || !(total > 0.0f)) return Rgb(0.0f);
+    if (!(total > 0.0f)) return Rgb(0.0f);
+    const Rgb gathered(r, g, b);
+    size_t last = m - 1;  // the last element with a share, for rounding at the top of the sum
+    while (last > 0 && !(cdf[last] > cdf[last - 1])) --last;
+    auto sends = [&](size_t k) { return k == 0 ? cdf[0] > 0.0f : cdf[k] > cdf[k - 1]; };
 
     // Occluders that the box around v and the patch misses cannot block; for the sharp shadows
     // of emitters the remaining ones are tested against each element's tetrahedron.
@@ -339,8 +343,9 @@ struct Receivers {
         may_be_blocked = true;
         break;
       }
-      for (size_t k = 0; k < count && !may_be_blocked; ++k) {
-        const auto& el = mesh.elements[which[k]];
+      for (size_t k = 0; k <= last && !may_be_blocked; ++k) {
+        if (!sends(k)) continue;
+        const auto& el = mesh.elements[src.elements[k]];
         may_be_blocked =
             tetrahedron_may_meet_box(p, mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]], box);
       }
@@ -358,16 +363,16 @@ struct Receivers {
         for (int j = 0; j < side; ++j) {
           // u.x picks the element by the running sum and is then stretched back to [0, 1).
           float ux = (float(i) + rng.uniform()) / float(side) * total;
-          size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + count, ux) - cdf.begin());
-          k = std::min(k, count - 1);
+          size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + m, ux) - cdf.begin());
+          k = std::min(k, last);
           const float lo = k ? cdf[k - 1] : 0.0f;
           ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
           const rc::Vec2 bary = rc::sample_uniform_triangle({ux, (float(j) + rng.uniform()) / float(side)});
-          const auto& el = mesh.elements[which[k]];
+          const auto& el = mesh.elements[src.elements[k]];
           const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
                          bary.y * mesh.positions[el[2]];
           ++counts.rays;
-          open += !scene.occluded(rc::spawn_shadow_ray(point[v], surface_point(q, mesh.element_normal[which[k]])));
+          open += !scene.occluded(rc::spawn_shadow_ray(point[v], surface_point(q, mesh.element_normal[src.elements[k]])));
         }
       return float(open) / float(side * side);
     };
