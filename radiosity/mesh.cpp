@@ -289,24 +289,24 @@ double meshed_area(const rc::Scene& scene) {
   return area;
 }
 
-/// The meshes whose bounding boxes meet mesh `m`'s (grown by a millionth of the scene's size):
-/// the only ones that can touch it.
-std::vector<const rc::TriangleMesh*> touching_meshes(const rc::Scene& scene, size_t m) {
-  const auto box_of = [](const rc::TriangleMesh& mesh) {
-    rc::Bounds3 b;
-    for (uint32_t i : mesh.indices) b.extend(mesh.positions.at(i));
-    return b;
-  };
-  rc::Bounds3 box = box_of(scene.meshes[m]);
-  if (box.empty()) return {};
-  float scale = 0.0f;
-  for (const rc::TriangleMesh& other : scene.meshes)
-    for (const Vec3& p : other.positions) scale = std::max(scale, glm::length(p - box.lo));
-  box.lo -= Vec3(1e-6f * scale);
-  box.hi += Vec3(1e-6f * scale);
-  std::vector<const rc::TriangleMesh*> out;
-  for (size_t o = 0; o < scene.meshes.size(); ++o)
-    if (o != m && box.overlaps(box_of(scene.meshes[o]))) out.push_back(&scene.meshes[o]);
+/// For each mesh of the scene, the other meshes whose bounding boxes meet its own (grown by a
+/// millionth of the scene's size): the only ones that can touch it.
+std::vector<std::vector<const rc::TriangleMesh*>> touching_meshes(const rc::Scene& scene) {
+  std::vector<rc::Bounds3> boxes(scene.meshes.size());
+  rc::Bounds3 all;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    for (uint32_t i : scene.meshes[m].indices) boxes[m].extend(scene.meshes[m].positions.at(i));
+    if (!boxes[m].empty()) all.extend(boxes[m].lo), all.extend(boxes[m].hi);
+  }
+  std::vector<std::vector<const rc::TriangleMesh*>> out(scene.meshes.size());
+  if (all.empty()) return out;
+  const Vec3 grow(1e-6f * glm::length(all.hi - all.lo));
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (boxes[m].empty()) continue;
+    const rc::Bounds3 box{boxes[m].lo - grow, boxes[m].hi + grow};
+    for (size_t o = 0; o < scene.meshes.size(); ++o)
+      if (o != m && !boxes[o].empty() && box.overlaps(boxes[o])) out[m].push_back(&scene.meshes[o]);
+  }
   return out;
 }
 
@@ -420,13 +420,14 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   std::vector<SplitSurface> surfaces(surface_count);
   std::vector<RepairCounts> counts(mesh_count);
   std::vector<size_t> buried(mesh_count, 0);
+  const auto touching = touching_meshes(scene);
   const RemeshParams params{kRemeshTargetScale * edge_length, settings.sharp_angle_degrees,
                             settings.remesh_iterations};
   rc::parallel_for(surface_count, [&](size_t s) {
     if (s < mesh_count) {
       const rc::TriangleMesh& mesh = scene.meshes[s];
       if (!is_meshed(scene.materials[mesh.material])) return;
-      TriangleSoup soup = repair_and_remesh(mesh, touching_meshes(scene, s), params, &counts[s]);
+      TriangleSoup soup = repair_and_remesh(mesh, touching[s], params, &counts[s]);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
       if (scene.committed()) buried[s] = drop_buried(scene, static_cast<uint32_t>(s), surfaces[s]);

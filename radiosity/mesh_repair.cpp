@@ -201,17 +201,23 @@ using Constrained = SurfaceMesh::Property_map<edge_descriptor, bool>;
 /// discontinuity: the floor is lit on one side and buried on the other); an element that
 /// straddles it would average the two, and Gouraud interpolation would smear the dark into the
 /// lit floor. CGAL's corefinement computes the intersection exactly and splits the faces along
-/// it; the other mesh is only read. Returns the number of imprinted edges; a mesh that
-/// intersects itself is left alone, since corefinement needs it free of self-intersections.
+/// it; the other mesh is only read. Returns the number of imprinted edges. Meshes that
+/// intersect themselves take no part, on either side.
 size_t imprint_contacts(SurfaceMesh& mesh, std::span<const rc::TriangleMesh* const> others, Constrained& constrained,
                         RepairCounts& counts) {
   if (others.empty() || counts.self_intersecting > 0) return 0;
   size_t before = 0;
   for (edge_descriptor e : mesh.edges()) before += constrained[e];
   for (const rc::TriangleMesh* other : others) {
-    RepairCounts ignored;
-    SurfaceMesh tool = repair(*other, ignored);
+    RepairCounts tool_counts;
+    SurfaceMesh tool = repair(*other, tool_counts);
     if (tool.number_of_faces() == 0) continue;
+    // CGAL promises to read a self-intersecting mesh it does not modify, but crashes on one
+    // (5.5: two boxes of one mesh sharing a face, tests/stress/test_pathological.cpp).
+    if (tool_counts.self_intersecting > 0) {
+      ++counts.contacts_failed;
+      continue;
+    }
     try {
       PMP::corefine(mesh, tool, CGAL::parameters::edge_is_constrained_map(constrained),
                     CGAL::parameters::do_not_modify(true));
