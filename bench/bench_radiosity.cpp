@@ -537,6 +537,8 @@ void run_scaling(const fs::path& out_dir) {
   double shots_per_element = 0.0;  // of the largest run that converged
   for (int requested : kScalingElements) {
     rad::SolverSettings settings = solver_settings(requested);
+    // The element count is the variable here: no adaptive subdivision, which would add elements.
+    settings.subdivision_levels = 0;
     // solve() meshes too, and its time limit counts from its start: meshing is timed on its own
     // first, and the limit leaves about the same time to shoot at every size.
     const auto mesh_start = std::chrono::steady_clock::now();
