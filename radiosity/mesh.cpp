@@ -324,17 +324,23 @@ std::vector<DVec3> burial_directions() {
   return dirs;
 }
 
-/// Removes the triangles of `surface` that are buried: every test ray from their centroid
+/// Largest share of the meshed area that burial may remove. Solids standing on or in other
+/// surfaces hide a few per cent of them (the Cornell blocks 2.9 % of the box); far more means a
+/// scene whose surfaces face the wrong way, and then nothing is removed.
+constexpr double kMaxBuriedShare = 0.25;
+
+/// Marks the triangles of `surface` that are buried: every test ray from their centroid
 /// (along the front hemisphere, see burial_directions) hits the back of some other surface, so
 /// they lie inside a closed solid or under an object standing on them and can neither receive
 /// nor send light. A surface inside-out with respect to its neighbours is never buried (its
-/// rays leave the scene). A face lying flat on another and facing it (a closed box's base on the
-/// floor) is not found by this test and is kept: it receives nothing and costs only its own
-/// elements. Unused vertices are removed with them. Returns the number removed.
-size_t drop_buried(const rc::Scene& scene, uint32_t surface_id, SplitSurface& surface) {
+/// rays leave the scene), nor is one enclosed by glass or in view of the camera. A face lying
+/// flat on another and facing it (a closed box's base on the floor) is not found by this test
+/// and is kept: it receives nothing and costs only its own elements. Returns the buried area.
+double mark_buried(const rc::Scene& scene, uint32_t surface_id, const SplitSurface& surface, std::vector<char>& buried) {
   static const std::vector<DVec3> dirs = burial_directions();
-  std::vector<bool> keep(surface.corners.size(), true);
-  size_t dropped = 0;
+  const Vec3 camera = scene.effective_camera().look_from;
+  buried.assign(surface.corners.size(), 0);
+  double area = 0.0;
   for (size_t t = 0; t < surface.corners.size(); ++t) {
     const auto& c = surface.corners[t];
     const DVec3 a = surface.positions[c[0]], b = surface.positions[c[1]], d = surface.positions[c[2]];
@@ -345,22 +351,37 @@ size_t drop_buried(const rc::Scene& scene, uint32_t surface_id, SplitSurface& su
     sp.p_error = rc::error_gamma(16) * rc::abs(sp.p);
     sp.ng = Vec3(glm::normalize(cross));
     const rc::Frame frame = rc::Frame::from_normal(sp.ng);
-    bool buried = true;
+    bool enclosed = true;
     for (const DVec3& dir : dirs) {
       const rc::Ray ray = rc::spawn_ray(sp, frame.to_world(Vec3(dir)));
       const std::optional<rc::Hit> hit = scene.intersect(ray);
-      if (!hit || hit->geom_id == surface_id || scene.surface(ray, *hit).front_face) {
-        buried = false;
+      if (!hit || hit->geom_id == surface_id) {
+        enclosed = false;
+        break;
+      }
+      const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+      if (si.front_face || scene.materials[si.material].kind == rc::MaterialKind::dielectric) {
+        enclosed = false;  // open, or enclosed by glass that lets light in
         break;
       }
     }
-    if (buried) keep[t] = false, ++dropped;
+    // A room modelled inside out (its walls facing outwards) encloses what is in it just as a
+    // block encloses the floor under it; the camera inside tells the two apart where it looks.
+    if (enclosed && glm::dot(camera - sp.p, sp.ng) > 0.0f && !scene.occluded(rc::spawn_shadow_ray(sp, camera)))
+      enclosed = false;
+    if (enclosed) buried[t] = 1, area += 0.5 * glm::length(cross);
   }
-  if (dropped == 0) return 0;
+  return area;
+}
+
+/// Removes the marked triangles and the vertices only they used. Returns the number removed.
+size_t remove_triangles(SplitSurface& surface, const std::vector<char>& remove) {
+  const size_t removed = static_cast<size_t>(std::count(remove.begin(), remove.end(), char{1}));
+  if (removed == 0) return 0;
   SplitSurface kept;
   std::vector<uint32_t> renumber(surface.positions.size(), UINT32_MAX);
   for (size_t t = 0; t < surface.corners.size(); ++t) {
-    if (!keep[t]) continue;
+    if (remove[t]) continue;
     std::array<uint32_t, 3> corners{};
     for (int k = 0; k < 3; ++k) {
       uint32_t& v = renumber[surface.corners[t][k]];
@@ -374,7 +395,7 @@ size_t drop_buried(const rc::Scene& scene, uint32_t surface_id, SplitSurface& su
     kept.corners.push_back(corners);
   }
   surface = std::move(kept);
-  return dropped;
+  return removed;
 }
 
 }  // namespace
@@ -419,7 +440,8 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   const size_t surface_count = mesh_count + scene.spheres.size();
   std::vector<SplitSurface> surfaces(surface_count);
   std::vector<RepairCounts> counts(mesh_count);
-  std::vector<size_t> buried(mesh_count, 0);
+  std::vector<std::vector<char>> buried(mesh_count);
+  std::vector<double> buried_area(mesh_count, 0.0);
   const auto touching = touching_meshes(scene);
   const RemeshParams params{kRemeshTargetScale * edge_length, settings.sharp_angle_degrees,
                             settings.remesh_iterations};
@@ -430,7 +452,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
       TriangleSoup soup = repair_and_remesh(mesh, touching[s], params, &counts[s]);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
-      if (scene.committed()) buried[s] = drop_buried(scene, static_cast<uint32_t>(s), surfaces[s]);
+      if (scene.committed()) buried_area[s] = mark_buried(scene, static_cast<uint32_t>(s), surfaces[s], buried[s]);
     } else {
       const rc::Sphere& sphere = scene.spheres[s - mesh_count];
       if (!is_meshed(scene.materials[sphere.material])) return;
@@ -445,7 +467,14 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     }
   });
 
+  const double total_buried = std::accumulate(buried_area.begin(), buried_area.end(), 0.0);
+  const bool remove_buried = total_buried <= kMaxBuriedShare * area;
+  if (!remove_buried)
+    rep.warnings.push_back(std::to_string(static_cast<int>(std::lround(100.0 * total_buried / area))) +
+                           " % of the surface area looks buried inside other surfaces; nothing was removed "
+                           "(do some surfaces face the wrong way?)");
   for (size_t s = 0; s < surface_count; ++s) {
+    if (s < mesh_count && remove_buried) rep.buried_elements += remove_triangles(surfaces[s], buried[s]);
     const uint32_t material =
         s < mesh_count ? scene.meshes[s].material : scene.spheres[s - mesh_count].material;
     append(out, surfaces[s], material, static_cast<uint32_t>(s));
@@ -456,7 +485,6 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     rep.reoriented += c.reoriented;
     rep.self_intersecting += c.self_intersecting;
     rep.contact_edges += c.contact_edges;
-    rep.buried_elements += buried[s];
     warn_counts(rep, mesh_label(scene.meshes[s], s), c);
   }
   return out;

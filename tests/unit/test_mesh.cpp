@@ -590,6 +590,35 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   EXPECT_EQ(straddling, 0u);
 }
 
+// A room modelled inside out (a closed box facing outwards, as a scaled cube primitive comes)
+// encloses what stands in it just as a block encloses the floor under it. What the camera inside
+// sees is kept; and when "buried" would take a large share of the scene, nothing is removed.
+TEST(Mesh, InsideOutRoomsKeepTheirContents) {
+  for (const bool camera_inside : {true, false}) {
+    Scene scene;
+    scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+    scene.meshes.push_back(closed_box("room", 0.0, 0.0, 2.0, 2.0, 0.0, 0.0f, 3.0f));  // faces outwards
+    // Small inside the room with the camera in it; large (a third of the area) with it outside.
+    scene.meshes.push_back(camera_inside ? closed_box("block", 0.5, 0.5, 0.3, 0.3, 0.2, 0.0f, 0.6f)
+                                         : closed_box("block", 0.0, 0.0, 1.5, 1.5, 0.0, 0.0f, 2.0f));
+    scene.camera = rc::Camera{.look_from = camera_inside ? Vec3(0.0f, -1.5f, 2.5f) : Vec3(0.0f, -10.0f, 1.5f),
+                              .look_at = Vec3(0.5f, 0.5f, 0.3f),
+                              .up = Vec3(0.0f, 0.0f, 1.0f)};
+    scene.commit();
+    MeshReport report;
+    const RadiosityMesh mesh = build_mesh(scene, MeshSettings{.max_edge = 0.25f}, &report);
+    double top = 0.0;
+    for (size_t e = 0; e < mesh.element_count(); ++e)
+      if (mesh.element_surface[e] == 1 && mesh.element_normal[e].z > 0.999f) top += mesh.element_area[e];
+    const double block_top = camera_inside ? 0.36 : 9.0;
+    EXPECT_NEAR(top, block_top, 1e-5 * block_top) << (camera_inside ? "camera inside" : "camera outside");
+    const bool warned = std::any_of(report.warnings.begin(), report.warnings.end(),
+                                    [](const std::string& w) { return w.find("buried") != std::string::npos; });
+    EXPECT_EQ(warned, !camera_inside);
+    if (!camera_inside) EXPECT_EQ(report.buried_elements, 0u);
+  }
+}
+
 TEST(Mesh, RepairsABrokenSoup) {
   // A 2 × 2 square in z = 0 facing +z, as a soup: every triangle has its own three vertices. One
   // triangle is wound the other way, one triangle repeats a point (zero area), one has three
