@@ -615,7 +615,9 @@ TEST(Mesh, InsideOutRoomsKeepTheirContents) {
     const bool warned = std::any_of(report.warnings.begin(), report.warnings.end(),
                                     [](const std::string& w) { return w.find("buried") != std::string::npos; });
     EXPECT_EQ(warned, !camera_inside);
-    if (!camera_inside) EXPECT_EQ(report.buried_elements, 0u);
+    if (!camera_inside) {
+      EXPECT_EQ(report.buried_elements, 0u);
+    }
   }
 }
 
