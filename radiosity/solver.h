@@ -23,10 +23,10 @@ struct SolverSettings {
   int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (stratified
                                 ///< on the source); pairs a 2×2 probe finds all open or all blocked take 4
   int reflected_visibility_probe = 1;  ///< probe side (rays = side²) for patches that only reflect light
-  int patch_elements = 16;
+  int patch_elements = 16;             ///< elements per shooting patch (1: every element shoots alone)
   int subdivision_levels = 2;          ///< adaptive subdivision may halve the mesh's edge this many times
   double subdivision_threshold = 0.6;  ///< bisect an element whose vertices' direct irradiance spreads by more
-                                       ///< than this fraction of the brightest      ///< elements per shooting patch (1: every element shoots alone)
+                                       ///< than this fraction of the brightest
   uint64_t seed = 0;
   int threads = 0;           ///< 0 = all
   bool progress = true;
