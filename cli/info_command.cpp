@@ -72,6 +72,10 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   const radiosity::SolvePlan rp = radiosity::plan_solve(scene, radiosity::SolverSettings{});
   rad.runs.push_back("mesh: about " + std::to_string(rp.elements) + " elements, " + std::to_string(rp.vertices) +
                      " vertices (edge " + short_number(rp.max_edge) + "), adaptive subdivision at steep direct light");
+  if (rp.contact_edges > 0)
+    rad.runs.push_back("contact lines imprinted where surfaces touch (" + std::to_string(rp.contact_edges) + " edges)");
+  if (rp.buried_elements > 0)
+    rad.skipped.push_back(std::to_string(rp.buried_elements) + " element(s) buried under or inside other surfaces");
   if (rp.convex_enclosure) rad.skipped.push_back("visibility rays: convex enclosure, nothing can occlude");
   else rad.runs.push_back("visibility rays only where " + std::to_string(rp.occluder_boxes) + " occluder box(es) may block");
   if (rp.punctual_lights > 0)

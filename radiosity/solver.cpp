@@ -395,6 +395,8 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.elements = mesh.element_count();
   plan.vertices = mesh.vertex_count();
   plan.max_edge = report.max_edge;
+  plan.contact_edges = report.contact_edges;
+  plan.buried_elements = report.buried_elements;
   plan.occluder_boxes = occluder_boxes(scene, mesh).size();
   plan.convex_enclosure = plan.occluder_boxes == 0;
   plan.punctual_lights = scene.punctual_lights.size();

@@ -66,6 +66,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings);
 /// What solve() will do on a scene, found by meshing it without solving.
 struct SolvePlan {
   size_t elements = 0, vertices = 0;  ///< before adaptive subdivision
+  size_t contact_edges = 0;           ///< see MeshReport
+  size_t buried_elements = 0;         ///< removed from the mesh (see MeshReport)
   float max_edge = 0.0f;
   bool convex_enclosure = false;      ///< nothing can occlude: no visibility rays at all
   size_t occluder_boxes = 0;          ///< boxes that shadow rays are tested against first

@@ -122,6 +122,11 @@ TEST_F(Cli, InfoSaysWhatEachMethodRunsAndSkips) {
   EXPECT_GT(j["memory_estimate_bytes"].get<double>(), 0.0);
   const std::string photon_skipped = j["methods"]["photon"]["skipped"].dump();
   EXPECT_NE(photon_skipped.find("no specular surface"), std::string::npos) << photon_skipped;
+  // The blocks stand on the floor: their outlines are imprinted and the floor under them skipped.
+  const std::string radiosity_runs = j["methods"]["radiosity"]["runs"].dump();
+  EXPECT_NE(radiosity_runs.find("contact lines"), std::string::npos) << radiosity_runs;
+  const std::string radiosity_skipped = j["methods"]["radiosity"]["skipped"].dump();
+  EXPECT_NE(radiosity_skipped.find("buried"), std::string::npos) << radiosity_skipped;
   // The furnace is one closed box: radiosity needs no visibility rays.
   const Result f = run("info furnace --json");
   ASSERT_EQ(f.code, 0) << f.err;
