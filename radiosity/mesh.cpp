@@ -330,13 +330,13 @@ std::vector<DVec3> burial_directions() {
 constexpr double kMaxBuriedShare = 0.25;
 
 /// Marks the triangles of `surface` that are buried: every test ray from their centroid
-/// (along the front hemisphere, see burial_directions) hits the back of some other surface, so
+/// (along the front hemisphere, see burial_directions) hits the back of a surface, so
 /// they lie inside a closed solid or under an object standing on them and can neither receive
 /// nor send light. A surface inside-out with respect to its neighbours is never buried (its
 /// rays leave the scene), nor is one enclosed by glass or in view of the camera. A face lying
 /// flat on another and facing it (a closed box's base on the floor) is not found by this test
 /// and is kept: it receives nothing and costs only its own elements. Returns the buried area.
-double mark_buried(const rc::Scene& scene, uint32_t surface_id, const SplitSurface& surface, std::vector<char>& buried) {
+double mark_buried(const rc::Scene& scene, const SplitSurface& surface, std::vector<char>& buried) {
   static const std::vector<DVec3> dirs = burial_directions();
   const Vec3 camera = scene.effective_camera().look_from;
   buried.assign(surface.corners.size(), 0);
@@ -355,7 +355,7 @@ double mark_buried(const rc::Scene& scene, uint32_t surface_id, const SplitSurfa
     for (const DVec3& dir : dirs) {
       const rc::Ray ray = rc::spawn_ray(sp, frame.to_world(Vec3(dir)));
       const std::optional<rc::Hit> hit = scene.intersect(ray);
-      if (!hit || hit->geom_id == surface_id) {
+      if (!hit) {
         enclosed = false;
         break;
       }
@@ -452,7 +452,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
       TriangleSoup soup = repair_and_remesh(mesh, touching[s], params, &counts[s]);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
-      if (scene.committed()) buried_area[s] = mark_buried(scene, static_cast<uint32_t>(s), surfaces[s], buried[s]);
+      if (scene.committed()) buried_area[s] = mark_buried(scene, surfaces[s], buried[s]);
     } else {
       const rc::Sphere& sphere = scene.spheres[s - mesh_count];
       if (!is_meshed(scene.materials[sphere.material])) return;

@@ -16,6 +16,8 @@
 #include <vector>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/bbox.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/detect_features.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
@@ -150,11 +152,32 @@ SurfaceMesh repair(const rc::TriangleMesh& input, RepairCounts& counts) {
     for (face_descriptor f : degenerate) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
     mesh.collect_garbage();
   }
-
-  std::vector<std::pair<face_descriptor, face_descriptor>> intersecting;
-  PMP::self_intersections(mesh, std::back_inserter(intersecting));
-  counts.self_intersecting = intersecting.size();
   return mesh;
+}
+
+/// One connected piece of a repaired mesh: the unit that is imprinted and remeshed.
+struct Part {
+  SurfaceMesh mesh;
+  CGAL::Bbox_3 box;
+  size_t self_intersecting = 0;  ///< pairs of its faces that intersect away from shared vertices and edges
+};
+
+/// Splits the mesh into its connected pieces. Pieces of one mesh that meet without sharing
+/// edges (a block standing on the floor, both in one OBJ material) are not a self-intersection
+/// but a contact, imprinted like a contact between meshes; only what intersects within a piece
+/// counts as one.
+std::vector<Part> split_parts(const SurfaceMesh& mesh) {
+  std::vector<SurfaceMesh> pieces;
+  PMP::split_connected_components(mesh, pieces);
+  std::vector<Part> parts(pieces.size());
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    parts[i].mesh = std::move(pieces[i]);
+    parts[i].box = PMP::bbox(parts[i].mesh);
+    std::vector<std::pair<face_descriptor, face_descriptor>> intersecting;
+    PMP::self_intersections(parts[i].mesh, std::back_inserter(intersecting));
+    parts[i].self_intersecting = intersecting.size();
+  }
+  return parts;
 }
 
 /// Cuts every protected edge longer than `max_length` into the fewest equal pieces no longer than
@@ -195,38 +218,42 @@ void split_protected_edges(SurfaceMesh& mesh, const std::vector<edge_descriptor>
 
 using Constrained = SurfaceMesh::Property_map<edge_descriptor, bool>;
 
-/// Imprints on `mesh` the lines where other surfaces touch or cross it (a block standing on a
+/// Most pieces one mesh may have for its pieces to be imprinted on each other (the pairs are
+/// found by bounding boxes, all against all); a mesh of more pieces (foliage, gravel) is
+/// imprinted by other meshes only.
+constexpr size_t kMaxImprintedParts = 4096;
+
+/// Imprints on `part` the lines where other surfaces touch or cross it (a block standing on a
 /// floor leaves its outline there) and marks them as constrained edges. Radiosity jumps across
 /// such a line (Heckbert 1992 and Lischinski, Tampieri & Greenberg 1992 call it a D0
 /// discontinuity: the floor is lit on one side and buried on the other); an element that
 /// straddles it would average the two, and Gouraud interpolation would smear the dark into the
 /// lit floor. CGAL's corefinement computes the intersection exactly and splits the faces along
-/// it; the other mesh is only read. Returns the number of imprinted edges. Meshes that
-/// intersect themselves take no part, on either side.
-size_t imprint_contacts(SurfaceMesh& mesh, std::span<const rc::TriangleMesh* const> others, Constrained& constrained,
+/// it; the tools are only read. Pieces that intersect themselves take no part, on either side:
+/// corefinement needs the modified mesh free of self-intersections, and CGAL 5.5 crashes on a
+/// self-intersecting tool even though it promises to read one (two boxes of one mesh sharing a
+/// face, tests/stress/test_pathological.cpp). Returns the number of imprinted edges.
+size_t imprint_contacts(Part& part, const std::vector<const Part*>& tools, Constrained& constrained,
                         RepairCounts& counts) {
-  if (others.empty() || counts.self_intersecting > 0) return 0;
+  if (part.self_intersecting > 0) return 0;
   size_t before = 0;
-  for (edge_descriptor e : mesh.edges()) before += constrained[e];
-  for (const rc::TriangleMesh* other : others) {
-    RepairCounts tool_counts;
-    SurfaceMesh tool = repair(*other, tool_counts);
-    if (tool.number_of_faces() == 0) continue;
-    // CGAL promises to read a self-intersecting mesh it does not modify, but crashes on one
-    // (5.5: two boxes of one mesh sharing a face, tests/stress/test_pathological.cpp).
-    if (tool_counts.self_intersecting > 0) {
+  for (edge_descriptor e : part.mesh.edges()) before += constrained[e];
+  for (const Part* tool : tools) {
+    if (!CGAL::do_overlap(part.box, tool->box)) continue;
+    if (tool->self_intersecting > 0) {
       ++counts.contacts_failed;
       continue;
     }
     try {
-      PMP::corefine(mesh, tool, CGAL::parameters::edge_is_constrained_map(constrained),
-                    CGAL::parameters::do_not_modify(true));
+      // corefine() takes both meshes by reference; the tool's is not modified.
+      PMP::corefine(part.mesh, const_cast<SurfaceMesh&>(tool->mesh),
+                    CGAL::parameters::edge_is_constrained_map(constrained), CGAL::parameters::do_not_modify(true));
     } catch (const std::exception&) {
-      ++counts.contacts_failed;  // corefinement gave up on this pair; the surface is meshed without it
+      ++counts.contacts_failed;  // corefinement gave up on this pair; the piece is meshed without it
     }
   }
   size_t after = 0;
-  for (edge_descriptor e : mesh.edges()) after += constrained[e];
+  for (edge_descriptor e : part.mesh.edges()) after += constrained[e];
   return after - before;
 }
 
@@ -277,10 +304,32 @@ TriangleSoup repair_and_remesh(const rc::TriangleMesh& input, std::span<const rc
   c = RepairCounts{};
   SurfaceMesh mesh = repair(input, c);
   if (mesh.number_of_faces() == 0) return {};
-  auto constrained = mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
-  c.contact_edges = imprint_contacts(mesh, touching, constrained, c);
-  remesh(mesh, params, constrained);
-  return to_soup(mesh);
+  std::vector<Part> parts = split_parts(mesh);
+  // The pieces of the meshes that may touch this one, all of them tools.
+  std::vector<Part> others;
+  for (const rc::TriangleMesh* other : touching) {
+    RepairCounts ignored;
+    std::vector<Part> pieces = split_parts(repair(*other, ignored));
+    std::move(pieces.begin(), pieces.end(), std::back_inserter(others));
+  }
+  TriangleSoup soup;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    Part& part = parts[i];
+    c.self_intersecting += part.self_intersecting;
+    std::vector<const Part*> tools;
+    if (parts.size() <= kMaxImprintedParts)
+      for (size_t j = 0; j < parts.size(); ++j)
+        if (j != i) tools.push_back(&parts[j]);
+    for (const Part& other : others) tools.push_back(&other);
+    auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
+    c.contact_edges += imprint_contacts(part, tools, constrained, c);
+    remesh(part.mesh, params, constrained);
+    const TriangleSoup piece = to_soup(part.mesh);
+    const auto offset = static_cast<uint32_t>(soup.points.size());
+    soup.points.insert(soup.points.end(), piece.points.begin(), piece.points.end());
+    for (const auto& t : piece.triangles) soup.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  }
+  return soup;
 }
 
 }  // namespace gilt::radiosity::detail

@@ -651,6 +651,13 @@ TEST(Mesh, RepairsABrokenSoup) {
                         Vec3(6, 1, -1), Vec3(6, 1, 1), Vec3(6, 3, 0)};
   crossing.indices = {0, 1, 2, 3, 4, 5};
 
+  // Two triangles on one edge, the second folded back over the first: one connected piece that
+  // overlaps itself.
+  TriangleMesh folded;
+  folded.name = "folded";
+  folded.positions = {Vec3(10, 0, 0), Vec3(12, 0, 0), Vec3(11, 2, 0), Vec3(10.5f, 0.5f, 0)};
+  folded.indices = {0, 1, 2, 2, 1, 3};
+
   // Three triangles on one edge: not a manifold, so orientation copies the edge's vertices and
   // meshes the three as separate sheets.
   TriangleMesh fin;
@@ -661,6 +668,7 @@ TEST(Mesh, RepairsABrokenSoup) {
   Scene scene = single_mesh_scene(soup);
   scene.meshes.push_back(crossing);
   scene.meshes.push_back(fin);
+  scene.meshes.push_back(folded);
   MeshReport report;
   const RadiosityMesh mesh = build_mesh(scene, MeshSettings{.max_edge = 0.25f}, &report);
 
@@ -668,9 +676,11 @@ TEST(Mesh, RepairsABrokenSoup) {
   EXPECT_EQ(report.merged_vertices, 30u - 9u);
   EXPECT_EQ(report.removed_degenerate, 2u);
   EXPECT_EQ(report.reoriented, 1u);
-  // 'crossing' gives one pair; 'fin', once its edge's vertices are copied, has three triangles
-  // touching along an edge they no longer share: three more pairs.
-  EXPECT_EQ(report.self_intersecting, 4u);
+  // Only 'folded' intersects itself, once. The two triangles of 'crossing' are separate pieces:
+  // where they cross is a contact, imprinted on both. So are the three sheets of 'fin', which
+  // meet along their borders.
+  EXPECT_EQ(report.self_intersecting, 1u);
+  EXPECT_GT(report.contact_edges, 0u);
   for (const std::string& w : report.warnings) note("repair_warning", w);
   const auto warned = [&](const std::string& what) {
     return std::any_of(report.warnings.begin(), report.warnings.end(), [&](const std::string& w) {
@@ -681,8 +691,30 @@ TEST(Mesh, RepairsABrokenSoup) {
   EXPECT_TRUE(warned("degenerate"));
   EXPECT_TRUE(warned("reoriented"));
   EXPECT_TRUE(std::any_of(report.warnings.begin(), report.warnings.end(), [](const std::string& w) {
-    return w.find("'crossing'") != std::string::npos && w.find("intersect") != std::string::npos;
+    return w.find("'folded'") != std::string::npos && w.find("intersect") != std::string::npos;
   }));
+  // Each crossing triangle is cut along the other, and they cross along x = 6, z = 0 for
+  // 1 < y < 2: no element of either may cross that segment. An element crosses it when it
+  // straddles the other triangle's plane (z = 0 for the second, x = 6 for the first) and the
+  // line where it meets that plane overlaps 1 < y < 2.
+  size_t straddling = 0;
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    if (mesh.element_surface[e] != 1) continue;
+    const auto& el = mesh.elements[e];
+    const bool first = mesh.element_normal[e].z > 0.5f || mesh.element_normal[e].z < -0.5f;  // lies in z = 0
+    auto side = [&](const Vec3& q) { return first ? q.x - 6.0f : q.z; };
+    float lo = std::numeric_limits<float>::max(), hi = -lo;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &a = mesh.positions[el[k]], &b = mesh.positions[el[(k + 1) % 3]];
+      const float sa = side(a), sb = side(b);
+      if ((sa < -1e-6f && sb > 1e-6f) || (sa > 1e-6f && sb < -1e-6f)) {
+        const float y = a.y + (b.y - a.y) * sa / (sa - sb);
+        lo = std::min(lo, y), hi = std::max(hi, y);
+      }
+    }
+    straddling += hi > 1.0f + 1e-4f && lo < 2.0f - 1e-4f;
+  }
+  EXPECT_EQ(straddling, 0u);
 
   EXPECT_TRUE(std::any_of(report.warnings.begin(), report.warnings.end(), [](const std::string& w) {
     return w.find("'fin'") != std::string::npos && w.find("manifold") != std::string::npos;
