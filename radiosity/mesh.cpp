@@ -291,21 +291,21 @@ double meshed_area(const rc::Scene& scene) {
 
 /// For each mesh of the scene, the other meshes whose bounding boxes meet its own (grown by a
 /// millionth of the scene's size): the only ones that can touch it.
-std::vector<std::vector<const rc::TriangleMesh*>> touching_meshes(const rc::Scene& scene) {
+std::vector<std::vector<size_t>> touching_meshes(const rc::Scene& scene) {
   std::vector<rc::Bounds3> boxes(scene.meshes.size());
   rc::Bounds3 all;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     for (uint32_t i : scene.meshes[m].indices) boxes[m].extend(scene.meshes[m].positions.at(i));
     if (!boxes[m].empty()) all.extend(boxes[m].lo), all.extend(boxes[m].hi);
   }
-  std::vector<std::vector<const rc::TriangleMesh*>> out(scene.meshes.size());
+  std::vector<std::vector<size_t>> out(scene.meshes.size());
   if (all.empty()) return out;
   const Vec3 grow(1e-6f * glm::length(all.hi - all.lo));
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     if (boxes[m].empty()) continue;
     const rc::Bounds3 box{boxes[m].lo - grow, boxes[m].hi + grow};
     for (size_t o = 0; o < scene.meshes.size(); ++o)
-      if (o != m && !boxes[o].empty() && box.overlaps(boxes[o])) out[m].push_back(&scene.meshes[o]);
+      if (o != m && !boxes[o].empty() && box.overlaps(boxes[o])) out[m].push_back(o);
   }
   return out;
 }
@@ -445,11 +445,23 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   const auto touching = touching_meshes(scene);
   const RemeshParams params{kRemeshTargetScale * edge_length, settings.sharp_angle_degrees,
                             settings.remesh_iterations};
+  // Every mesh that is meshed or touches one that is, mended once: the meshed ones are remeshed
+  // from it, and all of them imprint their neighbours.
+  std::vector<char> repair(mesh_count, 0);
+  for (size_t m = 0; m < mesh_count; ++m)
+    if (is_meshed(material_of(scene, scene.meshes[m].material, mesh_label(scene.meshes[m], m)))) {
+      repair[m] = 1;
+      for (size_t t : touching[m]) repair[t] = 1;
+    }
+  RepairedMeshes repaired(mesh_count);
+  rc::parallel_for(mesh_count, [&](size_t m) {
+    if (repair[m]) repaired.repair(m, scene.meshes[m]);
+  });
   rc::parallel_for(surface_count, [&](size_t s) {
     if (s < mesh_count) {
       const rc::TriangleMesh& mesh = scene.meshes[s];
       if (!is_meshed(scene.materials[mesh.material])) return;
-      TriangleSoup soup = repair_and_remesh(mesh, touching[s], params, &counts[s]);
+      TriangleSoup soup = repaired.remesh(s, touching[s], params, &counts[s]);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
       if (scene.committed()) buried_area[s] = mark_buried(scene, surfaces[s], buried[s]);

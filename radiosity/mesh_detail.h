@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -41,13 +42,32 @@ struct RemeshParams {
   int iterations = 3;                 ///< isotropic remeshing passes
 };
 
-/// Mends one input mesh with CGAL Polygon Mesh Processing (merge duplicate points and faces,
-/// drop degenerate faces, orient consistently while keeping the input's front where the input
-/// agreed, count self-intersections), imprints the lines where the `touching` meshes meet it,
-/// and remeshes it isotropically to `params.edge_length` with its border, sharp and contact
-/// edges protected. Returns the remeshed surface (empty when nothing is left) and fills `counts`.
-TriangleSoup repair_and_remesh(const rc::TriangleMesh& mesh, std::span<const rc::TriangleMesh* const> touching,
-                               const RemeshParams& params, RepairCounts* counts);
+/// The scene's input meshes, each mended once with CGAL Polygon Mesh Processing (merge duplicate
+/// points and faces, drop degenerate faces, orient consistently while keeping the input's front
+/// where the input agreed) and split into connected pieces. They are read by remesh() for the
+/// mesh itself and as tools by every mesh they touch. The CGAL types stay in mesh_repair.cpp.
+class RepairedMeshes {
+ public:
+  explicit RepairedMeshes(size_t mesh_count);
+  ~RepairedMeshes();
+  RepairedMeshes(const RepairedMeshes&) = delete;
+  RepairedMeshes& operator=(const RepairedMeshes&) = delete;
+
+  /// Mends mesh m; calls for different m may run in parallel.
+  void repair(size_t m, const rc::TriangleMesh& mesh);
+
+  /// Mesh m remeshed: the lines where the `touching` meshes (repaired too) and its own pieces
+  /// meet it are imprinted, and it is remeshed isotropically to `params.edge_length` with its
+  /// border, sharp and contact edges protected. Returns the remeshed surface (empty when nothing
+  /// is left) and fills `counts` with the repairs and what imprinting found. Reads only: calls
+  /// may run in parallel.
+  TriangleSoup remesh(size_t m, std::span<const size_t> touching, const RemeshParams& params,
+                      RepairCounts* counts) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// Geodesic sphere: an icosahedron whose edges are cut into `frequency` parts, projected onto the
 /// sphere; 20·frequency² triangles, counter-clockwise seen from outside.
