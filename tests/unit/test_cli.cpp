@@ -13,19 +13,14 @@
 #include <string>
 #include <thread>
 
+#include "tests/support/cli_run.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using Result = gilt::test::CliResult;
+using gilt::test::slurp;
 
 class Cli : public ::testing::Test {
  protected:
@@ -37,14 +32,7 @@ class Cli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   Result run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string("'") + GILT_BINARY_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
-                            err.string() + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-    fs::remove(out);
-    fs::remove(err);
-    return r;
+    return gilt::test::run_command(std::string("'") + GILT_BINARY_PATH + "' " + args, dir_);
   }
   fs::path write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;

@@ -15,20 +15,15 @@
 
 #include "raytrace_core/image_io.h"
 
+#include "tests/support/cli_run.h"
+
 namespace fs = std::filesystem;
 namespace rc = gilt::raytrace_core;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using Result = gilt::test::CliResult;
+using gilt::test::slurp;
 
 class Compare : public ::testing::Test {
  protected:
@@ -41,14 +36,7 @@ class Compare : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   Result run(const std::string& command) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = "GILT_CACHE_DIR='" + (dir_ / "cache").string() + "' " + command + " >'" + out.string() +
-                            "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-    fs::remove(out);
-    fs::remove(err);
-    return r;
+    return gilt::test::run_command("GILT_CACHE_DIR='" + (dir_ / "cache").string() + "' " + command, dir_);
   }
   Result gilt(const std::string& args) { return run(std::string("'") + GILT_BINARY_PATH + "' " + args); }
 
