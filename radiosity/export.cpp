@@ -1,6 +1,6 @@
 // Writing a radiosity solution as a mesh with one colour per vertex.
 //
-// PLY goes through OpenMesh's writer; OBJ + MTL are written as text, since no OBJ writer among
+// PLY is written directly (binary little-endian); OBJ + MTL are written as text, since no OBJ writer among
 // gilt's libraries emits `v x y z r g b` vertex colours; glTF and GLB go through tinygltf. Every
 // file is encoded in memory first, then written to a hidden temporary beside its destination,
 // flushed to disk and renamed into place (the scheme of raytrace_core/image_io.cpp): a failure
@@ -21,8 +21,6 @@
 #include <unistd.h>
 
 #include <tiny_gltf.h>
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include <algorithm>
 #include <array>
@@ -51,7 +49,7 @@ using rc::InputError;
 using rc::Material;
 using rc::StagedFile;
 
-// glTF buffers and OpenMesh's LSB option are little-endian; the buffers below are copied raw.
+// glTF buffers and binary PLY are little-endian; the buffers below are copied raw.
 static_assert(std::endian::native == std::endian::little, "mesh export assumes a little-endian host");
 
 namespace {
@@ -191,88 +189,45 @@ uint8_t to_srgb8(float linear, float scale) {
 
 // --- PLY ------------------------------------------------------------------------------------
 
-// OpenMesh's exporter converts colours to four-component vectors and does not compile with
-// three-component colour types; the alpha channel is not written (no Options::ColorAlpha).
-struct PlyTraits : OpenMesh::DefaultTraits {
-  using Point = OpenMesh::Vec3f;
-  using Normal = OpenMesh::Vec3f;
-  using Color = OpenMesh::Vec4f;
-  VertexAttributes(OpenMesh::Attributes::Normal | OpenMesh::Attributes::Color);
-};
-using PlyMesh = OpenMesh::TriMesh_ArrayKernelT<PlyTraits>;
-
-/// Mutes OpenMesh's error stream while alive: add_face reports each face it refuses there, and
-/// encode_ply handles those faces itself.
-class QuietOpenMeshErrors {
- public:
-  QuietOpenMeshErrors() : was_enabled_(omerr().is_enabled()) { omerr().disable(); }
-  ~QuietOpenMeshErrors() {
-    if (was_enabled_) omerr().enable();
-  }
-  QuietOpenMeshErrors(const QuietOpenMeshErrors&) = delete;
-  QuietOpenMeshErrors& operator=(const QuietOpenMeshErrors&) = delete;
-
- private:
-  bool was_enabled_;
-};
-
-/// Binary little-endian PLY of the mesh with `colours` written as floats, or as bytes
-/// ⌊255·c + 0.5⌋ (OpenMesh's conversion) when `float_colours` is false.
-std::string encode_ply(const RadiosityMesh& mesh, const std::vector<OpenMesh::Vec4f>& colours,
-                       bool float_colours) {
-  PlyMesh out;
-  out.reserve(mesh.vertex_count(), 3 * mesh.element_count(), mesh.element_count());
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    const Vec3& p = mesh.positions[v];
-    const Vec3& n = mesh.normals[v];
-    const auto handle = out.add_vertex(PlyMesh::Point(p.x, p.y, p.z));
-    out.set_normal(handle, PlyMesh::Normal(n.x, n.y, n.z));
-    out.set_color(handle, colours[v]);
-  }
-  // Vertex v keeps index v in the file. The half-edge structure refuses faces that would make the
-  // mesh non-manifold or flip its orientation (an edge shared by three elements, say); such a face
-  // gets its own copies of its vertices, appended at the end, so every element is written.
-  const QuietOpenMeshErrors quiet;
-  for (const auto& element : mesh.elements) {
-    std::array<OpenMesh::VertexHandle, 3> handles;
-    for (int k = 0; k < 3; ++k) handles[k] = OpenMesh::VertexHandle(static_cast<int>(element[k]));
-    if (out.add_face(handles[0], handles[1], handles[2]).is_valid()) continue;
-    for (auto& handle : handles) {
-      const PlyMesh::Point point = out.point(handle);  // a copy: add_vertex may reallocate
-      const auto copy = out.add_vertex(point);
-      out.set_normal(copy, out.normal(handle));
-      out.set_color(copy, out.color(handle));
-      handle = copy;
-    }
-    if (!out.add_face(handles[0], handles[1], handles[2]).is_valid()) {
-      throw std::logic_error("write_solution: OpenMesh refused a triangle of fresh vertices");
-    }
-  }
-
-  OpenMesh::IO::Options options = OpenMesh::IO::Options::Binary | OpenMesh::IO::Options::LSB |
-                                  OpenMesh::IO::Options::VertexNormal | OpenMesh::IO::Options::VertexColor;
-  if (float_colours) options += OpenMesh::IO::Options::ColorFloat;
-  std::ostringstream stream(std::ios::out | std::ios::binary);
-  if (!OpenMesh::IO::write_mesh(out, stream, ".ply", options)) {
-    throw std::runtime_error("write_solution: OpenMesh could not encode the mesh as PLY");
-  }
-  return std::move(stream).str();
+/// Appends the raw little-endian bytes of `value`.
+template <typename T>
+void append_raw(std::string& out, const T& value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  out.append(bytes, sizeof(T));
 }
 
-std::string encode_ply(const RadiosityMesh& mesh, const std::vector<Rgb>& colours,
-                       const ExportSettings& settings) {
-  std::vector<OpenMesh::Vec4f> values(colours.size());
-  if (settings.srgb8) {
-    // Code k is handed over as k/255, which OpenMesh's rounding turns back into k exactly.
-    const float scale = std::exp2(settings.exposure);
-    const auto code = [scale](float linear) { return float(to_srgb8(linear, scale)) / 255.0f; };
-    for (size_t v = 0; v < colours.size(); ++v) {
-      values[v] = {code(colours[v].r), code(colours[v].g), code(colours[v].b), 1.0f};
+/// Binary little-endian PLY: per vertex x y z, nx ny nz and the colour (float linear, or 8-bit
+/// sRGB after exposure with `settings.srgb8`), per element a three-index list. PLY is a face
+/// list, so it is written directly: a half-edge writer such as OpenMesh's must refuse or
+/// duplicate the vertices of non-manifold elements, and Debian's OpenMesh 9.0 aborts on an
+/// assertion for some of them (Khronos' 24_animation_pointer.gltf round-trip test scene).
+std::string encode_ply(const RadiosityMesh& mesh, const std::vector<Rgb>& colours, const ExportSettings& settings) {
+  const char* colour_type = settings.srgb8 ? "uchar" : "float";
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment gilt radiosity export\n";
+  out += "element vertex " + std::to_string(mesh.vertex_count()) + "\n";
+  for (const char* name : {"x", "y", "z", "nx", "ny", "nz"}) out += std::string("property float ") + name + "\n";
+  for (const char* name : {"red", "green", "blue"}) out += std::string("property ") + colour_type + " " + name + "\n";
+  out += "element face " + std::to_string(mesh.element_count()) + "\n";
+  out += "property list uchar int vertex_indices\nend_header\n";
+  const size_t colour_bytes = settings.srgb8 ? 3 : 12;
+  out.reserve(out.size() + mesh.vertex_count() * (24 + colour_bytes) + mesh.element_count() * 13);
+  const float scale = std::exp2(settings.exposure);
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    for (int k = 0; k < 3; ++k) append_raw(out, mesh.positions[v][k]);
+    for (int k = 0; k < 3; ++k) append_raw(out, mesh.normals[v][k]);
+    for (int k = 0; k < 3; ++k) {
+      if (settings.srgb8)
+        append_raw(out, to_srgb8(colours[v][k], scale));
+      else
+        append_raw(out, colours[v][k]);
     }
-  } else {
-    for (size_t v = 0; v < colours.size(); ++v) values[v] = {colours[v].r, colours[v].g, colours[v].b, 1.0f};
   }
-  return encode_ply(mesh, values, !settings.srgb8);
+  for (const auto& element : mesh.elements) {
+    append_raw(out, uint8_t{3});
+    for (uint32_t v : element) append_raw(out, static_cast<int32_t>(v));
+  }
+  return out;
 }
 
 // --- OBJ + MTL ------------------------------------------------------------------------------
