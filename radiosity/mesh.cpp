@@ -15,8 +15,6 @@
 #include <utility>
 #include <vector>
 
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-
 #include "radiosity/mesh_detail.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
@@ -39,15 +37,11 @@ constexpr double kRemeshTargetScale = 1.12;
 /// Area of an equilateral triangle of unit edge, √3/4.
 constexpr double kUnitEquilateralArea = 0.43301270189221932338;
 
-/// OpenMesh holds the connectivity for vertex splitting; the geometry stays in double precision
-/// in the soup (OpenMesh's float points are only written, never read).
-using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
-
 DVec3 triangle_cross(const TriangleSoup& soup, const std::array<uint32_t, 3>& t) {
   return glm::cross(soup.points[t[1]] - soup.points[t[0]], soup.points[t[2]] - soup.points[t[0]]);
 }
 
-/// Union–find over the few faces around one vertex.
+/// Union–find over triangle corners.
 struct FanSets {
   std::vector<size_t> parent;
   size_t find(size_t i) {
@@ -122,79 +116,79 @@ TriangleSoup tessellate_sphere(const DVec3& center, double radius, int frequency
 }
 
 SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_degrees) {
-  SplitSurface out;
-  out.corners.resize(soup.triangles.size());
-  std::vector<DVec3> face_cross(soup.triangles.size());  // |cross| = twice the area
-  std::vector<DVec3> face_normal(soup.triangles.size());
-  for (size_t t = 0; t < soup.triangles.size(); ++t) {
+  const size_t nt = soup.triangles.size();
+  std::vector<DVec3> face_cross(nt);  // |cross| = twice the area
+  std::vector<DVec3> face_normal(nt);
+  for (size_t t = 0; t < nt; ++t) {
     face_cross[t] = triangle_cross(soup, soup.triangles[t]);
     face_normal[t] = glm::normalize(face_cross[t]);
   }
 
-  OmMesh mesh;
-  std::vector<OmMesh::VertexHandle> handles;
-  handles.reserve(soup.points.size());
-  for (const DVec3& p : soup.points)
-    handles.push_back(mesh.add_vertex(OmMesh::Point(float(p.x), float(p.y), float(p.z))));
-  std::vector<size_t> triangle_of_face;
-  triangle_of_face.reserve(soup.triangles.size());
-  std::vector<size_t> loose;  // triangles OpenMesh cannot attach without a non-manifold vertex
-  for (size_t t = 0; t < soup.triangles.size(); ++t) {
-    const auto& tri = soup.triangles[t];
-    const auto face = mesh.add_face(handles[tri[0]], handles[tri[1]], handles[tri[2]]);
-    if (face.is_valid())
-      triangle_of_face.push_back(t);
-    else
-      loose.push_back(t);
-  }
-
+  // Corner 3t + k is triangle t at its k-th vertex. Two triangles that share an edge smoothly,
+  // with opposite windings along it (a manifold, consistently oriented edge), put the two
+  // corners at each end of the edge in one set; every set becomes an output vertex. Edges of
+  // three or more triangles, or of two wound the same way, join nothing, so any input gives
+  // a surface whose every vertex has a single fan.
+  struct EdgeUse {
+    uint64_t key;      // the two vertex indices, smaller first
+    uint32_t corner;   // corner of the edge's first vertex (in winding order)
+    bool forward;      // winding runs from the smaller index to the larger
+  };
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * nt);
+  for (size_t t = 0; t < nt; ++t)
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t a = soup.triangles[t][k], b = soup.triangles[t][(k + 1) % 3];
+      uses.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b), uint32_t(3 * t + k), a < b});
+    }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.key != y.key ? x.key < y.key : x.corner < y.corner;
+  });
   const double cos_sharp = std::cos(sharp_angle_degrees * (3.14159265358979323846 / 180.0));
-  const auto triangle = [&](OmMesh::FaceHandle f) { return triangle_of_face[static_cast<size_t>(f.idx())]; };
-
-  std::vector<OmMesh::FaceHandle> fan;
   FanSets sets;
-  std::vector<size_t> output_of_set;
-  for (OmMesh::VertexHandle v : mesh.vertices()) {
-    fan.clear();
-    for (OmMesh::FaceHandle f : mesh.vf_range(v)) fan.push_back(f);
-    if (fan.empty()) continue;
-    sets.parent.resize(fan.size());
-    std::iota(sets.parent.begin(), sets.parent.end(), size_t{0});
-    const auto local = [&](OmMesh::FaceHandle f) {
-      return static_cast<size_t>(std::find(fan.begin(), fan.end(), f) - fan.begin());
-    };
-    // Faces across a smooth edge belong to one fan; border and sharp edges separate fans.
-    for (OmMesh::HalfedgeHandle h : mesh.voh_range(v)) {
-      if (mesh.is_boundary(mesh.edge_handle(h))) continue;
-      const OmMesh::FaceHandle f = mesh.face_handle(h), g = mesh.opposite_face_handle(h);
-      if (glm::dot(face_normal[triangle(f)], face_normal[triangle(g)]) >= cos_sharp)
-        sets.parent[sets.find(local(f))] = sets.find(local(g));
-    }
-    output_of_set.assign(fan.size(), SIZE_MAX);
-    const DVec3 position = soup.points[static_cast<size_t>(v.idx())];
-    for (size_t i = 0; i < fan.size(); ++i) {
-      const size_t root = sets.find(i);
-      if (output_of_set[root] == SIZE_MAX) {
-        output_of_set[root] = out.positions.size();
-        out.positions.push_back(position);
-        out.normals.emplace_back(0.0);
-      }
-      const size_t t = triangle(fan[i]);
-      out.normals[output_of_set[root]] += face_cross[t];  // area-weighted
-      const auto& tri = soup.triangles[t];
-      const size_t corner =
-          static_cast<size_t>(std::find(tri.begin(), tri.end(), uint32_t(v.idx())) - tri.begin());
-      out.corners[t][corner] = static_cast<uint32_t>(output_of_set[root]);
-    }
+  sets.parent.resize(3 * nt);
+  std::iota(sets.parent.begin(), sets.parent.end(), size_t{0});
+  const auto next_corner = [](uint32_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
+  for (size_t i = 0; i + 1 < uses.size(); ++i) {
+    const EdgeUse &x = uses[i], &y = uses[i + 1];
+    if (x.key != y.key || (i + 2 < uses.size() && uses[i + 2].key == x.key) || (i > 0 && uses[i - 1].key == x.key))
+      continue;  // a border, or an edge of three or more triangles
+    if (x.forward == y.forward) continue;  // wound the same way: the two sides disagree on the front
+    if (glm::dot(face_normal[x.corner / 3], face_normal[y.corner / 3]) < cos_sharp) continue;
+    // x runs a → b, y runs b → a: a's corners are x.corner and y's second, b's the converse.
+    sets.parent[sets.find(x.corner)] = sets.find(next_corner(y.corner));
+    sets.parent[sets.find(next_corner(x.corner))] = sets.find(y.corner);
   }
-  for (DVec3& n : out.normals) n = glm::normalize(n);
 
-  for (size_t t : loose) {
-    for (size_t k = 0; k < 3; ++k) {
-      out.corners[t][k] = static_cast<uint32_t>(out.positions.size());
-      out.positions.push_back(soup.points[soup.triangles[t][k]]);
-      out.normals.push_back(face_normal[t]);
-    }
+  // Output vertices in order of their input vertex, then of their first corner.
+  std::vector<std::pair<uint32_t, uint32_t>> roots;  // (input vertex, corner) of each set's root
+  roots.reserve(3 * nt);
+  for (uint32_t c = 0; c < 3 * nt; ++c)
+    if (sets.find(c) == c) roots.emplace_back(soup.triangles[c / 3][c % 3], c);
+  std::sort(roots.begin(), roots.end());
+  std::vector<uint32_t> output_of_root(3 * nt, UINT32_MAX);
+  SplitSurface out;
+  out.positions.reserve(roots.size());
+  out.normals.assign(roots.size(), DVec3(0.0));
+  for (const auto& [vertex, root] : roots) {
+    output_of_root[root] = static_cast<uint32_t>(out.positions.size());
+    out.positions.push_back(soup.points[vertex]);
+  }
+  out.corners.resize(nt);
+  for (uint32_t c = 0; c < 3 * nt; ++c) {
+    const uint32_t v = output_of_root[sets.find(c)];
+    out.corners[c / 3][c % 3] = v;
+    out.normals[v] += face_cross[c / 3];  // area-weighted
+  }
+  // A fan of faces that cancel (possible only where the input folds back on itself) takes the
+  // normal of one of its faces.
+  for (DVec3& n : out.normals) {
+    const double length = glm::length(n);
+    n = length > 0.0 ? n / length : DVec3(0.0);
+  }
+  for (uint32_t c = 0; c < 3 * nt; ++c) {
+    DVec3& n = out.normals[out.corners[c / 3][c % 3]];
+    if (n == DVec3(0.0)) n = face_normal[c / 3];
   }
   return out;
 }
@@ -268,6 +262,7 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.duplicated_vertices, "vertices duplicated to make the surface manifold");
   warn(c.self_intersecting, "pairs of faces intersect each other (meshed as they are)");
   warn(c.contacts_failed, "touching surfaces whose contact lines could not be imprinted");
+  warn(c.remesh_failed, "pieces could not be remeshed and keep their input triangles");
 }
 
 double meshed_area(const rc::Scene& scene) {

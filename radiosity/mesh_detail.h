@@ -33,6 +33,7 @@ struct RepairCounts {
   size_t self_intersecting = 0;    ///< pairs of faces that intersect away from a shared vertex or edge
   size_t contact_edges = 0;        ///< edges imprinted where another surface touches or crosses this one
   size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
+  size_t remesh_failed = 0;        ///< pieces CGAL could not remesh, kept as they were
 };
 
 /// Remeshing parameters for one surface.
@@ -82,8 +83,9 @@ struct SplitSurface {
 };
 
 /// Splits the soup's vertices where the dihedral angle between neighbouring triangles exceeds
-/// `sharp_angle_degrees` (with OpenMesh): each smooth fan of triangles around a vertex gets its
-/// own copy of the vertex, with the fan's area-weighted normal.
+/// `sharp_angle_degrees`, and where the surface is not manifold (an edge of three triangles, two
+/// triangles wound against each other, fans meeting at a point): each smooth fan of triangles
+/// around a vertex gets its own copy of the vertex, with the fan's area-weighted normal.
 SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_degrees);
 
 }  // namespace gilt::radiosity::detail

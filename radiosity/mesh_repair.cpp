@@ -259,12 +259,138 @@ size_t imprint_contacts(Part& part, const std::vector<const Part*>& tools, Const
   return after - before;
 }
 
+/// Whether the triangles (a, b, c) and (b, a, d), which share the edge a–b, lie in one plane up to
+/// the rounding of corefinement's constructed points: each far corner within 1e-9 of the longest
+/// edge of the other triangle's plane, and the two facing the same way.
+bool flat_pair(const Point& a, const Point& b, const Point& c, const Point& d) {
+  const Kernel::Vector_3 n1 = CGAL::cross_product(b - a, c - a), n2 = CGAL::cross_product(a - b, d - b);
+  if (!(n1 * n2 > 0.0)) return false;
+  const double volume = std::abs(CGAL::determinant(b - a, c - a, d - a));
+  const double longest = std::sqrt(std::max({CGAL::squared_distance(a, b), CGAL::squared_distance(a, c),
+                                             CGAL::squared_distance(a, d), CGAL::squared_distance(b, c),
+                                             CGAL::squared_distance(b, d)}));
+  const double tolerance = 1e-9 * longest;
+  return volume <= tolerance * std::sqrt(n1.squared_length()) && volume <= tolerance * std::sqrt(n2.squared_length());
+}
+
+/// The point in the coordinate plane that `normal` is most nearly perpendicular to, with the
+/// two kept coordinates ordered so that counter-clockwise about `normal` stays counter-clockwise.
+Kernel::Point_2 project(const Point& p, const Kernel::Vector_3& normal) {
+  const double ax = std::abs(normal.x()), ay = std::abs(normal.y()), az = std::abs(normal.z());
+  if (az >= ax && az >= ay) return normal.z() > 0 ? Kernel::Point_2(p.x(), p.y()) : Kernel::Point_2(p.y(), p.x());
+  if (ax >= ay) return normal.x() > 0 ? Kernel::Point_2(p.y(), p.z()) : Kernel::Point_2(p.z(), p.y());
+  return normal.y() > 0 ? Kernel::Point_2(p.z(), p.x()) : Kernel::Point_2(p.x(), p.z());
+}
+
+/// Corefinement reports intersecting face pairs in an order that depends on memory addresses
+/// (CGAL 5.5's Box_intersection_d with ID_FROM_BOX_ADDRESS), so although the points it adds and
+/// the contact lines are the same in every run, the triangles it cuts a face into and the order
+/// of its new vertices are not, and the remesher follows both. This rebuilds the piece in a form
+/// that depends on its points and constrained edges alone: vertices in lexicographic order,
+/// faces in order of their corners, and every flat region triangulated as its constrained
+/// Delaunay triangulation (Lawson flips with exact 2D predicates in the region's projection;
+/// a diagonal of four cocircular points avoids the lowest-ranked of them, which is a symbolic
+/// perturbation and so picks one triangulation).
+void canonicalize(SurfaceMesh& mesh, Constrained& constrained) {
+  using vertex_descriptor = SurfaceMesh::Vertex_index;
+  std::vector<vertex_descriptor> order(mesh.vertices().begin(), mesh.vertices().end());
+  std::stable_sort(order.begin(), order.end(), [&](vertex_descriptor u, vertex_descriptor v) {
+    return CGAL::compare_xyz(mesh.point(u), mesh.point(v)) == CGAL::SMALLER;
+  });
+  std::vector<std::size_t> rank(mesh.number_of_vertices() + mesh.number_of_removed_vertices());
+  std::vector<Point> points;
+  points.reserve(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    rank[order[i].idx()] = i;
+    points.push_back(mesh.point(order[i]));
+  }
+  std::vector<Polygon> polygons;
+  polygons.reserve(mesh.number_of_faces());
+  for (face_descriptor f : mesh.faces()) {
+    Polygon polygon;
+    for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) polygon.push_back(rank[v.idx()]);
+    std::rotate(polygon.begin(), std::min_element(polygon.begin(), polygon.end()), polygon.end());
+    polygons.push_back(std::move(polygon));
+  }
+  std::sort(polygons.begin(), polygons.end());
+  std::vector<std::pair<std::size_t, std::size_t>> kept;  // constrained edges by rank, low first
+  for (edge_descriptor e : mesh.edges())
+    if (constrained[e]) {
+      const std::size_t a = rank[mesh.source(mesh.halfedge(e)).idx()], b = rank[mesh.target(mesh.halfedge(e)).idx()];
+      kept.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(kept.begin(), kept.end());
+
+  SurfaceMesh out;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, out);
+  Constrained marks = out.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
+  for (const auto& [a, b] : kept) {
+    const auto [h, found] = CGAL::halfedge(vertex_descriptor(static_cast<SurfaceMesh::size_type>(a)),
+                                           vertex_descriptor(static_cast<SurfaceMesh::size_type>(b)), out);
+    if (found) marks[out.edge(h)] = true;
+  }
+
+  // Lawson flips, in edge order, until none applies. Each flip removes a locally non-Delaunay
+  // edge, so the loop ends; the pass limit only guards against an unforeseen cycle.
+  for (int pass = 0; pass < 64; ++pass) {
+    bool flipped = false;
+    for (edge_descriptor e : out.edges()) {
+      if (marks[e] || out.is_border(e)) continue;
+      const auto h = out.halfedge(e), o = out.opposite(h);
+      const vertex_descriptor a = out.source(h), b = out.target(h), c = out.target(out.next(h)),
+                              d = out.target(out.next(o));
+      if (c == d || CGAL::halfedge(c, d, out).second) continue;
+      const Point &pa = out.point(a), &pb = out.point(b), &pc = out.point(c), &pd = out.point(d);
+      if (!flat_pair(pa, pb, pc, pd)) continue;
+      const Kernel::Vector_3 normal = CGAL::cross_product(pb - pa, pc - pa) + CGAL::cross_product(pa - pb, pd - pb);
+      const Kernel::Point_2 qa = project(pa, normal), qb = project(pb, normal), qc = project(pc, normal),
+                            qd = project(pd, normal);
+      // The flipped triangles (c, a, d) and (d, b, c) must both be proper.
+      if (CGAL::orientation(qc, qa, qd) != CGAL::LEFT_TURN || CGAL::orientation(qd, qb, qc) != CGAL::LEFT_TURN)
+        continue;
+      bool flip = false;
+      if (CGAL::orientation(qa, qb, qc) != CGAL::LEFT_TURN || CGAL::orientation(qb, qa, qd) != CGAL::LEFT_TURN) {
+        flip = true;  // a flat or folded triangle: the flip makes both proper
+      } else {
+        const CGAL::Oriented_side side = CGAL::side_of_oriented_circle(qa, qb, qc, qd);
+        if (side == CGAL::ON_POSITIVE_SIDE) {
+          flip = true;
+        } else if (side == CGAL::ON_ORIENTED_BOUNDARY) {
+          const auto lowest = std::min({a.idx(), b.idx(), c.idx(), d.idx()});
+          flip = lowest == a.idx() || lowest == b.idx();
+        }
+      }
+      if (!flip) continue;
+      CGAL::Euler::flip_edge(h, out);
+      flipped = true;
+    }
+    if (!flipped) break;
+  }
+  mesh = std::move(out);
+  constrained = mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
+}
+
+/// Cuts out the faces whose corners are collinear, which CGAL 5.5's remesher cannot take (a
+/// patch made of them alone makes it throw std::out_of_range from check_normals, or index past
+/// its per-patch trees). They have no area, so nothing visible goes. Returns how many there were.
+size_t remove_flat_faces(SurfaceMesh& mesh) {
+  std::vector<face_descriptor> degenerate;
+  PMP::degenerate_faces(mesh, std::back_inserter(degenerate));
+  for (face_descriptor f : degenerate) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+  if (!degenerate.empty()) mesh.collect_garbage();
+  return degenerate.size();
+}
+
 /// Isotropic remeshing to `params.edge_length` with border, sharp and contact edges kept in
 /// place: they are cut to at most the target length first, then protected, so the remesher
 /// neither moves nor collapses them. Three tangential relaxation steps per pass instead of
 /// CGAL's one: on the Cornell box they raise the 5th percentile of the elements' smallest angle
 /// from 33.7° to 37.3° for no measurable time.
-void remesh_part(SurfaceMesh& mesh, const RemeshParams& params, Constrained& constrained) {
+/// Faces with collinear corners are cut out first. If CGAL gives up on a piece, the piece keeps
+/// its triangles as imprinted (protected edges cut to the target length), and
+/// `counts.remesh_failed` says so.
+void remesh_part(SurfaceMesh& mesh, const RemeshParams& params, Constrained& constrained, RepairCounts& counts) {
+  counts.removed_degenerate += remove_flat_faces(mesh);
   PMP::detect_sharp_edges(mesh, params.sharp_angle_degrees, constrained);
   std::vector<edge_descriptor> protected_edges;
   for (edge_descriptor e : mesh.edges()) {
@@ -272,11 +398,17 @@ void remesh_part(SurfaceMesh& mesh, const RemeshParams& params, Constrained& con
     if (constrained[e]) protected_edges.push_back(e);
   }
   split_protected_edges(mesh, protected_edges, params.edge_length, constrained);
-  PMP::isotropic_remeshing(faces(mesh), params.edge_length, mesh,
-                           CGAL::parameters::number_of_iterations(static_cast<unsigned>(params.iterations))
-                               .edge_is_constrained_map(constrained)
-                               .protect_constraints(true)
-                               .number_of_relaxation_steps(3));
+  SurfaceMesh before = mesh;
+  try {
+    PMP::isotropic_remeshing(faces(mesh), params.edge_length, mesh,
+                             CGAL::parameters::number_of_iterations(static_cast<unsigned>(params.iterations))
+                                 .edge_is_constrained_map(constrained)
+                                 .protect_constraints(true)
+                                 .number_of_relaxation_steps(3));
+  } catch (const std::exception&) {
+    mesh = std::move(before);
+    ++counts.remesh_failed;
+  }
   mesh.collect_garbage();
 }
 
@@ -336,8 +468,10 @@ TriangleSoup RepairedMeshes::remesh(size_t m, std::span<const size_t> touching, 
         if (j != i) tools.push_back(&own[j]);
     tools.insert(tools.end(), others.begin(), others.end());
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
-    c.contact_edges += imprint_contacts(part, tools, constrained, c);
-    remesh_part(part.mesh, params, constrained);
+    const size_t imprinted = imprint_contacts(part, tools, constrained, c);
+    c.contact_edges += imprinted;
+    if (imprinted > 0) canonicalize(part.mesh, constrained);
+    remesh_part(part.mesh, params, constrained, c);
     const TriangleSoup piece = to_soup(part.mesh);
     const auto offset = static_cast<uint32_t>(soup.points.size());
     soup.points.insert(soup.points.end(), piece.points.begin(), piece.points.end());
