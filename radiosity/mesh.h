@@ -46,7 +46,9 @@ struct MeshReport {
   float max_edge = 0.0f;
   size_t merged_vertices = 0, removed_degenerate = 0, reoriented = 0, self_intersecting = 0;
   size_t contact_edges = 0;    ///< input edges imprinted where surfaces touch (before remeshing)
-  size_t buried_elements = 0;  ///< elements removed because they lie inside or under other surfaces
+  size_t buried_faces = 0;     ///< imprinted input faces removed: they lie inside or under other surfaces
+  double buried_area = 0.0;    ///< their area, scene units²
+  double meshed_area = 0.0;    ///< area of the input surfaces that are meshed, scene units²
   std::vector<std::string> warnings;
 };
 
@@ -56,8 +58,8 @@ struct MeshReport {
 /// reported). Where another surface touches or crosses one (a block standing on the floor),
 /// the contact line is imprinted; the surface is then remeshed isotropically with boundaries,
 /// sharp edges and contact lines protected. Spheres are tessellated to the same edge length.
-/// Elements buried inside or under other surfaces (the floor under a block) are removed; that
-/// test casts rays, so it runs only when the scene is committed.
+/// The parts of the input buried inside or under other surfaces (the floor under a block) are
+/// removed before remeshing; that test casts rays, so it runs only when the scene is committed.
 RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report = nullptr);
 
 /// Splits the longest edge of each listed element at its midpoint (at most once per element per

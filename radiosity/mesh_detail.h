@@ -45,8 +45,8 @@ struct RemeshParams {
 
 /// The scene's input meshes, each mended once with CGAL Polygon Mesh Processing (merge duplicate
 /// points and faces, drop degenerate faces, orient consistently while keeping the input's front
-/// where the input agreed) and split into connected pieces. They are read by remesh() for the
-/// mesh itself and as tools by every mesh they touch. The CGAL types stay in mesh_repair.cpp.
+/// where the input agreed) and split into connected pieces; then each is imprinted by the meshes
+/// it touches, which it reads as tools, and remeshed. The CGAL types stay in mesh_repair.cpp.
 class RepairedMeshes {
  public:
   explicit RepairedMeshes(size_t mesh_count);
@@ -57,13 +57,17 @@ class RepairedMeshes {
   /// Mends mesh m; calls for different m may run in parallel.
   void repair(size_t m, const rc::TriangleMesh& mesh);
 
-  /// Mesh m remeshed: the lines where the `touching` meshes (repaired too) and its own pieces
-  /// meet it are imprinted, and it is remeshed isotropically to `params.edge_length` with its
-  /// border, sharp and contact edges protected. Returns the remeshed surface (empty when nothing
-  /// is left) and fills `counts` with the repairs and what imprinting found. Reads only: calls
-  /// may run in parallel.
-  TriangleSoup remesh(size_t m, std::span<const size_t> touching, const RemeshParams& params,
-                      RepairCounts* counts) const;
+  /// Imprints on mesh m the lines where the `touching` meshes (repaired too) and its own pieces
+  /// meet it, and keeps the result for remesh(). Returns the imprinted surface, which lies on the
+  /// input's, and fills `counts` with the repairs and what imprinting found. Reads the other
+  /// meshes only: calls for different m may run in parallel.
+  TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts);
+
+  /// Mesh m as imprinted, without the triangles of the imprinted surface that `remove` marks,
+  /// remeshed isotropically to `params.edge_length` with its border, sharp and contact edges
+  /// protected. Returns the remeshed surface (empty when nothing is left) and adds to `counts`
+  /// what remeshing mended. Calls for different m may run in parallel.
+  TriangleSoup remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params, RepairCounts* counts);
 
  private:
   struct Impl;

@@ -429,16 +429,25 @@ TriangleSoup to_soup(const SurfaceMesh& mesh) {
   return soup;
 }
 
+/// Appends `piece` to `soup`, renumbering its vertices.
+void append_soup(TriangleSoup& soup, const TriangleSoup& piece) {
+  const auto offset = static_cast<uint32_t>(soup.points.size());
+  soup.points.insert(soup.points.end(), piece.points.begin(), piece.points.end());
+  for (const auto& t : piece.triangles) soup.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+}
+
 }  // namespace
 
 struct RepairedMeshes::Impl {
   std::vector<RepairCounts> counts;       ///< per mesh, what repair() did
   std::vector<std::vector<Part>> parts;   ///< per mesh, its connected pieces (empty until repaired)
+  std::vector<std::vector<Part>> imprinted;  ///< per mesh, its pieces imprinted, until remeshed
 };
 
 RepairedMeshes::RepairedMeshes(size_t mesh_count) : impl_(std::make_unique<Impl>()) {
   impl_->counts.resize(mesh_count);
   impl_->parts.resize(mesh_count);
+  impl_->imprinted.resize(mesh_count);
 }
 
 RepairedMeshes::~RepairedMeshes() = default;
@@ -448,8 +457,7 @@ void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh) {
   if (repaired.number_of_faces() > 0) impl_->parts[m] = split_parts(repaired);
 }
 
-TriangleSoup RepairedMeshes::remesh(size_t m, std::span<const size_t> touching, const RemeshParams& params,
-                                    RepairCounts* counts) const {
+TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts) {
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
   c = impl_->counts[m];
@@ -458,9 +466,11 @@ TriangleSoup RepairedMeshes::remesh(size_t m, std::span<const size_t> touching, 
   std::vector<const Part*> others;
   for (size_t t : touching)
     for (const Part& part : impl_->parts[t]) others.push_back(&part);
+  std::vector<Part>& imprinted = impl_->imprinted[m];
+  imprinted.clear();
   TriangleSoup soup;
   for (size_t i = 0; i < own.size(); ++i) {
-    Part part = own[i];  // the shared copy stays as it is, a tool for the others
+    Part& part = imprinted.emplace_back(own[i]);  // the shared copy stays as it is, a tool for the others
     c.self_intersecting += part.self_intersecting;
     std::vector<const Part*> tools;
     if (own.size() <= kMaxImprintedParts)
@@ -468,14 +478,35 @@ TriangleSoup RepairedMeshes::remesh(size_t m, std::span<const size_t> touching, 
         if (j != i) tools.push_back(&own[j]);
     tools.insert(tools.end(), others.begin(), others.end());
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
-    const size_t imprinted = imprint_contacts(part, tools, constrained, c);
-    c.contact_edges += imprinted;
-    if (imprinted > 0) canonicalize(part.mesh, constrained);
-    remesh_part(part.mesh, params, constrained, c);
-    const TriangleSoup piece = to_soup(part.mesh);
-    const auto offset = static_cast<uint32_t>(soup.points.size());
-    soup.points.insert(soup.points.end(), piece.points.begin(), piece.points.end());
-    for (const auto& t : piece.triangles) soup.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    const size_t added = imprint_contacts(part, tools, constrained, c);
+    c.contact_edges += added;
+    if (added > 0) canonicalize(part.mesh, constrained);
+    if (part.mesh.has_garbage()) part.mesh.collect_garbage();  // face f is soup triangle f
+    append_soup(soup, to_soup(part.mesh));
+  }
+  return soup;
+}
+
+TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params,
+                                    RepairCounts* counts) {
+  RepairCounts local;
+  RepairCounts& c = counts ? *counts : local;
+  std::vector<Part> imprinted = std::move(impl_->imprinted[m]);
+  TriangleSoup soup;
+  size_t first = 0;  // index in `remove` of the piece's first face
+  for (Part& part : imprinted) {
+    SurfaceMesh& mesh = part.mesh;
+    const size_t faces = mesh.number_of_faces();
+    std::vector<face_descriptor> removed;
+    for (face_descriptor f : mesh.faces())
+      if (first + f.idx() < remove.size() && remove[first + f.idx()]) removed.push_back(f);
+    first += faces;
+    for (face_descriptor f : removed) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+    if (!removed.empty()) mesh.collect_garbage();
+    if (mesh.number_of_faces() == 0) continue;
+    Constrained constrained = mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
+    remesh_part(mesh, params, constrained, c);
+    append_soup(soup, to_soup(mesh));
   }
   return soup;
 }

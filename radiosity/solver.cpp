@@ -396,7 +396,9 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.vertices = mesh.vertex_count();
   plan.max_edge = report.max_edge;
   plan.contact_edges = report.contact_edges;
-  plan.buried_elements = report.buried_elements;
+  plan.buried_faces = report.buried_faces;
+  plan.buried_area = report.buried_area;
+  plan.meshed_area = report.meshed_area;
   plan.occluder_boxes = occluder_boxes(scene, mesh).size();
   plan.convex_enclosure = plan.occluder_boxes == 0;
   plan.punctual_lights = scene.punctual_lights.size();

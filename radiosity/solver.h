@@ -67,7 +67,9 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings);
 struct SolvePlan {
   size_t elements = 0, vertices = 0;  ///< before adaptive subdivision
   size_t contact_edges = 0;           ///< see MeshReport
-  size_t buried_elements = 0;         ///< removed from the mesh (see MeshReport)
+  size_t buried_faces = 0;            ///< input faces removed before remeshing (see MeshReport)
+  double buried_area = 0.0;           ///< their area, scene units²
+  double meshed_area = 0.0;           ///< area of the meshed input surfaces, scene units²
   float max_edge = 0.0f;
   bool convex_enclosure = false;      ///< nothing can occlude: no visibility rays at all
   size_t occluder_boxes = 0;          ///< boxes that shadow rays are tested against first

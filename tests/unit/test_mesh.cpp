@@ -250,7 +250,7 @@ TEST(Mesh, CornellBoxAtTheDefault) {
   double footprints = 0.0;
   for (const TriangleMesh& m : scene.meshes)
     if (m.name.find("block") != std::string::npos) footprints += top_face_area(m);
-  EXPECT_GT(report.buried_elements, 0u);
+  EXPECT_GT(report.buried_faces, 0u);
   EXPECT_GT(report.contact_edges, 0u);
   double total_in = 0.0, total_out = 0.0;
   for (size_t s = 0; s < scene.meshes.size(); ++s) {
@@ -557,9 +557,9 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   MeshReport report;
   const RadiosityMesh mesh = build_mesh(scene, MeshSettings{.max_edge = 0.2f}, &report);
   note("contact", fmt("%.0f contact edges imprinted, %.0f buried elements removed", double(report.contact_edges),
-                      double(report.buried_elements)));
+                      double(report.buried_faces)));
   EXPECT_GT(report.contact_edges, 0u);
-  EXPECT_GT(report.buried_elements, 0u);
+  EXPECT_GT(report.buried_faces, 0u);
 
   // The floor loses exactly the two footprints (the floating box leaves it whole); float
   // coordinates of size ~1 round at ~1e-7, so 1e-5 relative is far above rounding and far
@@ -616,7 +616,7 @@ TEST(Mesh, InsideOutRoomsKeepTheirContents) {
                                     [](const std::string& w) { return w.find("buried") != std::string::npos; });
     EXPECT_EQ(warned, !camera_inside);
     if (!camera_inside) {
-      EXPECT_EQ(report.buried_elements, 0u);
+      EXPECT_EQ(report.buried_faces, 0u);
     }
   }
 }
