@@ -33,25 +33,6 @@ using rc::DVec3;
 
 constexpr float kPi = rc::kPi;
 
-/// Where a vertex receives: nudged a thousandth of the way towards the centroid of one of its
-/// elements. A vertex in a corner lies in the planes of the walls beside it, sees them edge-on
-/// and would miss their light (its form factors to a closed box sum to 1/4, not 1); just inside
-/// its element it sees them as the surface around it does, and its shadow rays do not start on
-/// the other wall.
-std::vector<Vec3> visibility_origins(const RadiosityMesh& mesh) {
-  std::vector<Vec3> origin(mesh.positions);
-  std::vector<bool> done(mesh.vertex_count(), false);
-  for (const auto& e : mesh.elements) {
-    const Vec3 centroid = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f;
-    for (uint32_t v : e) {
-      if (done[v]) continue;
-      origin[v] = mesh.positions[v] + 1e-3f * (centroid - mesh.positions[v]);
-      done[v] = true;
-    }
-  }
-  return origin;
-}
-
 /// A surface point for spawning rays at p on a surface with normal n; the error bound allows for
 /// rounding in meshing (γ(16)·|p|).
 rc::SurfacePoint surface_point(const Vec3& p, const Vec3& n) {
@@ -61,6 +42,69 @@ rc::SurfacePoint surface_point(const Vec3& p, const Vec3& n) {
   sp.ng = n;
   return sp;
 }
+
+/// How many of five short probes (along the normal and four directions 60° from it, each
+/// `reach` long) from a candidate receiver hit the back of a surface: a receiver that sees a
+/// back so close is inside the input, not on it.
+int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach) {
+  const rc::SurfacePoint at = surface_point(p, n);
+  const rc::Frame frame = rc::Frame::from_normal(n);
+  static const std::array<Vec3, 5> dirs = {Vec3(0.0f, 0.0f, 1.0f), Vec3(0.8660254f, 0.0f, 0.5f),
+                                           Vec3(-0.8660254f, 0.0f, 0.5f), Vec3(0.0f, 0.8660254f, 0.5f),
+                                           Vec3(0.0f, -0.8660254f, 0.5f)};
+  int backs = 0;
+  for (const Vec3& d : dirs) {
+    rc::Ray ray = rc::spawn_ray(at, frame.to_world(d));
+    ray.tmax = reach;
+    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    backs += hit && !scene.surface(ray, *hit).front_face;
+  }
+  return backs;
+}
+
+/// Where a vertex receives: a thousandth of the way towards the centroid of one of its elements.
+/// A vertex in a corner lies in the planes of the walls beside it, sees them edge-on and would
+/// miss their light (its form factors to a closed box sum to 1/4, not 1); just inside its
+/// element it sees them as the surface around it does, and its shadow rays do not start on the
+/// other wall. The vertex lies on the input surface, but its elements are chords of it: where
+/// the input is curved (a rounded edge, a scanned body) their centroids lie inside it, and a
+/// receiver moved towards one can see the input's back and go black (a band along the milk
+/// truck's rounded roof edge did). So each element of the vertex is tried in turn, the move
+/// first kept in the tangent plane and lifted along the normal by as much, then straight; the
+/// first candidate whose short probes (backs_seen, a hundredth of the element's size) meet no
+/// back is taken, or else the one that meets fewest.
+std::vector<Vec3> visibility_origins(const rc::Scene& scene, const RadiosityMesh& mesh) {
+  const size_t nv = mesh.vertex_count();
+  std::vector<uint32_t> offsets(nv + 1, 0), fan(3 * mesh.element_count());
+  for (const auto& e : mesh.elements)
+    for (uint32_t v : e) ++offsets[v + 1];
+  for (size_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
+  {
+    std::vector<uint32_t> next(offsets.begin(), offsets.end() - 1);
+    for (uint32_t e = 0; e < mesh.element_count(); ++e)
+      for (uint32_t v : mesh.elements[e]) fan[next[v]++] = e;
+  }
+  std::vector<Vec3> origin(mesh.positions);
+  rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+    for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
+      const Vec3 p = mesh.positions[v], n = mesh.normals[v];
+      int fewest = std::numeric_limits<int>::max();
+      for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
+        const auto& e = mesh.elements[fan[i]];
+        const Vec3 towards = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f - p;
+        const float reach = 0.03f * glm::length(towards);
+        const Vec3 lifted = p + 1e-3f * (towards - glm::dot(towards, n) * n + glm::length(towards) * n);
+        for (const Vec3& candidate : {lifted, p + 1e-3f * towards}) {
+          const int backs = backs_seen(scene, candidate, n, reach);
+          if (backs < fewest) fewest = backs, origin[v] = candidate;
+          if (fewest == 0) break;
+        }
+      }
+    }
+  });
+  return origin;
+}
+
 
 /// Potential occluders: boxes around every part of the scene that could block a segment between
 /// two mesh points. A segment between two points of a convex region never crosses the region's
@@ -300,7 +344,7 @@ struct Receivers {
     update();
   }
   void update() {
-    origin = visibility_origins(mesh);
+    origin = visibility_origins(scene, mesh);
     point.resize(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) point[v] = surface_point(origin[v], mesh.normals[v]);
   }
