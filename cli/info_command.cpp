@@ -74,9 +74,10 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
                      " vertices (edge " + short_number(rp.max_edge) + "), adaptive subdivision at steep direct light");
   if (rp.contact_edges > 0)
     rad.runs.push_back("contact lines imprinted where surfaces touch (" + std::to_string(rp.contact_edges) + " edges)");
-  if (rp.buried_faces > 0)
+  if (rp.buried_faces > 0 || rp.buried_elements > 0)
     rad.skipped.push_back(short_number(100.0 * rp.buried_area / std::max(rp.meshed_area, 1e-300)) + " % of the surface area (" +
-                          std::to_string(rp.buried_faces) + " input faces) buried under or inside other surfaces");
+                          std::to_string(rp.buried_faces) + " input faces, " + std::to_string(rp.buried_elements) +
+                          " elements) buried under or inside other surfaces");
   if (rp.convex_enclosure) rad.skipped.push_back("visibility rays: convex enclosure, nothing can occlude");
   else rad.runs.push_back("visibility rays only where " + std::to_string(rp.occluder_boxes) + " occluder box(es) may block");
   if (rp.punctual_lights > 0)

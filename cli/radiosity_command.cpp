@@ -58,6 +58,7 @@ void run_radiosity(RadiosityOptions& o) {
                         {"refined_elements", sol.refined_elements},
                         {"contact_edges", sol.mesh_report.contact_edges},
                         {"buried_faces", sol.mesh_report.buried_faces},
+                        {"buried_elements", sol.mesh_report.buried_elements},
                         {"buried_area", sol.mesh_report.buried_area},
                         {"meshed_area", sol.mesh_report.meshed_area},
                         {"patches", sol.patches},
@@ -79,12 +80,12 @@ void run_radiosity(RadiosityOptions& o) {
   std::printf("gilt radiosity: %s, %d thread(s)\n", o.scene.c_str(), threads);
   std::printf("  mesh:    %zu elements, %zu vertices, target edge %.4g, %zu elements bisected at steep direct light\n",
               sol.mesh.element_count(), sol.mesh.vertex_count(), sol.mesh_report.max_edge, sol.refined_elements);
-  if (sol.mesh_report.contact_edges > 0 || sol.mesh_report.buried_faces > 0)
+  if (sol.mesh_report.contact_edges > 0 || sol.mesh_report.buried_area > 0.0)
     std::printf("  contact: %zu edges imprinted where surfaces touch; %.3g %% of the area buried under or inside "
-                "other surfaces, removed (%zu input faces)\n",
+                "other surfaces, removed (%zu input faces, %zu elements)\n",
                 sol.mesh_report.contact_edges,
                 100.0 * sol.mesh_report.buried_area / std::max(sol.mesh_report.meshed_area, 1e-300),
-                sol.mesh_report.buried_faces);
+                sol.mesh_report.buried_faces, sol.mesh_report.buried_elements);
   std::printf("  solve:   %llu shots, residual %.3g (tolerance %.3g)\n", static_cast<unsigned long long>(sol.shots),
               sol.residual, o.solver.tolerance);
   std::printf("  work:    %llu form factors (%.3g/s), %llu shadow rays%s\n",

@@ -343,41 +343,85 @@ bool enclosed(const rc::Scene& scene, const rc::SurfacePoint& at) {
   return !(glm::dot(camera - at.p, at.ng) > 0.0f && !scene.occluded(rc::spawn_shadow_ray(at, camera)));
 }
 
-/// Marks the triangles of an imprinted input surface that are buried: they lie inside a closed
-/// solid or under an object standing on them (with the contact lines imprinted, a triangle lies
-/// wholly on one side of them), so they can neither receive nor send light. A triangle is buried
-/// when its centroid and three points near its corners (barycentric 2/3, 1/6, 1/6) are all
-/// enclosed. The test runs on the input's own surface, not on remeshed elements, which are
-/// chords of a curved input and lie up to their sagitta inside it: from there a convex scan sees
-/// its own input from behind in every direction (the Stanford bunny lost 84 % of its area that
-/// way). A surface inside-out with respect to its neighbours is never buried (its rays leave
-/// the scene), nor is one enclosed by glass or in view of the camera. A face lying flat on
-/// another and facing it (a closed box's base on the floor) is not found and is kept: it
-/// receives nothing and costs only its own elements. Returns the buried area.
+/// Whether the triangle (a, b, d) is buried: its centroid and three points near its corners
+/// (barycentric 2/3, 1/6, 1/6) are all enclosed, seen from its front.
+bool triangle_buried(const rc::Scene& scene, const DVec3& a, const DVec3& b, const DVec3& d) {
+  const DVec3 cross = glm::cross(b - a, d - a);
+  if (!(glm::dot(cross, cross) > 0.0)) return false;
+  for (const DVec3& p : {(a + b + d) / 3.0, (4.0 * a + b + d) / 6.0, (a + 4.0 * b + d) / 6.0, (a + b + 4.0 * d) / 6.0}) {
+    rc::SurfacePoint at;
+    at.p = Vec3(p);
+    at.p_error = rc::error_gamma(16) * rc::abs(at.p);
+    at.ng = Vec3(glm::normalize(cross));
+    if (!enclosed(scene, at)) return false;
+  }
+  return true;
+}
+
+double triangle_area(const DVec3& a, const DVec3& b, const DVec3& d) { return 0.5 * glm::length(glm::cross(b - a, d - a)); }
+
+/// Marks the triangles of an imprinted input surface that are buried (triangle_buried): they lie
+/// inside a closed solid or under an object standing on them (with the contact lines imprinted,
+/// a triangle lies wholly on one side of them), so they can neither receive nor send light. The
+/// test runs on the input's own surface, not on remeshed elements, which are chords of a curved
+/// input and lie up to their sagitta inside it: from there a convex scan sees its own input
+/// from behind in every direction (the Stanford bunny lost 84 % of its area that way). A
+/// surface inside-out with respect to its neighbours is never buried (its rays leave the
+/// scene), nor is one enclosed by glass or in view of the camera. A face lying flat on another
+/// and facing it (a closed box's base on the floor) is not found and is kept: it receives
+/// nothing and costs only its own elements. Returns the buried area.
 double mark_buried(const rc::Scene& scene, const TriangleSoup& surface, std::vector<char>& buried) {
   buried.assign(surface.triangles.size(), 0);
   double area = 0.0;
   for (size_t t = 0; t < surface.triangles.size(); ++t) {
     const auto& c = surface.triangles[t];
-    const DVec3 a = surface.points[c[0]], b = surface.points[c[1]], d = surface.points[c[2]];
-    const DVec3 cross = glm::cross(b - a, d - a);
-    if (!(glm::dot(cross, cross) > 0.0)) continue;
-    const std::array<DVec3, 4> points = {(a + b + d) / 3.0, (4.0 * a + b + d) / 6.0, (a + 4.0 * b + d) / 6.0,
-                                         (a + b + 4.0 * d) / 6.0};
-    bool all = true;
-    for (const DVec3& p : points) {
-      rc::SurfacePoint at;
-      at.p = Vec3(p);
-      at.p_error = rc::error_gamma(16) * rc::abs(at.p);
-      at.ng = Vec3(glm::normalize(cross));
-      if (!enclosed(scene, at)) {
-        all = false;
-        break;
-      }
-    }
-    if (all) buried[t] = 1, area += 0.5 * glm::length(cross);
+    const DVec3 &a = surface.points[c[0]], &b = surface.points[c[1]], &d = surface.points[c[2]];
+    if (triangle_buried(scene, a, b, d)) buried[t] = 1, area += triangle_area(a, b, d);
   }
   return area;
+}
+
+/// The same test on the flat elements of a remeshed surface (all three vertex normals within
+/// 0.26° of the element's), where an element is the input surface itself and not a chord of
+/// it. It finds what imprinting left whole: a floor under an object that stands a rounding
+/// error above it, or one that intersects itself and so imprints nothing. Returns the area.
+double mark_buried_flat(const rc::Scene& scene, const SplitSurface& surface, std::vector<char>& buried) {
+  buried.assign(surface.corners.size(), 0);
+  double area = 0.0;
+  for (size_t t = 0; t < surface.corners.size(); ++t) {
+    const auto& c = surface.corners[t];
+    const DVec3 &a = surface.positions[c[0]], &b = surface.positions[c[1]], &d = surface.positions[c[2]];
+    const DVec3 n = glm::normalize(glm::cross(b - a, d - a));
+    if (!(glm::dot(n, surface.normals[c[0]]) > 0.99999 && glm::dot(n, surface.normals[c[1]]) > 0.99999 &&
+          glm::dot(n, surface.normals[c[2]]) > 0.99999))
+      continue;
+    if (triangle_buried(scene, a, b, d)) buried[t] = 1, area += triangle_area(a, b, d);
+  }
+  return area;
+}
+
+/// Removes the marked triangles and the vertices only they used. Returns the number removed.
+size_t remove_triangles(SplitSurface& surface, const std::vector<char>& remove) {
+  const size_t removed = static_cast<size_t>(std::count(remove.begin(), remove.end(), char{1}));
+  if (removed == 0) return 0;
+  SplitSurface kept;
+  std::vector<uint32_t> renumber(surface.positions.size(), UINT32_MAX);
+  for (size_t t = 0; t < surface.corners.size(); ++t) {
+    if (remove[t]) continue;
+    std::array<uint32_t, 3> corners{};
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& v = renumber[surface.corners[t][k]];
+      if (v == UINT32_MAX) {
+        v = static_cast<uint32_t>(kept.positions.size());
+        kept.positions.push_back(surface.positions[surface.corners[t][k]]);
+        kept.normals.push_back(surface.normals[surface.corners[t][k]]);
+      }
+      corners[k] = v;
+    }
+    kept.corners.push_back(corners);
+  }
+  surface = std::move(kept);
+  return removed;
 }
 
 }  // namespace
@@ -447,23 +491,31 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     const TriangleSoup imprinted = repaired.imprint(m, touching[m], &counts[m]);
     if (scene.committed()) buried_area[m] = mark_buried(scene, imprinted, buried[m]);
   });
-  const double total_buried = std::accumulate(buried_area.begin(), buried_area.end(), 0.0);
-  if (total_buried > kMaxBuriedShare * area) {
-    rep.warnings.push_back(std::to_string(static_cast<int>(std::lround(100.0 * total_buried / area))) +
+  const auto too_much = [&](double buried_total) {
+    if (buried_total <= kMaxBuriedShare * area) return false;
+    rep.warnings.push_back(std::to_string(static_cast<int>(std::lround(100.0 * buried_total / area))) +
                            " % of the surface area looks buried inside other surfaces; nothing was removed "
                            "(do some surfaces face the wrong way?)");
+    return true;
+  };
+  double total_buried = std::accumulate(buried_area.begin(), buried_area.end(), 0.0);
+  if (too_much(total_buried)) {
     for (auto& flags : buried) flags.clear();
+    total_buried = 0.0;
   } else {
-    rep.buried_area = total_buried;
     for (const auto& flags : buried)
       rep.buried_faces += static_cast<size_t>(std::count(flags.begin(), flags.end(), char{1}));
   }
+  std::vector<std::vector<char>> buried_elements(mesh_count);
+  std::vector<double> buried_element_area(mesh_count, 0.0);
   rc::parallel_for(surface_count, [&](size_t s) {
     if (s < mesh_count) {
       if (!meshed[s]) return;
       TriangleSoup soup = repaired.remesh(s, buried[s], params, &counts[s]);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
+      if (scene.committed() && total_buried <= kMaxBuriedShare * area)
+        buried_element_area[s] = mark_buried_flat(scene, surfaces[s], buried_elements[s]);
     } else {
       const rc::Sphere& sphere = scene.spheres[s - mesh_count];
       if (!is_meshed(scene.materials[sphere.material])) return;
@@ -478,6 +530,13 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     }
   });
 
+  const double element_buried = std::accumulate(buried_element_area.begin(), buried_element_area.end(), 0.0);
+  if (element_buried > 0.0 && !too_much(total_buried + element_buried)) {
+    total_buried += element_buried;
+    for (size_t m = 0; m < mesh_count; ++m)
+      rep.buried_elements += remove_triangles(surfaces[m], buried_elements[m]);
+  }
+  rep.buried_area = total_buried;
   for (size_t s = 0; s < surface_count; ++s) {
     const uint32_t material =
         s < mesh_count ? scene.meshes[s].material : scene.spheres[s - mesh_count].material;

@@ -47,7 +47,8 @@ struct MeshReport {
   size_t merged_vertices = 0, removed_degenerate = 0, reoriented = 0, self_intersecting = 0;
   size_t contact_edges = 0;    ///< input edges imprinted where surfaces touch (before remeshing)
   size_t buried_faces = 0;     ///< imprinted input faces removed: they lie inside or under other surfaces
-  double buried_area = 0.0;    ///< their area, scene units²
+  size_t buried_elements = 0;  ///< flat elements removed after remeshing for the same reason (where no contact was imprinted)
+  double buried_area = 0.0;    ///< area of both, scene units²
   double meshed_area = 0.0;    ///< area of the input surfaces that are meshed, scene units²
   std::vector<std::string> warnings;
 };
@@ -59,7 +60,8 @@ struct MeshReport {
 /// the contact line is imprinted; the surface is then remeshed isotropically with boundaries,
 /// sharp edges and contact lines protected. Spheres are tessellated to the same edge length.
 /// The parts of the input buried inside or under other surfaces (the floor under a block) are
-/// removed before remeshing; that test casts rays, so it runs only when the scene is committed.
+/// removed before remeshing, and flat elements found buried after it; those tests cast rays, so
+/// they run only when the scene is committed.
 RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report = nullptr);
 
 /// Splits the longest edge of each listed element at its midpoint (at most once per element per

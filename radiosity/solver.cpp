@@ -70,9 +70,10 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
 /// the input is curved (a rounded edge, a scanned body) their centroids lie inside it, and a
 /// receiver moved towards one can see the input's back and go black (a band along the milk
 /// truck's rounded roof edge did). So each element of the vertex is tried in turn, the move
-/// first kept in the tangent plane and lifted along the normal by as much, then straight; the
-/// first candidate whose short probes (backs_seen, a hundredth of the element's size) meet no
-/// back is taken, or else the one that meets fewest.
+/// first kept in the tangent plane and lifted along the normal by as much, then straight, and
+/// last a lift alone along the vertex's and each element's normal; the first candidate whose
+/// probes (backs_seen, reaching twice the element's size) meet no back is taken, or else the
+/// one that meets fewest.
 std::vector<Vec3> visibility_origins(const rc::Scene& scene, const RadiosityMesh& mesh) {
   const size_t nv = mesh.vertex_count();
   std::vector<uint32_t> offsets(nv + 1, 0), fan(3 * mesh.element_count());
@@ -89,22 +90,29 @@ std::vector<Vec3> visibility_origins(const rc::Scene& scene, const RadiosityMesh
     for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
       const Vec3 p = mesh.positions[v], n = mesh.normals[v];
       int fewest = std::numeric_limits<int>::max();
+      const auto consider = [&](const Vec3& candidate, float reach) {
+        const int backs = backs_seen(scene, candidate, n, reach);
+        if (backs < fewest) fewest = backs, origin[v] = candidate;
+      };
       for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
         const auto& e = mesh.elements[fan[i]];
         const Vec3 towards = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f - p;
-        const float reach = 0.03f * glm::length(towards);
-        const Vec3 lifted = p + 1e-3f * (towards - glm::dot(towards, n) * n + glm::length(towards) * n);
-        for (const Vec3& candidate : {lifted, p + 1e-3f * towards}) {
-          const int backs = backs_seen(scene, candidate, n, reach);
-          if (backs < fewest) fewest = backs, origin[v] = candidate;
-          if (fewest == 0) break;
-        }
+        const float size = glm::length(towards);
+        consider(p + 1e-3f * (towards - glm::dot(towards, n) * n + size * n), 2.0f * size);
+        if (fewest > 0) consider(p + 1e-3f * towards, 2.0f * size);
+      }
+      // A vertex whose fan bridges a rounded edge with chords (its normal leaning far from its
+      // own face) may find every element's centroid inside the input: lift it straight out.
+      for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
+        const auto& e = mesh.elements[fan[i]];
+        const float size = glm::length((mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f - p);
+        consider(p + 1e-3f * size * n, 2.0f * size);
+        if (fewest > 0) consider(p + 1e-3f * size * mesh.element_normal[fan[i]], 2.0f * size);
       }
     }
   });
   return origin;
 }
-
 
 /// Potential occluders: boxes around every part of the scene that could block a segment between
 /// two mesh points. A segment between two points of a convex region never crosses the region's
@@ -441,6 +449,7 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.max_edge = report.max_edge;
   plan.contact_edges = report.contact_edges;
   plan.buried_faces = report.buried_faces;
+  plan.buried_elements = report.buried_elements;
   plan.buried_area = report.buried_area;
   plan.meshed_area = report.meshed_area;
   plan.occluder_boxes = occluder_boxes(scene, mesh).size();

@@ -68,6 +68,7 @@ struct SolvePlan {
   size_t elements = 0, vertices = 0;  ///< before adaptive subdivision
   size_t contact_edges = 0;           ///< see MeshReport
   size_t buried_faces = 0;            ///< input faces removed before remeshing (see MeshReport)
+  size_t buried_elements = 0;         ///< flat elements removed after it (see MeshReport)
   double buried_area = 0.0;           ///< their area, scene units²
   double meshed_area = 0.0;           ///< area of the meshed input surfaces, scene units²
   float max_edge = 0.0f;
