@@ -4,6 +4,7 @@
 // gilt that includes CGAL, so its slow compile is paid once.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -246,22 +247,27 @@ size_t imprint_contacts(Part& part, const std::vector<const Part*>& tools, Const
     }
     try {
       // corefine() takes the tool by non-const reference even when it leaves it unmodified, and
-      // the shared tools are read by other threads: it works on a copy.
-      SurfaceMesh copy = tool->mesh;
-      PMP::corefine(part.mesh, copy, CGAL::parameters::edge_is_constrained_map(constrained),
+      // the shared tools are read by other threads: it works on a copy. The piece is cut as a
+      // copy too, kept only if corefinement finishes: one that throws half-way has cut some faces.
+      SurfaceMesh tool_copy = tool->mesh, cut = part.mesh;
+      Constrained cut_constrained = cut.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
+      PMP::corefine(cut, tool_copy, CGAL::parameters::edge_is_constrained_map(cut_constrained),
                     CGAL::parameters::do_not_modify(true));
+      part.mesh = std::move(cut);
     } catch (const std::exception&) {
       ++counts.contacts_failed;  // corefinement gave up on this pair; the piece is meshed without it
     }
   }
+  constrained = part.mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
   size_t after = 0;
   for (edge_descriptor e : part.mesh.edges()) after += constrained[e];
   return after - before;
 }
 
 /// Whether the triangles (a, b, c) and (b, a, d), which share the edge a–b, lie in one plane up to
-/// the rounding of corefinement's constructed points: each far corner within 1e-9 of the longest
-/// edge of the other triangle's plane, and the two facing the same way.
+/// the rounding of corefinement's constructed points to float (snap_new_points): each far corner
+/// within 1e-9 of the longest edge, or four float steps of the largest coordinate, of the other
+/// triangle's plane, and the two facing the same way.
 bool flat_pair(const Point& a, const Point& b, const Point& c, const Point& d) {
   const Kernel::Vector_3 n1 = CGAL::cross_product(b - a, c - a), n2 = CGAL::cross_product(a - b, d - b);
   if (!(n1 * n2 > 0.0)) return false;
@@ -269,8 +275,34 @@ bool flat_pair(const Point& a, const Point& b, const Point& c, const Point& d) {
   const double longest = std::sqrt(std::max({CGAL::squared_distance(a, b), CGAL::squared_distance(a, c),
                                              CGAL::squared_distance(a, d), CGAL::squared_distance(b, c),
                                              CGAL::squared_distance(b, d)}));
-  const double tolerance = 1e-9 * longest;
+  double largest = 0.0;
+  for (const Point* p : {&a, &b, &c, &d})
+    largest = std::max({largest, std::abs(p->x()), std::abs(p->y()), std::abs(p->z())});
+  const double tolerance = std::max(1e-9 * longest, 4.0 * 0x1p-24 * largest);
   return volume <= tolerance * std::sqrt(n1.squared_length()) && volume <= tolerance * std::sqrt(n2.squared_length());
+}
+
+/// Rounds the points that corefinement added to `mesh` (those not among `input`, sorted) to
+/// float. Corefinement may construct one intersection point from different pairs of faces in
+/// different runs (its order depends on memory addresses), differing in the last bits of the
+/// double; rounded to float, which is all gilt's elements keep, they agree (unless they straddle
+/// a float rounding boundary: a chance of about 2⁻²⁹ per coordinate for a one-ulp difference),
+/// and so do the floor's and the block's copies of one contact point. Input points are floats
+/// already and stay where they are. Every −0 becomes +0.
+void snap_new_points(SurfaceMesh& mesh, const std::vector<std::array<double, 3>>& input) {
+  // Through a volatile float: GCC 12 folded double(float(x)) to x in this translation unit.
+  const auto to_float = [](double x) {
+    volatile float f = static_cast<float>(x);
+    return static_cast<double>(f);
+  };
+  for (auto v : mesh.vertices()) {
+    const Point p = mesh.point(v);
+    // x + 0.0 turns −0 into +0, which sorting could not tell apart.
+    if (std::binary_search(input.begin(), input.end(), std::array<double, 3>{p.x(), p.y(), p.z()}))
+      mesh.point(v) = Point(p.x() + 0.0, p.y() + 0.0, p.z() + 0.0);
+    else
+      mesh.point(v) = Point(to_float(p.x()) + 0.0, to_float(p.y()) + 0.0, to_float(p.z()) + 0.0);
+  }
 }
 
 /// The point in the coordinate plane that `normal` is most nearly perpendicular to, with the
@@ -283,52 +315,80 @@ Kernel::Point_2 project(const Point& p, const Kernel::Vector_3& normal) {
 }
 
 /// Corefinement reports intersecting face pairs in an order that depends on memory addresses
-/// (CGAL 5.5's Box_intersection_d with ID_FROM_BOX_ADDRESS), so although the points it adds and
-/// the contact lines are the same in every run, the triangles it cuts a face into and the order
-/// of its new vertices are not, and the remesher follows both. This rebuilds the piece in a form
-/// that depends on its points and constrained edges alone: vertices in lexicographic order,
-/// faces in order of their corners, and every flat region triangulated as its constrained
-/// Delaunay triangulation (Lawson flips with exact 2D predicates in the region's projection;
-/// a diagonal of four cocircular points avoids the lowest-ranked of them, which is a symbolic
-/// perturbation and so picks one triangulation).
+/// (CGAL 5.5's Box_intersection_d with ID_FROM_BOX_ADDRESS), so the triangles it cuts a face
+/// into, the order of its new vertices and (after snap_new_points, rarely) which of two nearby
+/// nodes exist change from run to run, and the remesher follows all three. This rebuilds the
+/// piece in a form that depends on its points and constrained edges alone: one vertex per
+/// position in lexicographic order, faces in order of their corners, and every flat region
+/// triangulated as its constrained Delaunay triangulation (Lawson flips with exact 2D
+/// predicates in the region's projection; a diagonal of four cocircular points avoids the
+/// lowest-ranked of them, which is a symbolic perturbation and so picks one triangulation).
 void canonicalize(SurfaceMesh& mesh, Constrained& constrained) {
   using vertex_descriptor = SurfaceMesh::Vertex_index;
-  std::vector<vertex_descriptor> order(mesh.vertices().begin(), mesh.vertices().end());
-  std::stable_sort(order.begin(), order.end(), [&](vertex_descriptor u, vertex_descriptor v) {
-    return CGAL::compare_xyz(mesh.point(u), mesh.point(v)) == CGAL::SMALLER;
-  });
-  std::vector<std::size_t> rank(mesh.number_of_vertices() + mesh.number_of_removed_vertices());
+  // Points in lexicographic order, each once: vertices that rounding put in one place (two
+  // corefinement nodes a float step apart) become one, or their order would depend on the run.
+  const auto less = [](const Point& p, const Point& q) { return CGAL::compare_xyz(p, q) == CGAL::SMALLER; };
   std::vector<Point> points;
-  points.reserve(order.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    rank[order[i].idx()] = i;
-    points.push_back(mesh.point(order[i]));
-  }
+  points.reserve(mesh.number_of_vertices());
+  for (auto v : mesh.vertices()) points.push_back(mesh.point(v));
+  std::sort(points.begin(), points.end(), less);
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  const auto index_of = [&](vertex_descriptor v) {
+    return static_cast<std::size_t>(std::lower_bound(points.begin(), points.end(), mesh.point(v), less) - points.begin());
+  };
   std::vector<Polygon> polygons;
   polygons.reserve(mesh.number_of_faces());
   for (face_descriptor f : mesh.faces()) {
     Polygon polygon;
-    for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) polygon.push_back(rank[v.idx()]);
+    for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) polygon.push_back(index_of(v));
     std::rotate(polygon.begin(), std::min_element(polygon.begin(), polygon.end()), polygon.end());
+    if (std::adjacent_find(polygon.begin(), polygon.end()) != polygon.end() || polygon.front() == polygon.back())
+      continue;  // two corners merged: no area
     polygons.push_back(std::move(polygon));
   }
   std::sort(polygons.begin(), polygons.end());
-  std::vector<std::pair<std::size_t, std::size_t>> kept;  // constrained edges by rank, low first
+  polygons.erase(std::unique(polygons.begin(), polygons.end()), polygons.end());
+  std::vector<std::pair<std::size_t, std::size_t>> kept;  // constrained edges, low index first
   for (edge_descriptor e : mesh.edges())
     if (constrained[e]) {
-      const std::size_t a = rank[mesh.source(mesh.halfedge(e)).idx()], b = rank[mesh.target(mesh.halfedge(e)).idx()];
-      kept.emplace_back(std::min(a, b), std::max(a, b));
+      const std::size_t a = index_of(mesh.source(mesh.halfedge(e))), b = index_of(mesh.target(mesh.halfedge(e)));
+      if (a != b) kept.emplace_back(std::min(a, b), std::max(a, b));
     }
   std::sort(kept.begin(), kept.end());
 
-  SurfaceMesh out;
-  PMP::polygon_soup_to_polygon_mesh(points, polygons, out);
-  Constrained marks = out.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
-  for (const auto& [a, b] : kept) {
-    const auto [h, found] = CGAL::halfedge(vertex_descriptor(static_cast<SurfaceMesh::size_type>(a)),
-                                           vertex_descriptor(static_cast<SurfaceMesh::size_type>(b)), out);
-    if (found) marks[out.edge(h)] = true;
+  // Merged points can pinch the surface: orient_polygon_soup() copies a vertex where it would be
+  // non-manifold, deterministically since the soup is canonical; each copy keeps its constraints.
+  std::vector<std::vector<std::size_t>> copies(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) copies[i].push_back(i);
+  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) {
+    struct CopyRecorder : PMP::Default_orientation_visitor {
+      std::vector<std::vector<std::size_t>>* copies = nullptr;
+      void duplicated_vertex(std::size_t original, std::size_t copy) { (*copies)[original].push_back(copy); }
+    } recorder;
+    recorder.copies = &copies;
+    PMP::orient_polygon_soup(points, polygons, CGAL::parameters::visitor(recorder));
   }
+
+  SurfaceMesh out;
+  std::vector<vertex_descriptor> vertex(points.size());
+  std::vector<char> used(points.size(), 0);
+  for (const Polygon& polygon : polygons)
+    for (std::size_t i : polygon) used[i] = 1;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (used[i]) vertex[i] = out.add_vertex(points[i]);
+  for (const Polygon& polygon : polygons) {
+    std::vector<vertex_descriptor> corners;
+    for (std::size_t i : polygon) corners.push_back(vertex[i]);
+    CGAL::Euler::add_face(corners, out);  // a face the soup could not take stays out
+  }
+  Constrained marks = out.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
+  for (const auto& [a, b] : kept)
+    for (std::size_t ca : copies[a])
+      for (std::size_t cb : copies[b]) {
+        if (ca >= points.size() || cb >= points.size() || !used[ca] || !used[cb]) continue;
+        const auto [h, found] = CGAL::halfedge(vertex[ca], vertex[cb], out);
+        if (found) marks[out.edge(h)] = true;
+      }
 
   // Lawson flips, in edge order, until none applies. Each flip removes a locally non-Delaunay
   // edge, so the loop ends; the pass limit only guards against an unforeseen cycle.
@@ -478,9 +538,18 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
         if (j != i) tools.push_back(&own[j]);
     tools.insert(tools.end(), others.begin(), others.end());
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
-    const size_t added = imprint_contacts(part, tools, constrained, c);
-    c.contact_edges += added;
-    if (added > 0) canonicalize(part.mesh, constrained);
+    std::vector<std::array<double, 3>> input;
+    for (auto v : part.mesh.vertices()) {
+      const Point& p = part.mesh.point(v);
+      input.push_back({p.x(), p.y(), p.z()});
+    }
+    std::sort(input.begin(), input.end());
+    const size_t faces = part.mesh.number_of_faces();
+    c.contact_edges += imprint_contacts(part, tools, constrained, c);
+    if (part.mesh.number_of_faces() != faces) {
+      snap_new_points(part.mesh, input);
+      canonicalize(part.mesh, constrained);
+    }
     if (part.mesh.has_garbage()) part.mesh.collect_garbage();  // face f is soup triangle f
     append_soup(soup, to_soup(part.mesh));
   }

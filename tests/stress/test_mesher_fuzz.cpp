@@ -1,0 +1,151 @@
+// Fuzzing the radiosity mesher and solver with the geometry real files bring: random triangle
+// soups (slivers, near-degenerate and repeated triangles, random winding), boxes that pierce
+// the floor or stand on it exactly, boxes duplicated in place (coplanar overlaps), and a box
+// that shares a face with another in the same mesh (self-intersecting). For every seed the
+// mesh must be valid (finite positions, unit normals, positive areas), the solution finite and
+// non-negative, and both identical for one and two threads.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "radiosity/mesh.h"
+#include "radiosity/solver.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/scene.h"
+
+namespace gilt::radiosity {
+namespace {
+
+using rc::Material;
+using rc::Rgb;
+using rc::Scene;
+using rc::TriangleMesh;
+
+/// Seeds tried; each scene takes about 20 ms to mesh and solve twice.
+constexpr uint64_t kSeeds = 300;
+
+void add_quad(TriangleMesh& mesh, const std::array<Vec3, 4>& c) {
+  const auto base = static_cast<uint32_t>(mesh.positions.size());
+  mesh.positions.insert(mesh.positions.end(), c.begin(), c.end());
+  mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+}
+
+/// A box with outward faces, turned about y by `turn`; its base at height `base`.
+void add_box(TriangleMesh& mesh, const Vec3& center, const Vec3& half, float turn) {
+  const float c = std::cos(turn), s = std::sin(turn);
+  const auto base = static_cast<uint32_t>(mesh.positions.size());
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 p((i & 1 ? 1.f : -1.f) * half.x, (i & 2 ? 1.f : -1.f) * half.y, (i & 4 ? 1.f : -1.f) * half.z);
+    mesh.positions.push_back(center + Vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z));
+  }
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads)
+    mesh.indices.insert(mesh.indices.end(), {base + q[0], base + q[1], base + q[2], base + q[0], base + q[2], base + q[3]});
+}
+
+Scene random_scene(uint64_t seed) {
+  rc::Rng rng = rc::Rng::for_item(seed, 0, 0x5eed);
+  const auto u = [&](float lo, float hi) { return lo + (hi - lo) * rng.uniform(); };
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.7f)));
+  scene.materials.push_back(Material::make_diffuse("red", Rgb(0.6f, 0.2f, 0.2f)));
+  scene.materials.push_back(Material::make_emitter("lamp", Rgb(4.0f)));
+
+  TriangleMesh floor;  // floor and boxes in one mesh, as one OBJ material groups them
+  floor.name = "floor";
+  add_quad(floor, {Vec3(-2, 0, -2), Vec3(-2, 0, 2), Vec3(2, 0, 2), Vec3(2, 0, -2)});
+  const int boxes = int(u(0.0f, 4.0f));
+  for (int b = 0; b < boxes; ++b) {
+    const Vec3 half(u(0.1f, 0.6f), u(0.1f, 0.6f), u(0.1f, 0.6f));
+    const float kind = rng.uniform();
+    // Standing exactly on the floor, sunk into it, or floating.
+    const float y = kind < 0.4f ? half.y : kind < 0.8f ? u(-0.5f, 0.5f) * half.y : half.y + u(0.01f, 0.5f);
+    add_box(floor, Vec3(u(-1.5f, 1.5f), y, u(-1.5f, 1.5f)), half, u(0.0f, 3.0f));
+    if (rng.uniform() < 0.2f) add_box(floor, Vec3(floor.positions.back()), half, 0.0f);  // overlapping copy
+  }
+  scene.meshes.push_back(std::move(floor));
+
+  TriangleMesh soup;  // a scanned or broken piece: random triangles, some slivers and repeats
+  soup.name = "soup";
+  soup.material = 1;
+  const Vec3 origin(u(-1.0f, 1.0f), u(0.0f, 1.0f), u(-1.0f, 1.0f));
+  const int triangles = int(u(1.0f, 40.0f));
+  for (int t = 0; t < triangles; ++t) {
+    const auto base = static_cast<uint32_t>(soup.positions.size());
+    const float kind = rng.uniform();
+    if (kind < 0.2f && base >= 3) {  // repeat an earlier triangle, perhaps wound the other way
+      const uint32_t first = 3 * uint32_t(rng.uniform() * float(base / 3));
+      soup.indices.insert(soup.indices.end(), {first, first + (kind < 0.1f ? 2u : 1u), first + (kind < 0.1f ? 1u : 2u)});
+      continue;
+    }
+    const Vec3 a = origin + Vec3(u(-0.5f, 0.5f), u(-0.5f, 0.5f), u(-0.5f, 0.5f));
+    const Vec3 b = a + Vec3(u(-0.4f, 0.4f), u(-0.4f, 0.4f), u(-0.4f, 0.4f));
+    Vec3 c = a + Vec3(u(-0.4f, 0.4f), u(-0.4f, 0.4f), u(-0.4f, 0.4f));
+    if (kind < 0.35f) c = a + (b - a) * u(0.0f, 1.0f) + Vec3(u(-1e-5f, 1e-5f));  // sliver or collinear
+    soup.positions.insert(soup.positions.end(), {a, b, c});
+    soup.indices.insert(soup.indices.end(), {base, base + 1, base + 2});
+  }
+  scene.meshes.push_back(std::move(soup));
+
+  TriangleMesh lamp;
+  lamp.name = "lamp";
+  lamp.material = 2;
+  add_quad(lamp, {Vec3(-0.5f, 3, -0.5f), Vec3(0.5f, 3, -0.5f), Vec3(0.5f, 3, 0.5f), Vec3(-0.5f, 3, 0.5f)});
+  scene.meshes.push_back(std::move(lamp));
+  if (rng.uniform() < 0.5f) {
+    rc::Light sun;
+    sun.kind = rc::LightKind::directional;
+    sun.direction = glm::normalize(Vec3(u(-1.0f, 1.0f), -1.0f, u(-1.0f, 1.0f)));
+    sun.irradiance = Rgb(1.0f);
+    scene.punctual_lights.push_back(sun);
+  }
+  scene.commit();
+  return scene;
+}
+
+Solution solve_with(const Scene& scene, int threads) {
+  SolverSettings settings;
+  settings.mesh.elements = 400;
+  settings.tolerance = 1e-2;
+  settings.subdivision_levels = 1;
+  settings.threads = threads;
+  settings.progress = false;
+  return solve(scene, settings);
+}
+
+TEST(MesherFuzz, RandomSoupsMeshAndSolveDeterministically) {
+  size_t elements = 0, contacts = 0, buried = 0;
+  for (uint64_t seed = 0; seed < kSeeds; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Scene scene = random_scene(seed);
+    Solution one, two;
+    ASSERT_NO_THROW(one = solve_with(scene, 1));
+    ASSERT_NO_THROW(two = solve_with(scene, 2));
+    const RadiosityMesh& mesh = one.mesh;
+    elements += mesh.element_count();
+    contacts += one.mesh_report.contact_edges;
+    buried += one.mesh_report.buried_faces + one.mesh_report.buried_elements;
+    for (const Vec3& p : mesh.positions) ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    for (const Vec3& n : mesh.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-4f);
+    for (float a : mesh.element_area) ASSERT_GT(a, 0.0f);
+    for (const auto& e : mesh.elements)
+      for (uint32_t v : e) ASSERT_LT(v, mesh.vertex_count());
+    for (const Rgb& b : one.vertex_radiosity)
+      for (int k = 0; k < 3; ++k) ASSERT_TRUE(std::isfinite(b[k]) && b[k] >= 0.0f);
+    EXPECT_TRUE(one.mesh.positions == two.mesh.positions && one.mesh.elements == two.mesh.elements)
+        << "the mesh depends on the thread count";
+    EXPECT_TRUE(one.vertex_radiosity == two.vertex_radiosity) << "the solution depends on the thread count";
+  }
+  std::printf("[ measured ] %llu scenes: %zu elements, %zu contact edges, %zu buried faces and elements\n",
+              static_cast<unsigned long long>(kSeeds), elements, contacts, buried);
+}
+
+}  // namespace
+}  // namespace gilt::radiosity
