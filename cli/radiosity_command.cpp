@@ -1,5 +1,7 @@
 // `gilt radiosity SCENE -o OUT.ply|.obj|.gltf|.glb`: solve, then export vertex colours.
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -40,9 +42,14 @@ void run_radiosity(RadiosityOptions& o) {
   ex.exposure = o.exposure;
   if (o.srgb8 && std::filesystem::path(o.output).extension() != ".ply")
     throw rc::InputError("--srgb8 applies to .ply output only");
+  const auto start = std::chrono::steady_clock::now();
   const rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   o.solver.progress = !o.quiet && !o.json;
+  // --time covers the whole command: loading has used some of it.
+  if (o.solver.time_limit > 0.0)
+    o.solver.time_limit = std::max(
+        1e-3, o.solver.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   const radiosity::Solution sol = radiosity::solve(scene, o.solver);
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
   radiosity::write_solution(o.output, scene, sol, ex);

@@ -434,6 +434,9 @@ struct Receivers {
   }
 };
 
+/// Share of a time budget that adaptive subdivision may use before it stops refining.
+constexpr double kRefinementShare = 0.3;
+
 /// Luminance-like scalar of a colour, for refinement decisions.
 float level(const Rgb& c) { return c.average(); }
 
@@ -531,6 +534,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   const float base_edge = target_edge_length(scene, settings.mesh);
   const float min_edge = base_edge * std::ldexp(1.0f, -settings.subdivision_levels);
   for (int round = 0; round < 2 * settings.subdivision_levels; ++round) {
+    // With a time budget, refinement stops once it has used its share, so shooting gets the rest.
+    if (settings.time_limit > 0.0 && elapsed() > kRefinementShare * settings.time_limit) break;
     // Mark elements whose vertices' direct irradiance spreads by more than the threshold times
     // the brightest of them (plus a floor of 1 % of the mean, so that darkness does not refine).
     double mean = 0.0, area = 0.0;
@@ -583,6 +588,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   uint64_t shown = 0;
   std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
   ShootingPatch source;
+  double last_shot = 0.0;  // seconds
   while (emitted_power > 0.0) {
     // The patch with the most unshot power.
     size_t src = 0;
@@ -597,7 +603,9 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
     if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
     if (sol.residual < settings.tolerance) break;
-    if (settings.time_limit > 0.0 && elapsed() > settings.time_limit) break;
+    // A shot takes about as long as the last one: stop before one would end past the budget.
+    if (settings.time_limit > 0.0 && elapsed() + last_shot > settings.time_limit) break;
+    const double shot_start = elapsed();
 
     // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
     // without bias, and the noise averages out over the many shots that reach each vertex.
@@ -621,6 +629,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       unshot[e] += albedo(mesh.element_material[e]) * (received[el[0]] + received[el[1]] + received[el[2]]) *
                    (1.0f / 3.0f);
     }
+    last_shot = elapsed() - shot_start;
   }
   progress.finish();
 
