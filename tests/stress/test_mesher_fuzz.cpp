@@ -19,6 +19,7 @@
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/scene.h"
+#include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {
 namespace {
@@ -27,28 +28,11 @@ using rc::Material;
 using rc::Rgb;
 using rc::Scene;
 using rc::TriangleMesh;
+using test::add_box;
+using test::add_quad;
 
 /// Seeds tried; each scene takes about 20 ms to mesh and solve twice.
 constexpr uint64_t kSeeds = 300;
-
-void add_quad(TriangleMesh& mesh, const std::array<Vec3, 4>& c) {
-  const auto base = static_cast<uint32_t>(mesh.positions.size());
-  mesh.positions.insert(mesh.positions.end(), c.begin(), c.end());
-  mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
-/// A box with outward faces, turned about y by `turn`; its base at height `base`.
-void add_box(TriangleMesh& mesh, const Vec3& center, const Vec3& half, float turn) {
-  const float c = std::cos(turn), s = std::sin(turn);
-  const auto base = static_cast<uint32_t>(mesh.positions.size());
-  for (int i = 0; i < 8; ++i) {
-    const Vec3 p((i & 1 ? 1.f : -1.f) * half.x, (i & 2 ? 1.f : -1.f) * half.y, (i & 4 ? 1.f : -1.f) * half.z);
-    mesh.positions.push_back(center + Vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z));
-  }
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads)
-    mesh.indices.insert(mesh.indices.end(), {base + q[0], base + q[1], base + q[2], base + q[0], base + q[2], base + q[3]});
-}
 
 Scene random_scene(uint64_t seed) {
   rc::Rng rng = rc::Rng::for_item(seed, 0, 0x5eed);
@@ -82,7 +66,8 @@ Scene random_scene(uint64_t seed) {
     const float kind = rng.uniform();
     if (kind < 0.2f && base >= 3) {  // repeat an earlier triangle, perhaps wound the other way
       const uint32_t first = 3 * uint32_t(rng.uniform() * float(base / 3));
-      soup.indices.insert(soup.indices.end(), {first, first + (kind < 0.1f ? 2u : 1u), first + (kind < 0.1f ? 1u : 2u)});
+      soup.indices.insert(soup.indices.end(),
+                          {first, first + (kind < 0.1f ? 2u : 1u), first + (kind < 0.1f ? 1u : 2u)});
       continue;
     }
     const Vec3 a = origin + Vec3(u(-0.5f, 0.5f), u(-0.5f, 0.5f), u(-0.5f, 0.5f));
@@ -94,11 +79,7 @@ Scene random_scene(uint64_t seed) {
   }
   scene.meshes.push_back(std::move(soup));
 
-  TriangleMesh lamp;
-  lamp.name = "lamp";
-  lamp.material = 2;
-  add_quad(lamp, {Vec3(-0.5f, 3, -0.5f), Vec3(0.5f, 3, -0.5f), Vec3(0.5f, 3, 0.5f), Vec3(-0.5f, 3, 0.5f)});
-  scene.meshes.push_back(std::move(lamp));
+  test::add_ceiling_lamp(scene, 2);
   if (rng.uniform() < 0.5f) {
     rc::Light sun;
     sun.kind = rc::LightKind::directional;
@@ -132,7 +113,8 @@ TEST(MesherFuzz, RandomSoupsMeshAndSolveDeterministically) {
     elements += mesh.element_count();
     contacts += one.mesh_report.contact_edges;
     buried += one.mesh_report.buried_faces + one.mesh_report.buried_elements;
-    for (const Vec3& p : mesh.positions) ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    for (const Vec3& p : mesh.positions)
+      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
     for (const Vec3& n : mesh.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-4f);
     for (float a : mesh.element_area) ASSERT_GT(a, 0.0f);
     for (const auto& e : mesh.elements)

@@ -24,6 +24,7 @@
 #include "radiosity/solver.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/scene_io.h"
+#include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {
 namespace {
@@ -33,6 +34,8 @@ using rc::Material;
 using rc::Rgb;
 using rc::Scene;
 using rc::TriangleMesh;
+using test::add_box;
+using test::add_quad;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -51,27 +54,6 @@ std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
   return text;
 }
 
-void add_quad(TriangleMesh& mesh, const std::array<Vec3, 4>& corners) {
-  const auto base = static_cast<uint32_t>(mesh.positions.size());
-  mesh.positions.insert(mesh.positions.end(), corners.begin(), corners.end());
-  mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
-/// A closed box with outward faces, turned by `turn` about y and tilted by `tilt` about x.
-void add_box(TriangleMesh& mesh, const Vec3& center, const Vec3& half, float turn, float tilt) {
-  const auto place = [&](float x, float y, float z) {
-    const float cy = std::cos(turn), sy = std::sin(turn), cx = std::cos(tilt), sx = std::sin(tilt);
-    const Vec3 p(x * half.x, y * half.y, z * half.z);
-    const Vec3 q(p.x, cx * p.y - sx * p.z, sx * p.y + cx * p.z);
-    return center + Vec3(cy * q.x + sy * q.z, q.y, -sy * q.x + cy * q.z);
-  };
-  const auto base = static_cast<uint32_t>(mesh.positions.size());
-  for (int i = 0; i < 8; ++i) mesh.positions.push_back(place(i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f));
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads)
-    mesh.indices.insert(mesh.indices.end(), {base + q[0], base + q[1], base + q[2], base + q[0], base + q[2], base + q[3]});
-}
-
 /// A floor with two boxes sunk into it at odd angles, all in one mesh (as an OBJ material
 /// groups them), and a second mesh crossing the first: every kind of imprinting at once.
 Scene contact_scene() {
@@ -88,11 +70,7 @@ Scene contact_scene() {
   slab.name = "slab";
   add_box(slab, Vec3(0.1f, 0.4f, 0.9f), Vec3(1.2f, 0.08f, 0.25f), 0.11f, 0.43f);
   scene.meshes.push_back(std::move(slab));
-  TriangleMesh lamp;
-  lamp.name = "lamp";
-  lamp.material = 1;
-  add_quad(lamp, {Vec3(-0.5f, 3, -0.5f), Vec3(0.5f, 3, -0.5f), Vec3(0.5f, 3, 0.5f), Vec3(-0.5f, 3, 0.5f)});
-  scene.meshes.push_back(std::move(lamp));
+  test::add_ceiling_lamp(scene, 1);
   scene.commit();
   return scene;
 }
@@ -126,7 +104,8 @@ TEST(MeshRobust, CollinearPatchFromTheConferenceRoomMeshes) {
   EXPECT_GT(mesh.element_count(), 0u);
   for (float a : mesh.element_area) ASSERT_GT(a, 0.0f);
   for (const Vec3& n : mesh.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-5f);
-  note("conference", fmt("%.0f elements, %.0f contact edges", double(mesh.element_count()), double(report.contact_edges)));
+  note("conference",
+       fmt("%.0f elements, %.0f contact edges", double(mesh.element_count()), double(report.contact_edges)));
 }
 
 /// The output vertices of `surface` that belong to more than one fan: the triangles around the
@@ -155,14 +134,15 @@ size_t vertices_with_several_fans(const detail::SplitSurface& surface) {
 TEST(MeshRobust, NonManifoldSoupsAreSplitIntoSingleFans) {
   detail::TriangleSoup soup;
   soup.points = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0, 1},  // three on edge 0–1
-                 {3, 0, 0}, {4, 1, 0}, {4, -1, 0}, {2, 1, 0}, {2, -1, 0},       // bow tie at 5
+                 {3, 0, 0}, {4, 1, 0}, {4, -1, 0},  {2, 1, 0},    {2, -1, 0},   // bow tie at 5
                  {6, 0, 0}, {7, 0, 0}, {6.5, 1, 0}, {6.5, -1, 0}};              // wound against each other
   soup.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {5, 6, 8}, {5, 7, 9}, {10, 11, 12}, {10, 11, 13}};
   const detail::SplitSurface split = detail::split_sharp_vertices(soup, 180.0);
   ASSERT_EQ(split.corners.size(), soup.triangles.size());
   EXPECT_EQ(vertices_with_several_fans(split), 0u);
   for (size_t t = 0; t < soup.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(split.positions[split.corners[t][k]], soup.points[soup.triangles[t][k]]);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(split.positions[split.corners[t][k]], soup.points[soup.triangles[t][k]]);
   // The bow tie's two wings get a copy of vertex 5 each; each triangle of the three-way edge and
   // of the pair wound against each other keeps vertices of its own along that edge.
   EXPECT_NE(split.corners[3][0], split.corners[4][0]);
@@ -217,10 +197,7 @@ TEST(MeshRobust, ScannedOpenSurfaceKeepsItsAreaAndCoversTheFloorUnderIt) {
     floor.name = "floor";
     add_quad(floor, {Vec3(-3, 0, -3), Vec3(-3, 0, 3), Vec3(3, 0, 3), Vec3(3, 0, -3)});
     scene.meshes.push_back(std::move(floor));
-    TriangleMesh lamp;
-    lamp.material = 1;
-    add_quad(lamp, {Vec3(-0.5f, 3, -0.5f), Vec3(0.5f, 3, -0.5f), Vec3(0.5f, 3, 0.5f), Vec3(-0.5f, 3, 0.5f)});
-    scene.meshes.push_back(std::move(lamp));
+    test::add_ceiling_lamp(scene, 1);
     if (commit) scene.commit();
     return scene;
   };
@@ -258,12 +235,9 @@ TEST(MeshRobust, FloorUnderAnObjectJustAboveItIsRemovedAfterRemeshing) {
   TriangleMesh box;
   box.name = "open box";
   add_box(box, Vec3(0.0f, 0.50001f, 0.0f), Vec3(0.5f), 0.0f, 0.0f);
-  box.indices.erase(box.indices.begin() + 12, box.indices.begin() + 18);  // the bottom quad {0, 1, 5, 4} goes
+  box.indices.erase(box.indices.begin() + 12, box.indices.begin() + 18);  // its bottom goes (see add_box)
   scene.meshes.push_back(std::move(box));
-  TriangleMesh lamp;
-  lamp.material = 1;
-  add_quad(lamp, {Vec3(-0.5f, 3, -0.5f), Vec3(0.5f, 3, -0.5f), Vec3(0.5f, 3, 0.5f), Vec3(-0.5f, 3, 0.5f)});
-  scene.meshes.push_back(std::move(lamp));
+  test::add_ceiling_lamp(scene, 1);
   scene.commit();
   MeshReport report;
   const float edge = 0.1f;
