@@ -18,6 +18,7 @@
 #include <span>
 #include <unordered_map>
 
+#include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
@@ -62,6 +63,8 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
   return backs;
 }
 
+}  // namespace
+
 /// Where a vertex receives: a thousandth of the way towards the centroid of one of its elements.
 /// A vertex in a corner lies in the planes of the walls beside it, sees them edge-on and would
 /// miss their light (its form factors to a closed box sum to 1/4, not 1); just inside its
@@ -74,7 +77,7 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
 /// last a lift alone along the vertex's and each element's normal; the first candidate whose
 /// probes (backs_seen, reaching twice the element's size) meet no back is taken, or else the
 /// one that meets fewest.
-std::vector<Vec3> visibility_origins(const rc::Scene& scene, const RadiosityMesh& mesh) {
+std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh) {
   const size_t nv = mesh.vertex_count();
   std::vector<uint32_t> offsets(nv + 1, 0), fan(3 * mesh.element_count());
   for (const auto& e : mesh.elements)
@@ -91,7 +94,7 @@ std::vector<Vec3> visibility_origins(const rc::Scene& scene, const RadiosityMesh
       const Vec3 p = mesh.positions[v], n = mesh.normals[v];
       int fewest = std::numeric_limits<int>::max();
       const auto consider = [&](const Vec3& candidate, float reach) {
-        const int backs = backs_seen(scene, candidate, n, reach);
+        const int backs = backs_seen(geometry, candidate, n, reach);
         if (backs < fewest) fewest = backs, origin[v] = candidate;
       };
       for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
@@ -113,6 +116,8 @@ std::vector<Vec3> visibility_origins(const rc::Scene& scene, const RadiosityMesh
   });
   return origin;
 }
+
+namespace {
 
 /// Potential occluders: boxes around every part of the scene that could block a segment between
 /// two mesh points. A segment between two points of a convex region never crosses the region's
@@ -252,9 +257,10 @@ Patches build_patches(const RadiosityMesh& mesh, int patch_elements) {
   return patches;
 }
 
-/// Irradiance at vertex v from a punctual or environment light, with visibility.
-Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc::SurfacePoint& at, const Vec3& n,
-                        rc::Rng& rng, int samples, uint64_t& rays) {
+/// Irradiance at vertex v from a punctual or environment light of `scene`, with visibility traced
+/// against `geometry`.
+Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const rc::Light& light,
+                        const rc::SurfacePoint& at, const Vec3& n, rc::Rng& rng, int samples, uint64_t& rays) {
   if (light.kind == rc::LightKind::environment) {
     // E = L ∫ V cos dω, by cosine-weighted stratified directions: π L · (fraction unblocked).
     const rc::Frame frame = rc::Frame::from_normal(n);
@@ -264,7 +270,8 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc
       for (int j = 0; j < side; ++j) {
         const rc::Vec2 u((i + rng.uniform()) / side, (j + rng.uniform()) / side);
         ++rays;
-        open += !scene.occluded(rc::spawn_shadow_ray_to_infinity(at, frame.to_world(rc::sample_cosine_hemisphere(u))));
+        open += !geometry.occluded(
+            rc::spawn_shadow_ray_to_infinity(at, frame.to_world(rc::sample_cosine_hemisphere(u))));
       }
     return light.radiance * (kPi * float(open) / float(side * side));
   }
@@ -272,7 +279,7 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Light& light, const rc
   const float cos_theta = glm::dot(ls.wi, n);
   if (!(cos_theta > 0.0f) || ls.radiance.is_black()) return Rgb(0.0f);
   ++rays;
-  if (scene.occluded(ls.shadow_ray)) return Rgb(0.0f);
+  if (geometry.occluded(ls.shadow_ray)) return Rgb(0.0f);
   return ls.radiance * cos_theta;
 }
 
@@ -342,9 +349,10 @@ struct Counts {
 
 /// What receives light: the mesh with the points its vertices receive at, and the occluders.
 struct Receivers {
-  const rc::Scene& scene;
+  const rc::Scene& scene;                   ///< the input: its lights
   const RadiosityMesh& mesh;
-  std::vector<Vec3> origin;                 ///< per vertex, see visibility_origins
+  rc::Scene geometry;                       ///< what visibility rays are traced against (element_scene)
+  std::vector<Vec3> origin;                 ///< per vertex, see receiver_points
   std::vector<rc::SurfacePoint> point;      ///< per vertex, for spawning shadow rays
   std::vector<rc::Bounds3> occluders;
 
@@ -352,7 +360,8 @@ struct Receivers {
     update();
   }
   void update() {
-    origin = visibility_origins(scene, mesh);
+    geometry = element_scene(scene, mesh);
+    origin = receiver_points(geometry, mesh);
     point.resize(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) point[v] = surface_point(origin[v], mesh.normals[v]);
   }
@@ -424,7 +433,8 @@ struct Receivers {
           const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
                          bary.y * mesh.positions[el[2]];
           ++counts.rays;
-          open += !scene.occluded(rc::spawn_shadow_ray(point[v], surface_point(q, mesh.element_normal[src.elements[k]])));
+          open += !geometry.occluded(
+              rc::spawn_shadow_ray(point[v], surface_point(q, mesh.element_normal[src.elements[k]])));
         }
       return float(open) / float(side * side);
     };
@@ -518,7 +528,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv, first_vertex + chunk * 128 + 128); ++v) {
         for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
           rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
-          direct_punctual[v] += punctual_irradiance(scene, scene.punctual_lights[li], receivers.point[v],
+          direct_punctual[v] += punctual_irradiance(scene, receivers.geometry, scene.punctual_lights[li], receivers.point[v],
                                                     mesh.normals[v], rng, settings.visibility_samples, counts.rays);
         }
         for (size_t q = 0; q < emitters.size(); ++q) {

@@ -61,6 +61,11 @@ struct Solution {
   Rgb vertex_radiance(size_t v) const { return vertex_radiosity[v] * (1.0f / 3.14159265358979f); }
 };
 
+/// Where each vertex of the mesh receives light: just inside one of its elements and in front of
+/// the mesh's other elements (see solver.cpp). `geometry` is element_scene() of the mesh, whose
+/// rays place the points.
+std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh);
+
 /// Meshes and solves the committed scene.
 Solution solve(const rc::Scene& scene, const SolverSettings& settings);
 

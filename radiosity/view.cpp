@@ -3,6 +3,7 @@
 
 #include "radiosity/view.h"
 
+#include "radiosity/element_scene.h"
 #include "raytrace_core/bsdf.h"
 
 namespace gilt::radiosity {
@@ -17,25 +18,10 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, b
       vertex_radiance_[v] += scene.materials[mesh.vertex_material[v]].albedo * solution.ambient * (1.0f / rc::kPi);
   }
 
-  // Geometry 0: every element; then the scene's specular meshes; spheres: the specular ones.
-  display_.materials = scene.materials;
-  rc::TriangleMesh elements;
-  elements.name = "radiosity elements";
-  elements.positions = mesh.positions;
-  elements.indices.reserve(3 * mesh.element_count());
-  for (const auto& e : mesh.elements) elements.indices.insert(elements.indices.end(), e.begin(), e.end());
-  // A neutral material: the elements' radiance comes from the solution, not from shading.
-  elements.material = static_cast<uint32_t>(display_.materials.size());
-  display_.materials.push_back(rc::Material::make_diffuse("radiosity elements", rc::Rgb(0.0f)));
-  display_.meshes.push_back(std::move(elements));
-  for (const rc::TriangleMesh& m : scene.meshes)
-    if (scene.materials[m.material].is_specular()) display_.meshes.push_back(m);
-  for (const rc::Sphere& s : scene.spheres)
-    if (scene.materials[s.material].is_specular()) display_.spheres.push_back(s);
+  // Geometry 0: every element; then the scene's specular meshes and spheres.
+  display_ = element_scene(scene, mesh);
   for (const rc::Light& l : scene.punctual_lights)
     if (l.kind == rc::LightKind::environment) environment_ += l.radiance;
-  display_.name = scene.name;
-  display_.commit();
 }
 
 Rgb RadiosityView::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {

@@ -1,0 +1,27 @@
+#include "radiosity/element_scene.h"
+
+#include <utility>
+
+namespace gilt::radiosity {
+
+rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh) {
+  rc::Scene out;
+  out.name = scene.name;
+  out.materials = scene.materials;
+  rc::TriangleMesh elements;
+  elements.name = "radiosity elements";
+  elements.positions = mesh.positions;
+  elements.indices.reserve(3 * mesh.element_count());
+  for (const auto& e : mesh.elements) elements.indices.insert(elements.indices.end(), e.begin(), e.end());
+  elements.material = static_cast<uint32_t>(out.materials.size());
+  out.materials.push_back(rc::Material::make_diffuse("radiosity elements", rc::Rgb(0.0f)));
+  out.meshes.push_back(std::move(elements));
+  for (const rc::TriangleMesh& m : scene.meshes)
+    if (scene.materials[m.material].is_specular()) out.meshes.push_back(m);
+  for (const rc::Sphere& s : scene.spheres)
+    if (scene.materials[s.material].is_specular()) out.spheres.push_back(s);
+  out.commit();
+  return out;
+}
+
+}  // namespace gilt::radiosity
