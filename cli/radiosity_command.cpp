@@ -5,9 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "radiosity/check.h"
 #include "radiosity/export.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/error.h"
@@ -21,6 +23,8 @@ namespace {
 struct RadiosityOptions {
   std::string scene, output, quantity = "radiance";
   radiosity::SolverSettings solver;
+  radiosity::CheckSettings check;
+  int check_points = 0;  ///< 0: no check
   bool srgb8 = false, json = false, quiet = false;
   float exposure = 0.0f;
 };
@@ -53,6 +57,13 @@ void run_radiosity(RadiosityOptions& o) {
   const radiosity::Solution sol = radiosity::solve(scene, o.solver);
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
   radiosity::write_solution(o.output, scene, sol, ex);
+  std::optional<radiosity::CheckResult> check;
+  if (o.check_points > 0) {
+    o.check.points = o.check_points;
+    o.check.seed = o.solver.seed;
+    const rc::ThreadLimit limit(o.solver.threads);
+    check = radiosity::check_against_path_tracer(scene, sol, o.check);
+  }
 
   const double secs = std::max(sol.seconds, 1e-9);
   const int threads = o.solver.threads > 0 ? o.solver.threads : rc::hardware_threads();
@@ -81,6 +92,13 @@ void run_radiosity(RadiosityOptions& o) {
                         {"threads", threads},
                         {"quantity", o.quantity},
                         {"output", o.output}};
+    if (check)
+      j["check"] = {{"points", check->points},
+                    {"samples", o.check.samples},
+                    {"mean_relative_error", check->mean_relative_error},
+                    {"relative_mean_absolute_error", check->relative_mean_absolute_error},
+                    {"reference_noise", check->reference_noise},
+                    {"seconds", check->seconds}};
     std::cout << j.dump() << std::endl;
     return;
   }
@@ -100,6 +118,11 @@ void run_radiosity(RadiosityOptions& o) {
               static_cast<unsigned long long>(sol.shadow_rays),
               sol.convex_enclosure ? " (convex enclosure: visibility rays skipped)" : "");
   std::printf("  time:    %.3f s\n", sol.seconds);
+  if (check)
+    std::printf("  check:   irradiance at %zu vertices against the path tracer (%d samples each): mean relative "
+                "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",
+                check->points, o.check.samples, 100.0 * check->mean_relative_error,
+                100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
   std::printf("  wrote %s (%s)\n", o.output.c_str(), o.quantity.c_str());
 }
 
@@ -143,6 +166,11 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
   cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--seed", o->solver.seed, "Random seed for the visibility samples")
       ->check(unsigned_integer());
+  cmd->add_option("--check", o->check_points,
+                  "After solving, compare the irradiance at N vertices with path-traced estimates")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--check-samples", o->check.samples, "Path-traced samples per checked vertex (default 4096)")
+      ->check(CLI::Range(2, 100000000));
   cmd->add_flag("--json", o->json, "Print the statistics as one JSON object");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
   return [o] { run_radiosity(*o); };

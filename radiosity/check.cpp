@@ -1,0 +1,115 @@
+// Object-space check. The path tracer looks straight down, along the vertex normal, at points of
+// the input surface around each checked vertex, and its estimate of the radiance leaving a
+// Lambertian surface, L = Le + ρE/π, with next-event estimation and MIS, gives E = π (L − Le) / ρ.
+// Sampling the incoming radiance by cosine-distributed directions instead leaves a small light to
+// chance (7.5 % noise at 4,096 samples on the Cornell box, against 2.6 % this way). The points
+// fill a disk around the vertex, half as wide as the distance to its nearest element centroid,
+// on the vertex's side of any crease: a vertex colour stands for that much surface, and a finely
+// detailed input (a scan) varies within it in ways no vertex colour can follow.
+
+#include "radiosity/check.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "radiosity/element_scene.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/sampling.h"
+
+namespace gilt::radiosity {
+
+void CheckSettings::validate() const {
+  if (points < 1) throw rc::InputError("check: points must be at least 1, not " + std::to_string(points));
+  if (samples < 2) throw rc::InputError("check: samples must be at least 2, not " + std::to_string(samples));
+}
+
+/// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings).
+constexpr float kSameSide = 0.8660254f;
+
+CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings) {
+  settings.validate();
+  const auto start = std::chrono::steady_clock::now();
+  CheckResult result;
+  const RadiosityMesh& mesh = solution.mesh;
+  const size_t nv = mesh.vertex_count();
+  if (nv == 0) return result;
+  const size_t count = std::min(nv, size_t(settings.points));
+  const std::vector<Vec3> origin = receiver_points(element_scene(scene, mesh), mesh);
+  // Each vertex stands for the surface around it: the radius of its disk is half the distance
+  // to the nearest centroid of its elements.
+  std::vector<float> radius(nv, std::numeric_limits<float>::max());
+  for (const auto& e : mesh.elements) {
+    const Vec3 centroid = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f;
+    for (uint32_t v : e) radius[v] = std::min(radius[v], 0.5f * glm::distance(centroid, mesh.positions[v]));
+  }
+  std::vector<Rgb> mean(count), standard_error(count);
+  std::vector<char> usable(count, 0);
+  const rc::PathSettings path;
+  rc::parallel_for(count, [&](size_t i) {
+    const size_t v = i * nv / count;
+    const Vec3 n = mesh.normals[v];
+    const rc::Frame frame = rc::Frame::from_normal(n);
+    const rc::Material& m = scene.materials[mesh.vertex_material[v]];
+    if (m.kind != rc::MaterialKind::diffuse) return;
+    for (int c = 0; c < 3; ++c)
+      if (!(m.albedo[c] > 0.0f)) return;
+    const float r = radius[v];
+    Rgb sum(0.0f), sum_squares(0.0f);
+    int taken = 0;
+    for (int s = 0; s < settings.samples; ++s) {
+      rc::SampleContext ctx{rc::Rng::for_item(settings.seed, v, 0xc0ffee0000ull + uint64_t(s)), 0};
+      const rc::Vec2 u = rc::sample_uniform_disk(ctx.rng.uniform2()) * r;
+      const rc::Ray ray{origin[v] + frame.to_world(Vec3(u.x, u.y, 0.0f)) + r * n, -n, 2.0f * r};
+      const std::optional<rc::Hit> hit = scene.intersect(ray);
+      if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &m) continue;
+      // Only the surface on the vertex's side of a crease (vertices are split at 30°) counts.
+      if (glm::dot(scene.surface(ray, *hit).ng, n) < kSameSide) continue;
+      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / m.albedo;  // E = π L / ρ
+      sum += e;
+      sum_squares += e * e;
+      ++taken;
+    }
+    if (taken < 2) return;
+    const float n_samples = float(taken);
+    mean[i] = sum / n_samples;
+    for (int c = 0; c < 3; ++c) {
+      const float variance = std::max(0.0f, (sum_squares[c] - sum[c] * sum[c] / n_samples) / (n_samples - 1.0f));
+      standard_error[i][c] = std::sqrt(variance / n_samples);
+    }
+    usable[i] = 1;
+  });
+  double reference_mean = 0.0;
+  size_t used = 0;
+  for (size_t i = 0; i < count; ++i)
+    if (usable[i]) reference_mean += mean[i].average(), ++used;
+  if (used == 0) return result;
+  const double floor = 0.01 * reference_mean / double(used);
+  double error = 0.0, noise = 0.0, absolute = 0.0, total = 0.0;
+  for (size_t i = 0; i < count; ++i) {
+    if (!usable[i]) continue;
+    const Rgb& solved = solution.vertex_irradiance[i * nv / count];
+    for (int c = 0; c < 3; ++c) {
+      const double denominator = double(mean[i][c]) + floor;
+      if (!(denominator > 0.0)) continue;  // black everywhere: nothing to compare
+      error += std::abs(double(solved[c]) - double(mean[i][c])) / denominator;
+      absolute += std::abs(double(solved[c]) - double(mean[i][c]));
+      total += double(mean[i][c]);
+      noise += double(standard_error[i][c]) / denominator;
+    }
+  }
+  result.points = used;
+  result.mean_relative_error = error / (3.0 * double(used));
+  result.reference_noise = noise / (3.0 * double(used));
+  result.relative_mean_absolute_error = total > 0.0 ? absolute / total : 0.0;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace gilt::radiosity

@@ -1,0 +1,43 @@
+#pragma once
+// Object-space check of a radiosity solution: the irradiance at a sample of its vertices against
+// independent path-traced estimates at the same points, with the estimates' own noise, so a
+// reader knows which differences the check can resolve.
+
+#include <cstdint>
+
+#include "radiosity/solver.h"
+
+namespace gilt::radiosity {
+
+/// How many vertices to check and how hard.
+struct CheckSettings {
+  int points = 64;        ///< vertices checked, spread evenly over the vertex list
+  int samples = 4096;     ///< cosine-distributed path-traced samples per vertex
+  uint64_t seed = 0;
+
+  /// Throws rc::InputError naming the field when a value is out of range.
+  void validate() const;
+};
+
+/// The check's findings, over the checked vertices and the three channels. The mean relative
+/// error divides by the reference plus 1 % of its mean, and a few nearly dark vertices still
+/// rule it; the relative mean absolute error weighs every vertex by its light.
+struct CheckResult {
+  size_t points = 0;                 ///< vertices compared
+  double mean_relative_error = 0.0;  ///< mean |E_solution − E_path| / (E_path + 0.01 Ē_path)
+  double relative_mean_absolute_error = 0.0;  ///< Σ |E_solution − E_path| / Σ E_path: not ruled by dark vertices
+  double reference_noise = 0.0;      ///< the same mean of the estimates' standard errors (noise and the
+                                     ///< surface's variation within each disk)
+  double seconds = 0.0;
+};
+
+/// Compares the solution's vertex irradiance with path-traced irradiance averaged over the input
+/// surface around each vertex (a disk half as wide as the distance to its nearest element
+/// centroid, seen along the vertex normal; see check.cpp). A vertex is left out when it is not
+/// diffuse, its albedo has a zero channel, or fewer than two of the path tracer's views land on
+/// its material. Each
+/// vertex's estimate draws from its own random stream, so the result is the same for any thread
+/// count.
+CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings);
+
+}  // namespace gilt::radiosity
