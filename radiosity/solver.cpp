@@ -44,9 +44,9 @@ rc::SurfacePoint surface_point(const Vec3& p, const Vec3& n) {
   return sp;
 }
 
-/// How many of five short probes (along the normal and four directions 60° from it, each
-/// `reach` long) from a candidate receiver hit the back of a surface: a receiver that sees a
-/// back so close is inside the input, not on it.
+/// How many of five probes (along the normal and four directions 60° from it, each `reach`
+/// long) from a candidate receiver hit the back of a surface: a receiver that sees a back so
+/// close lies behind part of the mesh around it.
 int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach) {
   const rc::SurfacePoint at = surface_point(p, n);
   const rc::Frame frame = rc::Frame::from_normal(n);
@@ -69,14 +69,15 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
 /// A vertex in a corner lies in the planes of the walls beside it, sees them edge-on and would
 /// miss their light (its form factors to a closed box sum to 1/4, not 1); just inside its
 /// element it sees them as the surface around it does, and its shadow rays do not start on the
-/// other wall. The vertex lies on the input surface, but its elements are chords of it: where
-/// the input is curved (a rounded edge, a scanned body) their centroids lie inside it, and a
-/// receiver moved towards one can see the input's back and go black (a band along the milk
-/// truck's rounded roof edge did). So each element of the vertex is tried in turn, the move
-/// first kept in the tangent plane and lifted along the normal by as much, then straight, and
-/// last a lift alone along the vertex's and each element's normal; the first candidate whose
-/// probes (backs_seen, reaching twice the element's size) meet no back is taken, or else the
-/// one that meets fewest.
+/// other wall. Where the surface bends (a rounded edge, a scanned body) a point inside one
+/// element lies behind the planes of its neighbours, and rays leaving it near the tangent plane
+/// meet their backs; a fan of chords bridging a rounded edge can lean its vertex normal far
+/// from any of its elements. So each element of the vertex is tried in turn, the move first
+/// kept in the tangent plane and lifted along the normal by as much, then straight, and last a
+/// lift alone along the vertex's and each element's normal; the first candidate whose probes
+/// (backs_seen, reaching twice the element's size) meet no back is taken, or else the one that
+/// meets fewest. (Traced against the input instead of the elements, the milk truck's rounded
+/// roof edge came out as a ragged black band.)
 std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh) {
   const size_t nv = mesh.vertex_count();
   std::vector<uint32_t> offsets(nv + 1, 0), fan(3 * mesh.element_count());
@@ -105,7 +106,7 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
         if (fewest > 0) consider(p + 1e-3f * towards, 2.0f * size);
       }
       // A vertex whose fan bridges a rounded edge with chords (its normal leaning far from its
-      // own face) may find every element's centroid inside the input: lift it straight out.
+      // elements') may find every element's centroid behind the others: lift it straight out.
       for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
         const auto& e = mesh.elements[fan[i]];
         const float size = glm::length((mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f - p);
