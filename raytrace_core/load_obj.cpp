@@ -39,7 +39,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The line's tokens before any '#': OBJ and MTL comments may follow the numbers on a line
+/// ("Kd 0.63 0.065 0.05 # Red", as McGuire's Cornell boxes have them).
 std::vector<std::string_view> split_whitespace(std::string_view line) {
+  line = line.substr(0, line.find('#'));
   std::vector<std::string_view> tokens;
   size_t i = 0;
   while (i < line.size()) {
@@ -78,7 +81,8 @@ void check_mtl_text(const fs::path& path) {
       throw InputError(path.string() + ":" + std::to_string(line_no) + ": " + std::string(tag) + " " + what);
     };
     if (tokens.size() != needed + 1)
-      fail(colour ? "needs three numbers r g b (spectral and xyz forms are not supported)" : "needs one number");
+      fail(colour ? "needs three numbers r g b (spectral and xyz forms are not supported)"
+                  : "needs one number");
     for (size_t k = 1; k <= needed; ++k) {
       double x = 0.0;
       if (!finite_number(tokens[k], x)) fail("value '" + std::string(tokens[k]) + "' is not a finite number");

@@ -168,6 +168,24 @@ TEST_F(Loaders, ObjWithoutMtlGetsDefaultMaterial) {
   EXPECT_TRUE(has_warning(scene, "missing.mtl"));
 }
 
+// Comments may follow the numbers on an MTL or OBJ line, as in McGuire's Cornell boxes; the
+// numbers before them are read as usual.
+TEST_F(Loaders, ObjAndMtlCommentsAfterNumbers) {
+  write("commented.mtl", "newmtl red\nKa 0.63 0.065 0.05 # Red\nKd 0.63 0.065 0.05 # Red\nNs 10 # shiny\n");
+  const std::string obj = write("commented.obj",
+                                "mtllib commented.mtl # materials\nv 0 0 0 # origin\nv 1 0 0\n"
+                                "v 0 1 0\nusemtl red\nf 1 2 3\n");
+  const Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  const Material& m = scene.materials[scene.meshes[0].material];
+  EXPECT_NEAR(m.albedo.r, 0.63f, 1e-6f);
+  EXPECT_NEAR(m.albedo.g, 0.065f, 1e-6f);
+  write("bad.mtl", "newmtl red\nKd 0.5 0.5 # two numbers and a comment 3\n");
+  const std::string bad_obj =
+      write("bad.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(bad_obj); }), "bad.mtl:2:");
+}
+
 TEST_F(Loaders, ObjFaceIndexOutOfRange) {
   const std::string obj = write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
   const std::string message = error_of([&] { load_scene(obj); });
