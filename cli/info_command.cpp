@@ -72,6 +72,7 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   const radiosity::SolvePlan rp = radiosity::plan_solve(scene, radiosity::SolverSettings{});
   rad.runs.push_back("mesh: about " + std::to_string(rp.elements) + " elements, " + std::to_string(rp.vertices) +
                      " vertices (edge " + short_number(rp.max_edge) + "), adaptive subdivision at steep direct light");
+  rad.runs.push_back(std::string("solver: ") + radiosity::to_string(rp.solver) + " (" + rp.solver_reason + ")");
   if (rp.contact_edges > 0)
     rad.runs.push_back("contact lines imprinted where surfaces touch (" + std::to_string(rp.contact_edges) + " edges)");
   if (rp.buried_faces > 0 || rp.buried_elements > 0)

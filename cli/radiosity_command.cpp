@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <nlohmann/json.hpp>
 
@@ -79,7 +80,13 @@ void run_radiosity(RadiosityOptions& o) {
                         {"buried_elements", sol.mesh_report.buried_elements},
                         {"buried_area", sol.mesh_report.buried_area},
                         {"meshed_area", sol.mesh_report.meshed_area},
+                        {"solver", radiosity::to_string(sol.solver)},
+                        {"solver_reason", sol.solver_reason},
                         {"patches", sol.patches},
+                        {"nodes", sol.nodes},
+                        {"links", sol.links},
+                        {"iterations", sol.iterations},
+                        {"final_gather", sol.final_gather},
                         {"shots", sol.shots},
                         {"residual", sol.residual},
                         {"tolerance", o.solver.tolerance},
@@ -111,8 +118,15 @@ void run_radiosity(RadiosityOptions& o) {
                 sol.mesh_report.contact_edges,
                 100.0 * sol.mesh_report.buried_area / std::max(sol.mesh_report.meshed_area, 1e-300),
                 sol.mesh_report.buried_faces, sol.mesh_report.buried_elements);
-  std::printf("  solve:   %llu shots, residual %.3g (tolerance %.3g)\n", static_cast<unsigned long long>(sol.shots),
-              sol.residual, o.solver.tolerance);
+  if (sol.solver == radiosity::SolverKind::hierarchical)
+    std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links, %d iterations, residual %.3g (tolerance %.3g), "
+                "final gather %s (%.3g nodes per vertex)\n",
+                sol.solver_reason.c_str(), sol.nodes, sol.links, sol.iterations, sol.residual, o.solver.tolerance,
+                sol.final_gather ? "at every vertex" : "stopped by --time",
+                double(sol.gather_nodes) / double(std::max<size_t>(1, sol.mesh.vertex_count())));
+  else
+    std::printf("  solve:   progressive (%s): %llu shots, residual %.3g (tolerance %.3g)\n", sol.solver_reason.c_str(),
+                static_cast<unsigned long long>(sol.shots), sol.residual, o.solver.tolerance);
   std::printf("  work:    %llu form factors (%.3g/s), %llu shadow rays%s\n",
               static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
               static_cast<unsigned long long>(sol.shadow_rays),
@@ -145,6 +159,23 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
   cmd.add_option("--subdivision-threshold", s.subdivision_threshold,
                  "Radiosity: bisect elements whose direct light spreads by more than this fraction (default 0.6)")
       ->check(CLI::Range(1e-3, 1.0))
+      ->check(finite_number());
+  cmd.add_option("--solver", s.solver,
+                 "Radiosity: progressive, hierarchical, or auto (hierarchical from " +
+                     std::to_string(radiosity::kHierarchicalElements) + " elements; default)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, radiosity::SolverKind>{
+          {"auto", radiosity::SolverKind::automatic},
+          {"progressive", radiosity::SolverKind::progressive},
+          {"hierarchical", radiosity::SolverKind::hierarchical}}));
+  cmd.add_option("--link-tolerance", s.hierarchical.link_tolerance,
+                 "Hierarchical radiosity: accept a link when the power it may carry wrongly is below this fraction "
+                 "of the reflected power (default 2e-6)")
+      ->check(CLI::Range(1e-12, 1.0))
+      ->check(finite_number());
+  cmd.add_option("--gather-tolerance", s.hierarchical.gather_tolerance,
+                 "Hierarchical radiosity: a cluster stands in for its elements in the vertex final gather when the "
+                 "irradiance it may carry wrongly is below this fraction of the vertex's own (default 0.02)")
+      ->check(CLI::Range(1e-6, 1.0))
       ->check(finite_number());
 }
 

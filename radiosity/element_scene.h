@@ -5,6 +5,7 @@
 // geometry the radiosity world does not have (the Stanford bunny came out in black blotches).
 
 #include "radiosity/mesh.h"
+#include "raytrace_core/ray.h"
 #include "raytrace_core/scene.h"
 
 namespace gilt::radiosity {
@@ -14,5 +15,15 @@ namespace gilt::radiosity {
 /// are, which the solver treats as opaque and the view ray traces. Materials are the input's,
 /// plus the elements' at the end.
 rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh);
+
+/// A point of the mesh for spawning rays at p on a surface with unit normal n; the error bound
+/// allows for rounding in meshing (γ(16)·|p|).
+inline rc::SurfacePoint mesh_surface_point(const Vec3& p, const Vec3& n) {
+  rc::SurfacePoint sp;
+  sp.p = p;
+  sp.p_error = rc::error_gamma(16) * rc::abs(p);
+  sp.ng = n;
+  return sp;
+}
 
 }  // namespace gilt::radiosity

@@ -34,15 +34,7 @@ using rc::DVec3;
 
 constexpr float kPi = rc::kPi;
 
-/// A surface point for spawning rays at p on a surface with normal n; the error bound allows for
-/// rounding in meshing (γ(16)·|p|).
-rc::SurfacePoint surface_point(const Vec3& p, const Vec3& n) {
-  rc::SurfacePoint sp;
-  sp.p = p;
-  sp.p_error = rc::error_gamma(16) * rc::abs(p);
-  sp.ng = n;
-  return sp;
-}
+constexpr auto surface_point = mesh_surface_point;
 
 /// How many of five probes (along the normal and four directions 60° from it, each `reach`
 /// long) from a candidate receiver hit the back of a surface: a receiver that sees a back so
@@ -453,6 +445,32 @@ float level(const Rgb& c) { return c.average(); }
 
 }  // namespace
 
+const char* to_string(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::automatic: return "auto";
+    case SolverKind::progressive: return "progressive";
+    case SolverKind::hierarchical: return "hierarchical";
+  }
+  return "?";
+}
+
+SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why) {
+  auto say = [&](std::string text) {
+    if (why) *why = std::move(text);
+  };
+  if (settings.solver != SolverKind::automatic) {
+    say("asked for");
+    return settings.solver;
+  }
+  if (elements >= kHierarchicalElements) {
+    say(std::to_string(elements) + " elements: progressive refinement would cost about n², hierarchical about n log n");
+    return SolverKind::hierarchical;
+  }
+  say(std::to_string(elements) + " elements (below " + std::to_string(kHierarchicalElements) +
+      "): progressive refinement is exact per vertex and fast enough");
+  return SolverKind::progressive;
+}
+
 SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (!scene.committed()) throw std::logic_error("radiosity::plan_solve: the scene was not committed");
   SolvePlan plan;
@@ -469,6 +487,7 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.occluder_boxes = occluder_boxes(scene, mesh).size();
   plan.convex_enclosure = plan.occluder_boxes == 0;
   plan.punctual_lights = scene.punctual_lights.size();
+  plan.solver = choose_solver(settings, plan.elements, &plan.solver_reason);
   for (const rc::TriangleMesh& m : scene.meshes) plan.specular_surfaces += scene.materials[m.material].is_specular();
   for (const rc::Sphere& s : scene.spheres) plan.specular_surfaces += scene.materials[s.material].is_specular();
   return plan;
@@ -573,90 +592,120 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.refined_elements += marked.size();
   }
 
-  // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
-  // and has not shot yet.
   const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
   sol.vertex_irradiance.resize(nv);
   for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
-  std::vector<Rgb> unshot(ne);
-  double emitted_power = 0.0;
-  for (size_t e = 0; e < ne; ++e) {
-    const auto& el = mesh.elements[e];
-    const Rgb rho = albedo(mesh.element_material[e]);
-    emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
-    emitted_power += double((rho * (direct_punctual[el[0]] + direct_punctual[el[1]] + direct_punctual[el[2]])).average()) /
-                     3.0 * mesh.element_area[e];
-    unshot[e] = rho * (sol.vertex_irradiance[el[0]] + sol.vertex_irradiance[el[1]] + sol.vertex_irradiance[el[2]]) *
-                (1.0f / 3.0f);
-  }
-  if (!(emitted_power > 0.0))
-    sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
-
-  const Patches patches = build_patches(mesh, settings.patch_elements);
-  sol.patches = patches.count();
-  // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
-  rc::Progress progress("radiosity", 1000, "‰", settings.progress);
-  uint64_t shown = 0;
-  std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
-  ShootingPatch source;
-  double last_shot = 0.0;  // seconds
-  while (emitted_power > 0.0) {
-    // The patch with the most unshot power.
-    size_t src = 0;
-    double best = -1.0, unshot_power = 0.0;
-    for (size_t q = 0; q < patches.count(); ++q) {
-      double p = 0.0;
-      for (uint32_t e : patches.of(q)) p += double(unshot[e].average()) * mesh.element_area[e];
-      unshot_power += p;
-      if (p > best) best = p, src = q;
-    }
-    sol.residual = unshot_power / emitted_power;
-    const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
-    if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
-    if (sol.residual < settings.tolerance) break;
-    // A shot takes about as long as the last one: stop before one would end past the budget.
-    if (settings.time_limit > 0.0 && elapsed() + last_shot > settings.time_limit) break;
-    const double shot_start = elapsed();
-
-    // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
-    // without bias, and the noise averages out over the many shots that reach each vertex.
-    source.assign(mesh, patches.of(src), unshot);
-    source.emitter = false;
-    source.probe = std::min(settings.reflected_visibility_probe, strata);
-    source.strata = source.probe;
-    const uint64_t shot_index = sol.shots++;
-    rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
-      Counts counts;
-      for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
-        rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
-        received[v] = receivers.receive(source, v, rng, counts);
-      }
-      add_counts(counts);
-    });
-    // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
-    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
+  // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
+  // and has not shot yet.
+  auto shoot_progressive = [&] {
+    std::vector<Rgb> unshot(ne);
+    double emitted_power = 0.0;
     for (size_t e = 0; e < ne; ++e) {
       const auto& el = mesh.elements[e];
-      unshot[e] += albedo(mesh.element_material[e]) * (received[el[0]] + received[el[1]] + received[el[2]]) *
-                   (1.0f / 3.0f);
+      const Rgb rho = albedo(mesh.element_material[e]);
+      emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
+      emitted_power += double((rho * (direct_punctual[el[0]] + direct_punctual[el[1]] + direct_punctual[el[2]])).average()) /
+                       3.0 * mesh.element_area[e];
+      unshot[e] = rho * (sol.vertex_irradiance[el[0]] + sol.vertex_irradiance[el[1]] + sol.vertex_irradiance[el[2]]) *
+                  (1.0f / 3.0f);
     }
-    last_shot = elapsed() - shot_start;
-  }
-  progress.finish();
+    if (!(emitted_power > 0.0))
+      sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
 
-  {
-    Rgb unshot_sum(0.0f), reflectance_sum(0.0f);
-    double area = 0.0;
-    for (size_t e = 0; e < ne; ++e) {
-      unshot_sum += unshot[e] * mesh.element_area[e];
-      reflectance_sum += albedo(mesh.element_material[e]) * mesh.element_area[e];
-      area += mesh.element_area[e];
+    const Patches patches = build_patches(mesh, settings.patch_elements);
+    sol.patches = patches.count();
+    // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
+    rc::Progress progress("radiosity", 1000, "‰", settings.progress);
+    uint64_t shown = 0;
+    std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
+    ShootingPatch source;
+    double last_shot = 0.0;  // seconds
+    while (emitted_power > 0.0) {
+      // The patch with the most unshot power.
+      size_t src = 0;
+      double best = -1.0, unshot_power = 0.0;
+      for (size_t q = 0; q < patches.count(); ++q) {
+        double p = 0.0;
+        for (uint32_t e : patches.of(q)) p += double(unshot[e].average()) * mesh.element_area[e];
+        unshot_power += p;
+        if (p > best) best = p, src = q;
+      }
+      sol.residual = unshot_power / emitted_power;
+      const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
+      if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
+      if (sol.residual < settings.tolerance) break;
+      // A shot takes about as long as the last one: stop before one would end past the budget.
+      if (settings.time_limit > 0.0 && elapsed() + last_shot > settings.time_limit) break;
+      const double shot_start = elapsed();
+
+      // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
+      // without bias, and the noise averages out over the many shots that reach each vertex.
+      source.assign(mesh, patches.of(src), unshot);
+      source.emitter = false;
+      source.probe = std::min(settings.reflected_visibility_probe, strata);
+      source.strata = source.probe;
+      const uint64_t shot_index = sol.shots++;
+      rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+        Counts counts;
+        for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
+          rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
+          received[v] = receivers.receive(source, v, rng, counts);
+        }
+        add_counts(counts);
+      });
+      // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
+      for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
+      for (size_t e = 0; e < ne; ++e) {
+        const auto& el = mesh.elements[e];
+        unshot[e] += albedo(mesh.element_material[e]) * (received[el[0]] + received[el[1]] + received[el[2]]) *
+                     (1.0f / 3.0f);
+      }
+      last_shot = elapsed() - shot_start;
     }
-    if (area > 0.0) {
-      const float inv_area = float(1.0 / area);
-      const Rgb rho = reflectance_sum * inv_area;
-      for (int k = 0; k < 3; ++k) sol.ambient[k] = unshot_sum[k] * inv_area / std::max(1e-3f, 1.0f - rho[k]);
+    progress.finish();
+
+    {
+      Rgb unshot_sum(0.0f), reflectance_sum(0.0f);
+      double area = 0.0;
+      for (size_t e = 0; e < ne; ++e) {
+        unshot_sum += unshot[e] * mesh.element_area[e];
+        reflectance_sum += albedo(mesh.element_material[e]) * mesh.element_area[e];
+        area += mesh.element_area[e];
+      }
+      if (area > 0.0) {
+        const float inv_area = float(1.0 / area);
+        const Rgb rho = reflectance_sum * inv_area;
+        for (int k = 0; k < 3; ++k) sol.ambient[k] = unshot_sum[k] * inv_area / std::max(1e-3f, 1.0f - rho[k]);
+      }
     }
+  };
+  sol.solver = choose_solver(settings, ne, &sol.solver_reason);
+  if (sol.solver == SolverKind::hierarchical) {
+    // Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex.
+    std::vector<Rgb> element_albedo(ne);
+    for (size_t e = 0; e < ne; ++e) element_albedo[e] = albedo(mesh.element_material[e]);
+    HierarchicalSettings hs = settings.hierarchical;
+    hs.tolerance = settings.tolerance;
+    hs.seed = settings.seed;
+    const HierarchicalInput input{
+        mesh, receivers.geometry, receivers.point, element_albedo, sol.vertex_irradiance,
+        [&](const rc::Bounds3& reach) {
+          return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
+                             [&](const rc::Bounds3& box) { return reach.overlaps(box); });
+        },
+        [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; }};
+    const HierarchicalResult h = solve_hierarchical(input, hs);
+    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += h.vertex_irradiance[v];
+    sol.nodes = h.nodes;
+    sol.links = h.links;
+    sol.iterations = h.iterations;
+    sol.residual = h.residual;
+    sol.gather_nodes = h.gather_nodes;
+    sol.final_gather = h.final_gather;
+    rays += h.shadow_rays;
+    form_factors += h.form_factors;
+  } else {
+    shoot_progressive();
   }
 
   sol.vertex_radiosity.resize(nv);

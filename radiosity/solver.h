@@ -8,6 +8,9 @@
 #include <cstdint>
 #include <vector>
 
+#include <string>
+
+#include "radiosity/hierarchical.h"
 #include "radiosity/mesh.h"
 #include "raytrace_core/rgb.h"
 
@@ -15,8 +18,24 @@ namespace gilt::radiosity {
 
 using rc::Rgb;
 
+/// How the light reflected between surfaces is solved (the direct light is gathered at every
+/// vertex by shadow rays either way).
+enum class SolverKind {
+  automatic,     ///< chosen by the element count (see choose_solver)
+  progressive,   ///< progressive refinement: every patch shoots to every vertex, O(n²)
+  hierarchical,  ///< hierarchical radiosity with clustering and a vertex final gather, about O(n log n)
+};
+
+/// "auto", "progressive" or "hierarchical".
+const char* to_string(SolverKind kind);
+
+/// At and above this many elements `automatic` picks the hierarchical solver.
+inline constexpr size_t kHierarchicalElements = 20000;
+
 /// Solver parameters; the defaults are the documented defaults.
 struct SolverSettings {
+  SolverKind solver = SolverKind::automatic;
+  HierarchicalSettings hierarchical;  ///< its tolerance and seed are taken from the fields below
   MeshSettings mesh;
   double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
   double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); refinement
@@ -42,13 +61,20 @@ struct Solution {
   std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
 
   // What the solve did.
+  SolverKind solver = SolverKind::progressive;  ///< the one that ran
+  std::string solver_reason;                    ///< why it was chosen
   uint64_t shots = 0;            ///< patches shot
   size_t patches = 0;            ///< shooting patches the elements were grouped into
   size_t refined_elements = 0;   ///< elements bisected by adaptive subdivision
   uint64_t form_factors = 0;     ///< vertex–element form factors evaluated
   uint64_t shadow_rays = 0;
   uint64_t skipped_pairs = 0;    ///< vertex–patch pairs whose visibility the scene proved without rays
-  double residual = 0.0;         ///< unshot power / emitted power at the end
+  size_t nodes = 0, links = 0;   ///< hierarchical: clusters and elements in the tree, links between them
+  int iterations = 0;            ///< hierarchical: gathering iterations
+  uint64_t gather_nodes = 0;     ///< hierarchical: nodes the vertex final gather evaluated
+  bool final_gather = false;     ///< hierarchical: the vertex final gather ran to the end
+  double residual = 0.0;         ///< progressive: unshot power / emitted power at the end;
+                                 ///< hierarchical: relative change of the last iteration
   /// Ambient radiosity (W·m⁻²) standing in for the light not yet shot, for displaying a partial
   /// solution only (Cohen, Chen, Wallace & Greenberg 1988): the area-weighted mean unshot
   /// radiosity times the interreflection factor 1 / (1 − ρ̄). Never part of exported values.
@@ -66,6 +92,9 @@ struct Solution {
 /// rays place the points.
 std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh);
 
+/// The solver `settings` asks for on a mesh of `elements` elements, and why.
+SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why = nullptr);
+
 /// Meshes and solves the committed scene.
 Solution solve(const rc::Scene& scene, const SolverSettings& settings);
 
@@ -82,6 +111,8 @@ struct SolvePlan {
   size_t occluder_boxes = 0;          ///< boxes that shadow rays are tested against first
   size_t punctual_lights = 0;         ///< point, spot, directional and environment lights, shot unmeshed
   size_t specular_surfaces = 0;       ///< meshes and spheres left to ray tracing (mirror, glass)
+  SolverKind solver = SolverKind::progressive;  ///< what `automatic` resolves to here
+  std::string solver_reason;
 };
 SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings);
 

@@ -1,0 +1,686 @@
+// Hierarchical radiosity with clustering: Hanrahan, Salzman & Aupperle 1991, "A Rapid
+// Hierarchical Radiosity Algorithm"; clusters: Smits, Arvo & Greenberg 1994, "A Clustering
+// Algorithm for Radiosity in Complex Environments", and Sillion 1995, "A Unified Hierarchical
+// Algorithm for Global Illumination with Scattering Volumes and Object Clusters"; final gather:
+// Lischinski, Tampieri & Greenberg 1993, "Combining Hierarchical Radiosity and Discontinuity
+// Meshing".
+//
+// The hierarchy is a binary tree over the elements (median splits of their centroids), so a
+// cluster is a compact piece of one surface near the leaves and a group of objects near the
+// root. Linking starts from the root paired with itself and splits the larger end of a pair
+// until the oracle accepts it: the power the link may carry wrongly, ρ_R A_R F̂ B_S times the
+// point-source error ((r_R + r_S)/d)², where F̂ = A_S / (π d²) bounds the form factor from R to S
+// at a gap d, must stay below link_tolerance × the scene's reflected power. A pair of elements
+// that the oracle never accepts gets an exact link: Lambert's point-to-triangle factor at the
+// receiver's centroid. Pairs that provably exchange nothing (each end behind the other's
+// surfaces, coplanar pieces of one wall) are dropped before any test.
+//
+// Clusters emit and receive through two models. A flat cluster (every element within about 20°
+// of its mean normal) sends I(ω) = ω·Σ B_k A_k n_k / π, exact for a plane, and receives the
+// irradiance vector W = Σ J w (J the irradiance facing the source, w towards it), so that an
+// element below it with normal n gets n·W: exact when every source is in front of it. A
+// curved or scattered cluster uses the first two spherical-harmonic bands of the clamped cosine
+// (max(0, cos) ≈ 1/4 + cos/2) for both; the oracle's error factor is then 1, so such links are
+// accepted only where little light travels.
+
+#include "radiosity/hierarchical.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+
+#include "radiosity/element_scene.h"
+#include "radiosity/form_factor.h"
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene.h"
+
+namespace gilt::radiosity {
+namespace {
+
+constexpr float kPi = rc::kPi;
+constexpr uint32_t kNone = ~0u;
+/// Slack of the "sends nothing" tests, as a slope over the nearest distance between the two: a
+/// source within 10⁻⁴ rad of the receiver's plane, as seen from every point of the receiver,
+/// sends at most 10⁻⁴ of its light (the same bound as kTangentSlope).
+constexpr float kPlaneSlack = 1e-4f;
+/// How many levels a far link's mixed end (elements facing both ways) is split into children
+/// that share its visibility.
+constexpr int kMixedDepth = 3;
+
+/// One vector per colour channel: Σ B A n and the irradiance vector W.
+struct RgbVec {
+  Vec3 c[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};
+  void add(const Rgb& w, const Vec3& d) {
+    for (int k = 0; k < 3; ++k) c[k] += w[k] * d;
+  }
+  void add(const RgbVec& o) {
+    for (int k = 0; k < 3; ++k) c[k] += o.c[k];
+  }
+  Rgb dot(const Vec3& d) const { return Rgb(glm::dot(c[0], d), glm::dot(c[1], d), glm::dot(c[2], d)); }
+};
+
+struct Node {
+  uint32_t first = 0, count = 0;  ///< elements order[first .. first + count)
+  uint32_t right = kNone;         ///< second child (the first is the next node); kNone for a leaf
+  rc::Bounds3 box;                ///< of the elements' vertices
+  Vec3 center{0.0f};              ///< area-weighted centroid
+  float radius = 0.0f;            ///< of a sphere about center holding every vertex
+  Vec3 normal{0.0f};              ///< unit area-weighted mean normal (0 when it cancels)
+  float spread = 2.0f;            ///< max |n_k − normal| over the elements
+  float low = 0.0f, high = 0.0f;  ///< least and greatest normal·(x − center) over the vertices
+  float area = 0.0f;
+  Vec3 area_vector{0.0f};  ///< Σ A_k n_k
+  float albedo = 0.0f;     ///< area-weighted mean reflectance (channel mean)
+
+  bool leaf() const { return right == kNone; }
+};
+
+/// How a node's elements face a direction ω: all in front (n_k·ω ≥ 0 for every k, since
+/// n_k·ω ≥ n̄·ω − |n_k − n̄|), all behind, or some each way.
+enum class Facing { front, back, mixed };
+
+/// With `margin` = sin of the largest angle between ω and the directions it stands for, the
+/// answer holds for all of them.
+Facing facing(const Node& node, const Vec3& omega, float margin = 0.0f) {
+  if (node.spread >= 2.0f) return Facing::mixed;
+  const float c = glm::dot(node.normal, omega), bound = node.spread + margin;
+  return c >= bound ? Facing::front : (c <= -bound ? Facing::back : Facing::mixed);
+}
+
+/// The element hierarchy, nodes in depth-first pre-order (a parent before its children).
+struct Tree {
+  std::vector<Node> nodes;
+  std::vector<uint32_t> order;  ///< elements in leaf order
+  std::vector<SourceTriangle> triangles;
+
+  uint32_t element(const Node& leaf) const { return order[leaf.first]; }
+};
+
+class TreeBuilder {
+ public:
+  TreeBuilder(const RadiosityMesh& mesh, std::span<const Rgb> albedo) : mesh_(mesh), albedo_(albedo) {
+    const size_t n = mesh.element_count();
+    centroid_.resize(n);
+    for (size_t e = 0; e < n; ++e) {
+      const auto& el = mesh.elements[e];
+      centroid_[e] = (mesh.positions[el[0]] + mesh.positions[el[1]] + mesh.positions[el[2]]) / 3.0f;
+    }
+  }
+
+  Tree build() {
+    const size_t n = mesh_.element_count();
+    tree_.order.resize(n);
+    std::iota(tree_.order.begin(), tree_.order.end(), 0u);
+    tree_.nodes.reserve(2 * n);
+    if (n > 0) add(0, uint32_t(n));
+    tree_.triangles.resize(n);
+    for (size_t e = 0; e < n; ++e) {
+      const auto& el = mesh_.elements[e];
+      tree_.triangles[e] =
+          SourceTriangle(mesh_.positions[el[0]], mesh_.positions[el[1]], mesh_.positions[el[2]]);
+    }
+    return std::move(tree_);
+  }
+
+ private:
+  uint32_t add(uint32_t first, uint32_t count) {
+    const uint32_t index = uint32_t(tree_.nodes.size());
+    tree_.nodes.push_back(summarise(first, count));
+    if (count > 1) {
+      // Median split along the longest extent of the centroids; ties broken by element index so
+      // the tree, and everything after it, is the same on every run.
+      rc::Bounds3 cb;
+      for (uint32_t i = first; i < first + count; ++i) cb.extend(centroid_[tree_.order[i]]);
+      const Vec3 ext = cb.diagonal();
+      const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+      const uint32_t half = count / 2;
+      auto begin = tree_.order.begin() + first;
+      std::nth_element(begin, begin + half, begin + count, [&](uint32_t a, uint32_t b) {
+        const float ca = centroid_[a][axis], cb2 = centroid_[b][axis];
+        return ca < cb2 || (ca == cb2 && a < b);
+      });
+      add(first, half);
+      const uint32_t right = add(first + half, count - half);
+      tree_.nodes[index].right = right;
+    }
+    return index;
+  }
+
+  Node summarise(uint32_t first, uint32_t count) const {
+    Node node;
+    node.first = first;
+    node.count = count;
+    double area = 0.0, albedo = 0.0;
+    DVec3 weighted_centroid(0.0), weighted_normal(0.0);
+    for (uint32_t i = first; i < first + count; ++i) {
+      const uint32_t e = tree_.order[i];
+      const double a = mesh_.element_area[e];
+      area += a;
+      albedo += a * albedo_[e].average();
+      weighted_centroid += a * DVec3(centroid_[e]);
+      weighted_normal += a * DVec3(mesh_.element_normal[e]);
+      for (uint32_t v : mesh_.elements[e]) node.box.extend(mesh_.positions[v]);
+    }
+    node.area = float(area);
+    node.area_vector = Vec3(weighted_normal);
+    node.albedo = area > 0.0 ? float(albedo / area) : 0.0f;
+    node.center = area > 0.0 ? Vec3(weighted_centroid / area) : node.box.center();
+    const double len = glm::length(weighted_normal);
+    node.normal = len > 1e-6 * area && len > 0.0 ? Vec3(weighted_normal / len) : Vec3(0.0f);
+    float spread = node.normal == Vec3(0.0f) ? 2.0f : 0.0f, radius2 = 0.0f;
+    float low = 0.0f, high = 0.0f;
+    for (uint32_t i = first; i < first + count; ++i) {
+      const uint32_t e = tree_.order[i];
+      if (node.normal != Vec3(0.0f))
+        spread = std::max(spread, glm::length(mesh_.element_normal[e] - node.normal));
+      for (uint32_t v : mesh_.elements[e]) {
+        const Vec3 d = mesh_.positions[v] - node.center;
+        radius2 = std::max(radius2, glm::dot(d, d));
+        const float h = glm::dot(node.normal, d);
+        low = std::min(low, h), high = std::max(high, h);
+      }
+    }
+    node.spread = spread;
+    node.radius = std::sqrt(radius2) * (1.0f + 1e-6f);
+    node.low = low, node.high = high;
+    return node;
+  }
+
+  const RadiosityMesh& mesh_;
+  std::span<const Rgb> albedo_;
+  std::vector<Vec3> centroid_;
+  Tree tree_;
+};
+
+/// True when no point of `to` lies in front of any element of `from` (beyond the slack): from
+/// then sends nothing to `to`, and receives nothing from it. Bounds n_k·(x − y) for x in `to`,
+/// y in `from`, by n̄·(x − y) plus the normals' spread times the largest |x − y|.
+bool behind(const Node& from, const Node& to) {
+  const Vec3 d = to.center - from.center;
+  const float dist = glm::length(d), far = dist + from.radius + to.radius;
+  const float near = std::max(0.0f, dist - from.radius - to.radius);
+  // The greatest n̄_from·(x − c_to) over `to`: its radius, or less when the two face alike.
+  const float to_high = std::min(to.radius, to.high + glm::length(from.normal - to.normal) * to.radius);
+  const float reach = glm::dot(from.normal, d) + to_high - from.low + from.spread * far;
+  return reach <= kPlaneSlack * near;
+}
+
+/// The same with a point receiver (p, n) as `to`: the node sends nothing to it.
+bool sends_nothing(const Node& s, const Vec3& p, const Vec3& n) {
+  const Vec3 d = s.center - p;
+  const float dist = glm::length(d), far = dist + s.radius, near = std::max(0.0f, dist - s.radius);
+  if (glm::dot(n, d) + s.radius <= kPlaneSlack * near) return true;  // behind the receiver's plane
+  return glm::dot(s.normal, -d) - s.low + s.spread * far <= kPlaneSlack * near;
+}
+
+/// Radiant intensity (W·sr⁻¹) of node s towards unit direction ω, from Σ B A and Σ B A n.
+Rgb intensity(const Node& s, const Rgb& power, const RgbVec& moment, const Vec3& omega) {
+  const Rgb along = moment.dot(omega);
+  const Facing side = facing(s, omega);
+  Rgb out;
+  for (int k = 0; k < 3; ++k) {
+    const float x =
+        side == Facing::front ? along[k] : (side == Facing::back ? 0.0f : 0.25f * power[k] + 0.5f * along[k]);
+    out[k] = std::max(0.0f, x) * (1.0f / kPi);
+  }
+  return out;
+}
+
+/// What a node sends towards (or receives from) unit direction ω, by the cluster models above:
+/// `total` is Σ x_k A_k and `moment` Σ x_k A_k n_k for some per-element x (radiosity, or 1).
+float towards(const Node& node, float total, const Vec3& moment, const Vec3& omega) {
+  const float along = glm::dot(omega, moment);
+  switch (facing(node, omega)) {
+    case Facing::front:
+      return std::max(0.0f, along);
+    case Facing::back:
+      return 0.0f;
+    case Facing::mixed:
+      break;
+  }
+  return std::max(0.0f, 0.25f * total + 0.5f * along);
+}
+
+/// A point for a visibility ray on node `s`'s elements. The element is drawn by walking down
+/// the tree, each child taken in proportion to weight(child) (what it exchanges with the other
+/// end of the ray), so that the ray tests the part of a cluster that carries the light: a
+/// cluster holding a bright roof and a dark plate under it must not be seen through the plate.
+/// Children that both weigh nothing are taken by area. Uniform by area within the element.
+template <class Weight>
+rc::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint32_t s, Weight weight,
+                              rc::Rng& rng) {
+  while (!tree.nodes[s].leaf()) {
+    const uint32_t a = s + 1, b = tree.nodes[s].right;
+    float wa = weight(a), wb = weight(b);
+    if (!(wa + wb > 0.0f)) wa = tree.nodes[a].area, wb = tree.nodes[b].area;
+    s = rng.uniform() * (wa + wb) < wa ? a : b;
+  }
+  const uint32_t e = tree.element(tree.nodes[s]);
+  const rc::Vec2 b = rc::sample_uniform_triangle(rng.uniform2());
+  const auto& el = mesh.elements[e];
+  const Vec3 q =
+      (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
+  return mesh_surface_point(q, mesh.element_normal[e]);
+}
+
+/// A link: node `receiver` gathers from node `source`. Far links give the irradiance facing the
+/// source, I_S(−dir)·factor with factor = V / r²; exact links (element to element) give
+/// B_S·factor with factor = F·V, along the receiver's normal.
+struct Link {
+  uint32_t receiver, source;
+  Vec3 dir;
+  float factor;
+  bool exact;
+};
+
+struct Counters {
+  std::atomic<uint64_t> rays{0}, form_factors{0}, gather_nodes{0};
+};
+
+class Linker {
+ public:
+  Linker(const HierarchicalInput& in, const Tree& tree, std::span<const float> power_estimate,
+         std::span<const Vec3> moment_estimate, double epsilon, const HierarchicalSettings& settings,
+         Counters& counters)
+      : in_(in),
+        tree_(tree),
+        power_(power_estimate),
+        moment_(moment_estimate),
+        epsilon_(epsilon),
+        settings_(settings),
+        counters_(counters) {}
+
+  std::vector<Link> link() {
+    if (tree_.nodes.empty()) return {};
+    // Breadth-first from the root pair until there are enough pairs to share out, then each
+    // pair's refinement runs on its own, its links appended in pair order (deterministic).
+    std::vector<std::pair<uint32_t, uint32_t>> frontier{{0, 0}}, next;
+    std::vector<Link> links;
+    while (!frontier.empty() && frontier.size() < 4096) {
+      next.clear();
+      for (const auto& [r, s] : frontier) refine(r, s, links, next);
+      frontier.swap(next);
+    }
+    std::vector<std::vector<Link>> parts(frontier.size());
+    rc::parallel_for(frontier.size(), [&](size_t i) {
+      std::vector<std::pair<uint32_t, uint32_t>> stack{frontier[i]};
+      while (!stack.empty()) {
+        const auto [r, s] = stack.back();
+        stack.pop_back();
+        refine(r, s, parts[i], stack);
+      }
+    });
+    for (auto& part : parts) links.insert(links.end(), part.begin(), part.end());
+    return links;
+  }
+
+ private:
+  /// Accepts, drops or splits the pair (r, s): accepted links go to `links`, halves to `pending`.
+  void refine(uint32_t r, uint32_t s, std::vector<Link>& links,
+              std::vector<std::pair<uint32_t, uint32_t>>& pending) {
+    const Node& R = tree_.nodes[r];
+    const Node& S = tree_.nodes[s];
+    if (r == s) {
+      if (R.leaf()) return;
+      const uint32_t kids[2] = {r + 1, R.right};
+      for (uint32_t a : kids)
+        for (uint32_t b : kids) pending.emplace_back(a, b);
+      return;
+    }
+    // Nothing to gather: the receiver reflects nothing, the source sends nothing, or they face away.
+    if (!(R.albedo > 0.0f) || !(power_[s] > 0.0f) || behind(R, S) || behind(S, R)) return;
+    if (R.leaf() && S.leaf()) {
+      const uint32_t er = tree_.element(R), es = tree_.element(S);
+      ++counters_.form_factors;
+      const float f = float(tree_.triangles[es].form_factor(R.center, in_.mesh.element_normal[er]));
+      if (f > 0.0f) add(r, s, in_.mesh.element_normal[er], f, true, links);
+      return;
+    }
+    const Vec3 d = S.center - R.center;
+    const float dist = glm::length(d), gap = dist - R.radius - S.radius;
+    const Facing receiving = facing(R, d / dist), sending = facing(S, -d / dist);
+    if (gap > 0.0f) {
+      // Every segment between the two leaves R within asin((r_R + r_S) / |d|) of d: an end
+      // that faces away from all of them exchanges nothing.
+      const float margin = (R.radius + S.radius) / dist;
+      if (facing(R, d / dist, margin) == Facing::back || facing(S, -d / dist, margin) == Facing::back) return;
+      const double bound = std::min(1.0, double(S.area) / (double(kPi) * gap * gap));
+      double error = double(R.albedo) * R.area * bound * power_[s] / S.area;
+      // Both ends wholly facing each other: the models are exact up to the point-source error.
+      if (receiving == Facing::front && sending == Facing::front)
+        error *= std::min(1.0, std::pow(double(R.radius + S.radius) / gap, 2.0));
+      if (error <= epsilon_) {
+        add(r, s, d / dist, 1.0f / (dist * dist), false, links);
+        return;
+      }
+    }
+    // Split the larger end (a leaf cannot be split).
+    const bool split_receiver = S.leaf() || (!R.leaf() && R.radius >= S.radius);
+    if (split_receiver) {
+      pending.emplace_back(r + 1, s);
+      pending.emplace_back(R.right, s);
+    } else {
+      pending.emplace_back(r, s + 1);
+      pending.emplace_back(r, S.right);
+    }
+  }
+
+  /// Adds the link with its visible fraction (dropped when nothing is visible).
+  void add(uint32_t r, uint32_t s, const Vec3& dir, float factor, bool exact, std::vector<Link>& links) {
+    const Node& R = tree_.nodes[r];
+    const Node& S = tree_.nodes[s];
+    rc::Bounds3 both = R.box;
+    both.extend(S.box);
+    float visible = 1.0f;
+    if (in_.may_be_blocked(both)) {
+      rc::Rng rng = rc::Rng::for_item(settings_.seed, r, 0x5100000000ull + s);
+      const int n = std::max(1, settings_.link_rays);
+      int open = 0;
+      // The receiving end by what it faces towards the source, the source by what it sends.
+      const Vec3 w = glm::normalize(S.center - R.center);
+      auto receives = [&](uint32_t c) {
+        return towards(tree_.nodes[c], tree_.nodes[c].area, tree_.nodes[c].area_vector, w);
+      };
+      auto sends = [&](uint32_t c) { return towards(tree_.nodes[c], power_[c], moment_[c], -w); };
+      for (int i = 0; i < n; ++i) {
+        const rc::SurfacePoint a = sample_point(tree_, in_.mesh, r, receives, rng);
+        const rc::SurfacePoint b = sample_point(tree_, in_.mesh, s, sends, rng);
+        open += !in_.geometry.occluded(rc::spawn_shadow_ray(a, b));
+      }
+      counters_.rays += uint64_t(n);
+      visible = float(open) / float(n);
+    }
+    if (!(visible > 0.0f)) return;
+    if (exact) {
+      links.push_back({r, s, dir, factor * visible, true});
+      return;
+    }
+    split_mixed(r, s, 0, 0, visible, links);
+  }
+
+  /// Emits the far link (r, s), or, where an end has elements facing both ways (where the
+  /// cluster models are only approximate), links between its children instead, down to
+  /// kMixedDepth levels; parts that face away are dropped. All share the pair's visibility.
+  void split_mixed(uint32_t r, uint32_t s, int r_depth, int s_depth, float visible,
+                   std::vector<Link>& links) const {
+    const Node& R = tree_.nodes[r];
+    const Node& S = tree_.nodes[s];
+    const Vec3 d = S.center - R.center;
+    const float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) return;
+    const Vec3 w = d / std::sqrt(dist2);
+    const Facing receiving = facing(R, w), sending = facing(S, -w);
+    if (receiving == Facing::back || sending == Facing::back) return;
+    if (receiving == Facing::mixed && !R.leaf() && r_depth < kMixedDepth) {
+      split_mixed(r + 1, s, r_depth + 1, s_depth, visible, links);
+      split_mixed(R.right, s, r_depth + 1, s_depth, visible, links);
+    } else if (sending == Facing::mixed && !S.leaf() && s_depth < kMixedDepth) {
+      split_mixed(r, s + 1, r_depth, s_depth + 1, visible, links);
+      split_mixed(r, S.right, r_depth, s_depth + 1, visible, links);
+    } else {
+      links.push_back({r, s, w, visible / dist2, false});
+    }
+  }
+
+  const HierarchicalInput& in_;
+  const Tree& tree_;
+  std::span<const float> power_;
+  std::span<const Vec3> moment_;
+  double epsilon_;
+  const HierarchicalSettings& settings_;
+  Counters& counters_;
+};
+
+/// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
+void pull(const Tree& tree, const RadiosityMesh& mesh, std::span<const Rgb> radiosity,
+          std::vector<Rgb>& power, std::vector<RgbVec>& moment) {
+  const size_t n = tree.nodes.size();
+  power.assign(n, Rgb(0.0f));
+  moment.assign(n, RgbVec{});
+  for (size_t i = n; i-- > 0;) {
+    const Node& node = tree.nodes[i];
+    if (node.leaf()) {
+      const uint32_t e = tree.element(node);
+      power[i] = radiosity[e] * mesh.element_area[e];
+      moment[i].add(power[i], mesh.element_normal[e]);
+    } else {
+      for (size_t c : {i + 1, size_t(node.right)}) {
+        power[i] += power[c];
+        moment[i].add(moment[c]);
+      }
+    }
+  }
+}
+
+/// What a node has gathered: the irradiance vector of flat receivers, and the two bands of
+/// curved ones (Σ J and Σ J w).
+struct Gathered {
+  RgbVec flat;
+  Rgb sum{0.0f};
+  RgbVec band1;
+};
+
+Rgb irradiance_at(const Gathered& g, const Vec3& n) {
+  Rgb out = g.flat.dot(n);
+  const Rgb b1 = g.band1.dot(n);
+  for (int k = 0; k < 3; ++k)
+    out[k] = std::max(0.0f, out[k] + std::max(0.0f, 0.25f * g.sum[k] + 0.5f * b1[k]));
+  return out;
+}
+
+}  // namespace
+
+HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const HierarchicalSettings& settings) {
+  const RadiosityMesh& mesh = in.mesh;
+  const size_t ne = mesh.element_count(), nv = mesh.vertex_count();
+  HierarchicalResult result;
+  result.vertex_irradiance.assign(nv, Rgb(0.0f));
+  if (ne == 0) return result;
+  auto out_of_time = [&] { return in.out_of_time && in.out_of_time(); };
+  Counters counters;
+
+  const Tree tree = TreeBuilder(mesh, in.albedo).build();
+  result.nodes = tree.nodes.size();
+
+  // Direct irradiance per element (mean of its vertices) and the first reflected radiosity.
+  std::vector<Rgb> direct(ne), radiosity(ne);
+  double reflected = 0.0, area = 0.0, albedo = 0.0;
+  for (size_t e = 0; e < ne; ++e) {
+    const auto& el = mesh.elements[e];
+    direct[e] = (in.direct_irradiance[el[0]] + in.direct_irradiance[el[1]] + in.direct_irradiance[el[2]]) *
+                (1.0f / 3.0f);
+    radiosity[e] = in.albedo[e] * direct[e];
+    reflected += double(radiosity[e].average()) * mesh.element_area[e];
+    area += mesh.element_area[e];
+    albedo += double(in.albedo[e].average()) * mesh.element_area[e];
+  }
+  if (!(reflected > 0.0)) return result;
+
+  // The oracle's estimate of each element's reflected radiosity: the first bounce plus the
+  // later ones spread evenly, (mean first-bounce radiosity) / (1 − ρ̄) as irradiance.
+  const double mean_albedo = std::min(0.95, albedo / area);
+  const float ambient = float(reflected / area / (1.0 - mean_albedo));
+  std::vector<float> power_estimate(tree.nodes.size(), 0.0f);
+  std::vector<Vec3> moment_estimate(tree.nodes.size(), Vec3(0.0f));
+  double total_estimate = 0.0;
+  for (size_t i = tree.nodes.size(); i-- > 0;) {
+    const Node& node = tree.nodes[i];
+    if (node.leaf()) {
+      const uint32_t e = tree.element(node);
+      power_estimate[i] = (in.albedo[e] * (direct[e] + Rgb(ambient))).average() * mesh.element_area[e];
+      moment_estimate[i] = power_estimate[i] * mesh.element_normal[e];
+      total_estimate += power_estimate[i];
+    } else {
+      power_estimate[i] = power_estimate[i + 1] + power_estimate[node.right];
+      moment_estimate[i] = moment_estimate[i + 1] + moment_estimate[node.right];
+    }
+  }
+
+  // Links, grouped by receiver for gathering.
+  std::vector<Link> links = Linker(in, tree, power_estimate, moment_estimate,
+                                   settings.link_tolerance * total_estimate, settings, counters)
+                                .link();
+  std::stable_sort(links.begin(), links.end(),
+                   [](const Link& a, const Link& b) { return a.receiver < b.receiver; });
+  result.links = links.size();
+  std::vector<uint32_t> receivers, first_link;
+  for (uint32_t i = 0; i < links.size(); ++i)
+    if (i == 0 || links[i].receiver != links[i - 1].receiver)
+      receivers.push_back(links[i].receiver), first_link.push_back(i);
+  first_link.push_back(uint32_t(links.size()));
+
+  // Jacobi iteration: pull B up the tree, gather over the links, push the gathered irradiance
+  // down to the elements, and reflect it.
+  std::vector<Rgb> power, indirect(ne, Rgb(0.0f));
+  std::vector<RgbVec> moment;
+  std::vector<Gathered> gathered(tree.nodes.size());
+  std::vector<Rgb> next(ne);
+  for (int it = 0; it < settings.max_iterations; ++it) {
+    if (out_of_time()) break;
+    pull(tree, mesh, radiosity, power, moment);
+    std::fill(gathered.begin(), gathered.end(), Gathered{});
+    rc::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
+      for (size_t g = chunk * 64; g < std::min(receivers.size(), chunk * 64 + 64); ++g) {
+        const Node& R = tree.nodes[receivers[g]];
+        Gathered& acc = gathered[receivers[g]];
+        for (uint32_t l = first_link[g]; l < first_link[g + 1]; ++l) {
+          const Link& link = links[l];
+          const Node& S = tree.nodes[link.source];
+          const Rgb j = link.exact
+                            ? power[link.source] * (link.factor / S.area)
+                            : intensity(S, power[link.source], moment[link.source], -link.dir) * link.factor;
+          const Facing side = facing(R, link.dir);
+          if (side == Facing::front) {
+            acc.flat.add(j, link.dir);
+          } else if (side == Facing::mixed) {
+            acc.sum += j;
+            acc.band1.add(j, link.dir);
+          }
+        }
+      }
+    });
+    for (size_t i = 0; i < tree.nodes.size(); ++i) {
+      const Node& node = tree.nodes[i];
+      if (node.leaf()) continue;
+      for (size_t c : {i + 1, size_t(node.right)}) {
+        gathered[c].flat.add(gathered[i].flat);
+        gathered[c].sum += gathered[i].sum;
+        gathered[c].band1.add(gathered[i].band1);
+      }
+    }
+    double change = 0.0, total = 0.0;
+    for (const Node& node : tree.nodes) {
+      if (!node.leaf()) continue;
+      const uint32_t e = tree.element(node);
+      indirect[e] = irradiance_at(gathered[&node - tree.nodes.data()], mesh.element_normal[e]);
+      next[e] = in.albedo[e] * (direct[e] + indirect[e]);
+      const Rgb delta = next[e] - radiosity[e];
+      change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e];
+      total += double(next[e].average()) * mesh.element_area[e];
+    }
+    radiosity.swap(next);
+    ++result.iterations;
+    result.residual = total > 0.0 ? change / total : 0.0;
+    if (result.residual < settings.tolerance) break;
+  }
+  pull(tree, mesh, radiosity, power, moment);
+
+  // Vertices first take the area-weighted mean of their elements' gathered irradiance; the
+  // final gather then replaces it while time allows.
+  {
+    std::vector<double> weight(nv, 0.0);
+    std::vector<Rgb> sum(nv, Rgb(0.0f));
+    for (size_t e = 0; e < ne; ++e)
+      for (uint32_t v : mesh.elements[e])
+        sum[v] += indirect[e] * mesh.element_area[e], weight[v] += mesh.element_area[e];
+    for (size_t v = 0; v < nv; ++v)
+      if (weight[v] > 0.0) result.vertex_irradiance[v] = sum[v] * float(1.0 / weight[v]);
+  }
+  double mean_indirect = 0.0;
+  for (size_t e = 0; e < ne; ++e) mean_indirect += double(indirect[e].average()) * mesh.element_area[e];
+  mean_indirect /= area;
+
+  // Final gather: each vertex walks the tree from the root, taking a cluster whole when the
+  // irradiance it may carry wrongly is below gather_tolerance of the vertex's own indirect
+  // irradiance (at least 5 % of the scene's mean), and elements by Lambert's formula.
+  std::atomic<bool> stopped{false};
+  rc::parallel_for((nv + 63) / 64, [&](size_t chunk) {
+    if (stopped.load(std::memory_order_relaxed) || out_of_time()) {
+      stopped = true;
+      return;
+    }
+    uint64_t rays = 0, evaluated = 0, form_factors = 0;
+    std::vector<uint32_t> stack;
+    for (size_t v = chunk * 64; v < std::min(nv, chunk * 64 + 64); ++v) {
+      const rc::SurfacePoint& at = in.vertex_point[v];
+      const Vec3 p = at.p, n = mesh.normals[v];
+      const double epsilon = settings.gather_tolerance *
+                             std::max(double(result.vertex_irradiance[v].average()), 0.05 * mean_indirect);
+      rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5200000000ull);
+      Rgb e_sum(0.0f);
+      stack.assign(1, 0u);
+      while (!stack.empty()) {
+        const uint32_t s = stack.back();
+        stack.pop_back();
+        const Node& S = tree.nodes[s];
+        ++evaluated;
+        if (!(power[s].average() > 0.0f) || sends_nothing(S, p, n)) continue;
+        Rgb value(0.0f);
+        if (S.leaf()) {
+          ++form_factors;
+          const uint32_t e = tree.element(S);
+          const float f = float(tree.triangles[e].form_factor(p, n));
+          if (!(f > 0.0f)) continue;
+          value = radiosity[e] * f;
+        } else {
+          const Vec3 d = S.center - p;
+          const float dist = glm::length(d), gap = dist - S.radius;
+          bool accept = false;
+          if (gap > 0.0f) {
+            const double bound = std::min(1.0, double(S.area) / (double(kPi) * gap * gap));
+            double error = bound * power[s].average() / S.area;
+            if (facing(S, -d / dist) == Facing::front)
+              error *= std::min(1.0, std::pow(double(S.radius) / gap, 2.0));
+            accept = error <= epsilon;
+          }
+          if (!accept) {
+            stack.push_back(S.right);
+            stack.push_back(s + 1);
+            continue;
+          }
+          const float cos_receiver = glm::dot(n, d) / dist;
+          if (!(cos_receiver > 0.0f)) continue;
+          value = intensity(S, power[s], moment[s], -d / dist) * (cos_receiver / (dist * dist));
+        }
+        rc::Bounds3 reach = S.box;
+        reach.extend(p);
+        if (in.may_be_blocked(reach)) {
+          ++rays;
+          const Vec3 omega = glm::normalize(p - S.center);
+          auto sends = [&](uint32_t c) {
+            const RgbVec& m = moment[c];
+            return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f),
+                           omega);
+          };
+          if (in.geometry.occluded(rc::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng))))
+            continue;
+        }
+        e_sum += value;
+      }
+      result.vertex_irradiance[v] = e_sum;
+    }
+    counters.rays += rays;
+    counters.gather_nodes += evaluated;
+    counters.form_factors += form_factors;
+  });
+  result.final_gather = !stopped;
+  result.shadow_rays = counters.rays;
+  result.form_factors = counters.form_factors;
+  result.gather_nodes = counters.gather_nodes;
+  return result;
+}
+
+}  // namespace gilt::radiosity

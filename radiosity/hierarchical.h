@@ -1,0 +1,66 @@
+#pragma once
+// Hierarchical radiosity with clustering for the light reflected between diffuse surfaces:
+// links between element clusters at the level an error oracle accepts (Hanrahan, Salzman &
+// Aupperle 1991), clusters over whole surfaces so that linking starts from one root pair rather
+// than every pair of patches (Smits, Arvo & Greenberg 1994; Sillion 1995), gathering with
+// push–pull, and a final gather at the mesh vertices (Lischinski, Tampieri & Greenberg 1993).
+// The direct light (punctual lights, sky, emitting elements) is computed by the caller with
+// shadow rays at every vertex; this pass adds what it leaves out: every later bounce.
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "radiosity/mesh.h"
+#include "raytrace_core/rgb.h"
+
+namespace gilt::radiosity {
+
+using rc::Rgb;
+
+/// Parameters of the hierarchical pass; the defaults are the documented defaults.
+struct HierarchicalSettings {
+  /// A link is accepted when the power it may carry wrongly is below this fraction of the
+  /// scene's reflected power (the BF·A oracle, with the point-source error (size/distance)²).
+  double link_tolerance = 2e-6;
+  /// A cluster stands in for its elements in the vertex final gather when the irradiance it may
+  /// carry wrongly is below this fraction of the local indirect irradiance.
+  double gather_tolerance = 0.02;
+  int link_rays = 4;        ///< shadow rays per link (between random points of the two ends)
+  double tolerance = 1e-3;  ///< stop iterating when the solution changes by less than this (relative)
+  int max_iterations = 200;
+  uint64_t seed = 0;
+};
+
+/// What the pass needs to know of the scene: the mesh, the scene its visibility rays are traced
+/// against (element_scene()), where each vertex receives, each element's reflectance and each
+/// vertex's direct irradiance.
+struct HierarchicalInput {
+  const RadiosityMesh& mesh;
+  const rc::Scene& geometry;
+  std::span<const rc::SurfacePoint> vertex_point;  ///< per vertex: receiver point (see receiver_points)
+  std::span<const Rgb> albedo;                     ///< per element
+  std::span<const Rgb> direct_irradiance;          ///< per vertex, W·m⁻²
+  /// Whether a segment between the two boxes' contents may be blocked at all (false: no rays).
+  std::function<bool(const rc::Bounds3&)> may_be_blocked;
+  /// Called between steps; returning true stops the pass early (the result is then partial).
+  std::function<bool()> out_of_time;
+};
+
+/// The reflected (indirect) irradiance at every vertex, and what it took.
+struct HierarchicalResult {
+  std::vector<Rgb> vertex_irradiance;  ///< indirect only, W·m⁻²
+  size_t nodes = 0, links = 0;
+  int iterations = 0;
+  double residual = 0.0;  ///< relative change of the last iteration
+  uint64_t shadow_rays = 0, form_factors = 0;
+  uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated
+  bool final_gather = true;   ///< false when time ran out before it (vertices then take their elements' mean)
+};
+
+/// Solves the interreflection above the given direct light: links, iterates to `tolerance`,
+/// then gathers at every vertex from the cluster hierarchy.
+HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const HierarchicalSettings& settings);
+
+}  // namespace gilt::radiosity
