@@ -8,14 +8,18 @@
 //                   remains. Prints the curve, the floor each measure cannot go below, and the
 //                   time it takes to reach 1 % (target: under 2 s on two cores).
 //   --form-factors  point_to_triangle_form_factor per second, a Google Benchmark on one thread.
-//   --scaling       solve cost at 1k, 10k and 100k elements on `cornell`, each run given about
-//                   20 s of shooting: shots, form factors and shadow rays per second, residual.
+//   --scaling       progressive refinement's cost at 1k, 10k and 100k elements on `cornell`, each
+//                   run given about 20 s of shooting: shots, form factors and shadow rays per
+//                   second, residual.
+//   --hierarchical  the hierarchical solver's whole run at 10k, 100k and 1M elements on `cornell`
+//                   (--largest=N stops after N): nodes, links, iterations, time, the growth exponent
+//                   of the time and the peak memory.
 //
 // Other options: --out-dir=DIR (default out/bench) for the CSV files and the cached references,
 // --reference-spp=N (default 32768) for the references' samples per pixel, --fresh-reference to
 // render them again, --repeats=N (default 3) timed runs of each sweep point, of which the median
 // time is reported, --subdivision-levels=N to override the solver's adaptive subdivision (0:
-// none). The sweep also writes radiosity_error_<elements>.png: per-pixel relative error against
+// none), --solver=progressive|hierarchical for the sweep (default: auto). The sweep also writes radiosity_error_<elements>.png: per-pixel relative error against
 // the centre reference, 10 % white. Google Benchmark flags apply to the form-factor part. Every part checks its
 // results before it reports a time, and stops with a message when they are wrong.
 
@@ -28,6 +32,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <sys/resource.h>
 #include <fstream>
 #include <functional>
 #include <optional>
@@ -205,10 +210,12 @@ double median(std::vector<double> values) {
 
 /// Adaptive subdivision levels for every solve (--subdivision-levels=N; default: the solver's).
 int g_subdivision_levels = rad::SolverSettings{}.subdivision_levels;
+rad::SolverKind g_solver = rad::SolverKind::automatic;
 
 rad::SolverSettings solver_settings(int elements) {
   rad::SolverSettings s;
   s.subdivision_levels = g_subdivision_levels;
+  s.solver = g_solver;
   s.mesh.elements = elements;
   s.tolerance = kTolerance;
   s.threads = 0;
@@ -537,6 +544,7 @@ void run_scaling(const fs::path& out_dir) {
   double shots_per_element = 0.0;  // of the largest run that converged
   for (int requested : kScalingElements) {
     rad::SolverSettings settings = solver_settings(requested);
+    settings.solver = rad::SolverKind::progressive;  // this part measures shooting
     // The element count is the variable here: no adaptive subdivision, which would add elements.
     settings.subdivision_levels = 0;
     // solve() meshes too, and its time limit counts from its start: meshing is timed on its own
@@ -585,11 +593,67 @@ void run_scaling(const fs::path& out_dir) {
           shots_per_element, run.elements, shots_per_element * double(run.elements) / run.shots_per_second);
 }
 
+// ================================================================================================
+// Part 4: the hierarchical solver's whole run (meshing, direct light, linking, iteration, final
+// gather) against the element count, with its growth exponent and peak memory.
+
+constexpr int kHierarchicalElements[] = {10000, 100000, 1000000};
+
+/// Peak resident memory of this process so far, in GiB.
+double peak_gib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) / (1024.0 * 1024.0);  // ru_maxrss is in KiB on Linux
+}
+
+void run_hierarchical(const fs::path& out_dir, int largest) {
+  const rc::Scene scene = rc::load_scene("cornell");
+  std::printf("\n== Hierarchical solve against element count on cornell (tolerance %g, no subdivision) ==\n",
+              kTolerance);
+  std::printf("  %9s %8s %8s %9s %10s %5s %9s %8s %8s %8s %9s\n", "requested", "elements", "vertices", "nodes",
+              "links", "iter", "residual", "total s", "exponent", "peak GiB", "rays/s");
+  std::ofstream csv(out_dir / "radiosity_hierarchical.csv");
+  csv << "requested_elements,elements,vertices,nodes,links,iterations,residual,seconds,peak_gib,shadow_rays\n";
+  double last_elements = 0.0, last_seconds = 0.0;
+  for (int requested : kHierarchicalElements) {
+    if (requested > largest) break;
+    rad::SolverSettings settings = solver_settings(requested);
+    settings.solver = rad::SolverKind::hierarchical;
+    settings.subdivision_levels = 0;
+    const auto start = std::chrono::steady_clock::now();
+    const rad::Solution sol = rad::solve(scene, settings);
+    const double seconds = seconds_since(start);
+    for (const rc::Rgb& b : sol.vertex_radiosity)
+      if (!(b.r >= 0.0f && b.g >= 0.0f && b.b >= 0.0f && std::isfinite(b.r + b.g + b.b)))
+        fail("negative or non-finite radiosity at " + std::to_string(requested) + " elements");
+    if (!(sol.residual < kTolerance) || !sol.final_gather)
+      fail("the hierarchical solve of " + std::to_string(requested) + " elements did not converge");
+    const double elements = double(sol.mesh.element_count());
+    const double exponent =
+        last_elements > 0.0 ? std::log(seconds / last_seconds) / std::log(elements / last_elements) : 0.0;
+    std::printf("  %9d %8zu %8zu %9zu %10zu %5d %9.2e %8.2f %8s %8.2f %9.3e\n", requested, sol.mesh.element_count(),
+                sol.mesh.vertex_count(), sol.nodes, sol.links, sol.iterations, sol.residual, seconds,
+                last_elements > 0.0 ? std::to_string(exponent).substr(0, 5).c_str() : "-", peak_gib(),
+                double(sol.shadow_rays) / seconds);
+    std::fflush(stdout);
+    char line[320];
+    std::snprintf(line, sizeof line, "%d,%zu,%zu,%zu,%zu,%d,%.6e,%.4f,%.4f,%llu\n", requested,
+                  sol.mesh.element_count(), sol.mesh.vertex_count(), sol.nodes, sol.links, sol.iterations,
+                  sol.residual, seconds, peak_gib(), (unsigned long long)sol.shadow_rays);
+    csv << line;
+    last_elements = elements, last_seconds = seconds;
+  }
+  if (!csv) fail("cannot write " + (out_dir / "radiosity_hierarchical.csv").string());
+  std::printf("  total s: meshing, direct light, linking, iteration and the vertex final gather; exponent: of\n"
+              "  the time against the element count since the previous row\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  bool sweep = false, form_factors = false, scaling = false, fresh_reference = false;
+  bool sweep = false, form_factors = false, scaling = false, hierarchical = false, fresh_reference = false;
+  int largest = 1000000;
   int half_spp = kHalfSpp;
   fs::path out_dir = "out/bench";
   for (int i = 1; i < argc; ++i) {
@@ -600,6 +664,14 @@ int main(int argc, char** argv) {
       form_factors = true;
     else if (arg == "--scaling")
       scaling = true;
+    else if (arg == "--hierarchical")
+      hierarchical = true;
+    else if (arg.starts_with("--largest="))
+      largest = std::max(1, std::atoi(argv[i] + 10));
+    else if (arg == "--solver=progressive")
+      g_solver = rad::SolverKind::progressive;
+    else if (arg == "--solver=hierarchical")
+      g_solver = rad::SolverKind::hierarchical;
     else if (arg.starts_with("--subdivision-levels="))
       g_subdivision_levels = std::max(0, std::atoi(argv[i] + 21));
     else if (arg.starts_with("--repeats="))
@@ -611,9 +683,9 @@ int main(int argc, char** argv) {
     else if (arg.starts_with("--reference-spp="))
       half_spp = std::max(1, std::atoi(argv[i] + 16) / 2);
     else
-      fail("unknown option '" + std::string(arg) + "' (parts: --sweep --form-factors --scaling)");
+      fail("unknown option '" + std::string(arg) + "' (parts: --sweep --form-factors --scaling --hierarchical)");
   }
-  if (!sweep && !form_factors && !scaling) sweep = form_factors = scaling = true;
+  if (!sweep && !form_factors && !scaling && !hierarchical) sweep = form_factors = scaling = hierarchical = true;
   fs::create_directories(out_dir);
 
   const auto start = std::chrono::steady_clock::now();
@@ -621,6 +693,7 @@ int main(int argc, char** argv) {
   if (form_factors) run_form_factors();
   if (sweep) run_sweep(out_dir, half_spp, fresh_reference);
   if (scaling) run_scaling(out_dir);
+  if (hierarchical) run_hierarchical(out_dir, largest);
   std::printf("\nbench_radiosity: done in %.0f s\n", seconds_since(start));
   benchmark::Shutdown();
   return EXIT_SUCCESS;
