@@ -471,7 +471,125 @@ Rgb irradiance_at(const Gathered& g, const Vec3& n) {
   return out;
 }
 
+struct WalkCounts {
+  uint64_t rays = 0, nodes = 0, form_factors = 0;
+};
+
+/// Irradiance at a vertex from every element's radiosity, by a walk down the tree: a cluster is
+/// taken whole, as a point source seen through `rays` shadow rays, when the irradiance it may carry
+/// wrongly (F̂ B times the point-source error (r/d)², or all of it where its elements face both
+/// ways) is below `epsilon`; an element by Lambert's formula. With more than one ray, a probe of
+/// min(rays, 4) that finds the node partly hidden is extended to `rays`.
+struct TreeWalk {
+  const HierarchicalInput& in;
+  const Tree& tree;
+  std::span<const Rgb> radiosity;  ///< per element
+  const std::vector<Rgb>& power;
+  const std::vector<RgbVec>& moment;
+
+  Rgb irradiance(size_t v, double epsilon, int rays, rc::Rng& rng, std::vector<uint32_t>& stack,
+                 WalkCounts& counts) const {
+    const RadiosityMesh& mesh = in.mesh;
+    const rc::SurfacePoint& at = in.vertex_point[v];
+    const Vec3 p = at.p, n = mesh.normals[v];
+    Rgb sum(0.0f);
+    stack.assign(1, 0u);
+    while (!stack.empty()) {
+      const uint32_t s = stack.back();
+      stack.pop_back();
+      const Node& S = tree.nodes[s];
+      ++counts.nodes;
+      if (!(power[s].average() > 0.0f) || sends_nothing(S, p, n)) continue;
+      Rgb value(0.0f);
+      if (S.leaf()) {
+        ++counts.form_factors;
+        const uint32_t e = tree.element(S);
+        const float f = float(tree.triangles[e].form_factor(p, n));
+        if (!(f > 0.0f)) continue;
+        value = radiosity[e] * f;
+      } else {
+        const Vec3 d = S.center - p;
+        const float dist = glm::length(d), gap = dist - S.radius;
+        bool accept = false;
+        if (gap > 0.0f) {
+          const double bound = std::min(1.0, double(S.area) / (double(kPi) * gap * gap));
+          double error = bound * power[s].average() / S.area;
+          if (facing(S, -d / dist) == Facing::front)
+            error *= std::min(1.0, std::pow(double(S.radius) / gap, 2.0));
+          accept = error <= epsilon;
+        }
+        if (!accept) {
+          stack.push_back(S.right);
+          stack.push_back(s + 1);
+          continue;
+        }
+        const float cos_receiver = glm::dot(n, d) / dist;
+        if (!(cos_receiver > 0.0f)) continue;
+        value = intensity(S, power[s], moment[s], -d / dist) * (cos_receiver / (dist * dist));
+      }
+      rc::Bounds3 reach = S.box;
+      reach.extend(p);
+      if (in.may_be_blocked(reach)) {
+        const Vec3 omega = glm::normalize(p - S.center);
+        auto sends = [&](uint32_t c) {
+          const RgbVec& m = moment[c];
+          return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f),
+                         omega);
+        };
+        auto open = [&](int count) {
+          int hits = 0;
+          for (int i = 0; i < count; ++i)
+            hits += !in.geometry.occluded(rc::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
+          counts.rays += uint64_t(count);
+          return hits;
+        };
+        const int probe = std::min(rays, 4);
+        int hits = open(probe), total = probe;
+        if (hits > 0 && hits < probe && rays > probe) hits += open(rays - probe), total = rays;
+        if (hits == 0) continue;
+        value = value * (float(hits) / float(total));
+      }
+      sum += value;
+    }
+    return sum;
+  }
+};
+
 }  // namespace
+
+std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const Rgb> emitted,
+                                    size_t first_vertex, const HierarchicalSettings& settings, int rays,
+                                    uint64_t* shadow_rays) {
+  const RadiosityMesh& mesh = in.mesh;
+  const size_t ne = mesh.element_count(), nv = mesh.vertex_count();
+  std::vector<Rgb> out(nv, Rgb(0.0f));
+  double total = 0.0, area = 0.0;
+  for (size_t e = 0; e < ne; ++e) {
+    total += double(emitted[e].average()) * mesh.element_area[e];
+    area += mesh.element_area[e];
+  }
+  if (!(total > 0.0) || first_vertex >= nv) return out;
+  const Tree tree = TreeBuilder(mesh, in.albedo).build();
+  std::vector<Rgb> power;
+  std::vector<RgbVec> moment;
+  pull(tree, mesh, emitted, power, moment);
+  const TreeWalk walker{in, tree, emitted, power, moment};
+  // The emitted power spread over every surface: a scale of the direct irradiance.
+  const double epsilon = settings.gather_tolerance * total / area;
+  std::atomic<uint64_t> ray_count{0};
+  const size_t count = nv - first_vertex;
+  rc::parallel_for((count + 63) / 64, [&](size_t chunk) {
+    WalkCounts walk;
+    std::vector<uint32_t> stack;
+    for (size_t v = first_vertex + chunk * 64; v < std::min(nv, first_vertex + chunk * 64 + 64); ++v) {
+      rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5300000000ull);
+      out[v] = walker.irradiance(v, epsilon, rays, rng, stack, walk);
+    }
+    ray_count += walk.rays;
+  });
+  if (shadow_rays) *shadow_rays += ray_count;
+  return out;
+}
 
 HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const HierarchicalSettings& settings) {
   const RadiosityMesh& mesh = in.mesh;
@@ -606,75 +724,25 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // Final gather: each vertex walks the tree from the root, taking a cluster whole when the
   // irradiance it may carry wrongly is below gather_tolerance of the vertex's own indirect
   // irradiance (at least 5 % of the scene's mean), and elements by Lambert's formula.
+  const TreeWalk walker{in, tree, radiosity, power, moment};
   std::atomic<bool> stopped{false};
   rc::parallel_for((nv + 63) / 64, [&](size_t chunk) {
     if (stopped.load(std::memory_order_relaxed) || out_of_time()) {
       stopped = true;
       return;
     }
-    uint64_t rays = 0, evaluated = 0, form_factors = 0;
+    WalkCounts walk;
     std::vector<uint32_t> stack;
     for (size_t v = chunk * 64; v < std::min(nv, chunk * 64 + 64); ++v) {
-      const rc::SurfacePoint& at = in.vertex_point[v];
-      const Vec3 p = at.p, n = mesh.normals[v];
       const double epsilon = settings.gather_tolerance *
                              std::max(double(result.vertex_irradiance[v].average()), 0.05 * mean_indirect);
       rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5200000000ull);
-      Rgb e_sum(0.0f);
-      stack.assign(1, 0u);
-      while (!stack.empty()) {
-        const uint32_t s = stack.back();
-        stack.pop_back();
-        const Node& S = tree.nodes[s];
-        ++evaluated;
-        if (!(power[s].average() > 0.0f) || sends_nothing(S, p, n)) continue;
-        Rgb value(0.0f);
-        if (S.leaf()) {
-          ++form_factors;
-          const uint32_t e = tree.element(S);
-          const float f = float(tree.triangles[e].form_factor(p, n));
-          if (!(f > 0.0f)) continue;
-          value = radiosity[e] * f;
-        } else {
-          const Vec3 d = S.center - p;
-          const float dist = glm::length(d), gap = dist - S.radius;
-          bool accept = false;
-          if (gap > 0.0f) {
-            const double bound = std::min(1.0, double(S.area) / (double(kPi) * gap * gap));
-            double error = bound * power[s].average() / S.area;
-            if (facing(S, -d / dist) == Facing::front)
-              error *= std::min(1.0, std::pow(double(S.radius) / gap, 2.0));
-            accept = error <= epsilon;
-          }
-          if (!accept) {
-            stack.push_back(S.right);
-            stack.push_back(s + 1);
-            continue;
-          }
-          const float cos_receiver = glm::dot(n, d) / dist;
-          if (!(cos_receiver > 0.0f)) continue;
-          value = intensity(S, power[s], moment[s], -d / dist) * (cos_receiver / (dist * dist));
-        }
-        rc::Bounds3 reach = S.box;
-        reach.extend(p);
-        if (in.may_be_blocked(reach)) {
-          ++rays;
-          const Vec3 omega = glm::normalize(p - S.center);
-          auto sends = [&](uint32_t c) {
-            const RgbVec& m = moment[c];
-            return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f),
-                           omega);
-          };
-          if (in.geometry.occluded(rc::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng))))
-            continue;
-        }
-        e_sum += value;
-      }
+      const Rgb e_sum = walker.irradiance(v, epsilon, 1, rng, stack, walk);
       result.vertex_irradiance[v] = e_sum;
     }
-    counters.rays += rays;
-    counters.gather_nodes += evaluated;
-    counters.form_factors += form_factors;
+    counters.rays += walk.rays;
+    counters.gather_nodes += walk.nodes;
+    counters.form_factors += walk.form_factors;
   });
   result.final_gather = !stopped;
   result.shadow_rays = counters.rays;

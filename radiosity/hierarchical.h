@@ -59,6 +59,14 @@ struct HierarchicalResult {
   bool final_gather = true;   ///< false when time ran out before it (vertices then take their elements' mean)
 };
 
+/// Direct irradiance at vertices first_vertex.. from elements that emit `emitted` radiosity
+/// (W·m⁻², per element), by the final gather's walk down a tree of the elements, with `rays`
+/// shadow rays per node in a penumbra (a probe of up to 4 first). Earlier vertices get 0.
+/// `in.direct_irradiance` is not used. Adds the rays traced to *shadow_rays.
+std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const Rgb> emitted,
+                                    size_t first_vertex, const HierarchicalSettings& settings, int rays,
+                                    uint64_t* shadow_rays);
+
 /// Solves the interreflection above the given direct light: links, iterates to `tolerance`,
 /// then gathers at every vertex from the cluster hierarchy.
 HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const HierarchicalSettings& settings);

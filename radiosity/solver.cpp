@@ -521,6 +521,22 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     skipped += c.skipped;
   };
 
+  // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
+  sol.solver = choose_solver(settings, mesh.element_count(), &sol.solver_reason);
+  const bool hierarchical = sol.solver == SolverKind::hierarchical;
+  HierarchicalSettings hs = settings.hierarchical;
+  hs.tolerance = settings.tolerance;
+  hs.seed = settings.seed;
+  auto may_be_blocked = [&](const rc::Bounds3& reach) {
+    return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
+                       [&](const rc::Bounds3& box) { return reach.overlaps(box); });
+  };
+  auto element_albedo = [&] {
+    std::vector<Rgb> out(mesh.element_count());
+    for (size_t e = 0; e < out.size(); ++e) out[e] = albedo(mesh.element_material[e]);
+    return out;
+  };
+
   // Pass 1, direct light: every vertex gathers from the punctual lights and from the emitting
   // patches. Sharp shadows and near-field falloff show up here, so this is where the mesh is
   // refined: elements whose vertices disagree steeply are bisected and only the new vertices
@@ -530,7 +546,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     const Patches patches = build_patches(mesh, settings.patch_elements);
     std::vector<ShootingPatch> emitters;
     std::vector<Rgb> radiosity(mesh.element_count());
-    for (size_t q = 0; q < patches.count(); ++q) {
+    for (size_t q = 0; q < patches.count() && !hierarchical; ++q) {
       if (!is_emitter(patches.of(q)[0])) continue;
       for (uint32_t e : patches.of(q)) radiosity[e] = emitted(mesh.element_material[e]);
       ShootingPatch& sp = emitters.emplace_back();
@@ -559,6 +575,18 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       }
       add_counts(counts);
     });
+    if (hierarchical) {
+      // Emitting elements by the tree walk: the patches above would make this pass cost the
+      // vertex count times the emitter count.
+      std::vector<Rgb> emission(mesh.element_count());
+      for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
+      const std::vector<Rgb> rho = element_albedo();
+      const HierarchicalInput input{mesh, receivers.geometry, receivers.point, rho, {}, may_be_blocked, {}};
+      uint64_t tree_rays = 0;
+      const std::vector<Rgb> e = emitted_irradiance(input, emission, first_vertex, hs, settings.visibility_samples, &tree_rays);
+      for (size_t v = first_vertex; v < nv; ++v) direct_emitted[v] = e[v];
+      rays += tree_rays;
+    }
   };
   gather_direct(0);
   const float base_edge = target_edge_length(scene, settings.mesh);
@@ -679,21 +707,14 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       }
     }
   };
-  sol.solver = choose_solver(settings, ne, &sol.solver_reason);
-  if (sol.solver == SolverKind::hierarchical) {
+  if (hierarchical) {
     // Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex.
-    std::vector<Rgb> element_albedo(ne);
-    for (size_t e = 0; e < ne; ++e) element_albedo[e] = albedo(mesh.element_material[e]);
-    HierarchicalSettings hs = settings.hierarchical;
-    hs.tolerance = settings.tolerance;
-    hs.seed = settings.seed;
-    const HierarchicalInput input{
-        mesh, receivers.geometry, receivers.point, element_albedo, sol.vertex_irradiance,
-        [&](const rc::Bounds3& reach) {
-          return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
-                             [&](const rc::Bounds3& box) { return reach.overlaps(box); });
-        },
-        [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; }};
+    const std::vector<Rgb> rho = element_albedo();
+    const HierarchicalInput input{mesh, receivers.geometry, receivers.point, rho, sol.vertex_irradiance, may_be_blocked,
+                                  [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; }};
+    if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
+                    [](const Rgb& e) { return e.is_black(); }))
+      sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
     const HierarchicalResult h = solve_hierarchical(input, hs);
     for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += h.vertex_irradiance[v];
     sol.nodes = h.nodes;
