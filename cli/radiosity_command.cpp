@@ -96,6 +96,13 @@ void run_radiosity(RadiosityOptions& o) {
                         {"pairs_without_visibility_rays", sol.skipped_pairs},
                         {"convex_enclosure", sol.convex_enclosure},
                         {"seconds", sol.seconds},
+                        {"phase_seconds",
+                         {{"mesh", sol.mesh_seconds},
+                          {"direct", sol.direct_seconds},
+                          {"links", sol.link_seconds},
+                          {"iterations", sol.iterate_seconds},
+                          {"final_gather", sol.gather_seconds},
+                          {"shooting", sol.shoot_seconds}}},
                         {"threads", threads},
                         {"quantity", o.quantity},
                         {"output", o.output}};
@@ -131,7 +138,13 @@ void run_radiosity(RadiosityOptions& o) {
               static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
               static_cast<unsigned long long>(sol.shadow_rays),
               sol.convex_enclosure ? " (convex enclosure: visibility rays skipped)" : "");
-  std::printf("  time:    %.3f s\n", sol.seconds);
+  if (sol.solver == radiosity::SolverKind::hierarchical)
+    std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, links %.3g, iterations %.3g, final gather %.3g)\n",
+                sol.seconds, sol.mesh_seconds, sol.direct_seconds, sol.link_seconds, sol.iterate_seconds,
+                sol.gather_seconds);
+  else
+    std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, shooting %.3g)\n", sol.seconds, sol.mesh_seconds,
+                sol.direct_seconds, sol.shoot_seconds);
   if (check)
     std::printf("  check:   irradiance at %zu vertices against the path tracer (%d samples each): mean relative "
                 "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",

@@ -27,6 +27,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 
@@ -600,6 +601,13 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   auto out_of_time = [&] { return in.out_of_time && in.out_of_time(); };
   Counters counters;
 
+  const auto start = std::chrono::steady_clock::now();
+  auto lap = [&, last = start]() mutable {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - last).count();
+    last = now;
+    return seconds;
+  };
   const Tree tree = TreeBuilder(mesh, in.albedo).build();
   result.nodes = tree.nodes.size();
 
@@ -644,6 +652,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   std::stable_sort(links.begin(), links.end(),
                    [](const Link& a, const Link& b) { return a.receiver < b.receiver; });
   result.links = links.size();
+  result.link_seconds = lap();
   std::vector<uint32_t> receivers, first_link;
   for (uint32_t i = 0; i < links.size(); ++i)
     if (i == 0 || links[i].receiver != links[i - 1].receiver)
@@ -705,6 +714,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     if (result.residual < settings.tolerance) break;
   }
   pull(tree, mesh, radiosity, power, moment);
+  result.iterate_seconds = lap();
 
   // Vertices first take the area-weighted mean of their elements' gathered irradiance; the
   // final gather then replaces it while time allows.
@@ -745,6 +755,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     counters.form_factors += walk.form_factors;
   });
   result.final_gather = !stopped;
+  result.gather_seconds = lap();
   result.shadow_rays = counters.rays;
   result.form_factors = counters.form_factors;
   result.gather_nodes = counters.gather_nodes;

@@ -57,6 +57,7 @@ struct HierarchicalResult {
   uint64_t shadow_rays = 0, form_factors = 0;
   uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated
   bool final_gather = true;   ///< false when time ran out before it (vertices then take their elements' mean)
+  double link_seconds = 0.0, iterate_seconds = 0.0, gather_seconds = 0.0;  ///< tree and links; iterations; final gather
 };
 
 /// Direct irradiance at vertices first_vertex.. from elements that emit `emitted` radiosity

@@ -507,6 +507,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
 
   Solution sol;
   sol.mesh = build_mesh(scene, settings.mesh, &sol.mesh_report);
+  sol.mesh_seconds = elapsed();
   RadiosityMesh& mesh = sol.mesh;
   Receivers receivers(scene, mesh);
   sol.convex_enclosure = receivers.occluders.empty();
@@ -620,6 +621,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.refined_elements += marked.size();
   }
 
+  sol.direct_seconds = elapsed() - sol.mesh_seconds;
   const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
   sol.vertex_irradiance.resize(nv);
   for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
@@ -723,10 +725,14 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.residual = h.residual;
     sol.gather_nodes = h.gather_nodes;
     sol.final_gather = h.final_gather;
+    sol.link_seconds = h.link_seconds;
+    sol.iterate_seconds = h.iterate_seconds;
+    sol.gather_seconds = h.gather_seconds;
     rays += h.shadow_rays;
     form_factors += h.form_factors;
   } else {
     shoot_progressive();
+    sol.shoot_seconds = elapsed() - sol.mesh_seconds - sol.direct_seconds;
   }
 
   sol.vertex_radiosity.resize(nv);

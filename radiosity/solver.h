@@ -80,6 +80,10 @@ struct Solution {
   /// radiosity times the interreflection factor 1 / (1 − ρ̄). Never part of exported values.
   Rgb ambient{0.0f};
   double seconds = 0.0;
+  /// Where the time went: meshing, the direct light with adaptive subdivision, and the
+  /// interreflection (hierarchical: linking, iterating, the final gather; progressive: shooting).
+  double mesh_seconds = 0.0, direct_seconds = 0.0, link_seconds = 0.0, iterate_seconds = 0.0, gather_seconds = 0.0,
+         shoot_seconds = 0.0;
   bool convex_enclosure = false; ///< nothing can occlude (an empty convex room): no visibility rays at all
   MeshReport mesh_report;
 

@@ -3,7 +3,8 @@
 // the floor or stand on it exactly, boxes duplicated in place (coplanar overlaps), and a box
 // that shares a face with another in the same mesh (self-intersecting). For every seed the
 // mesh must be valid (finite positions, unit normals, positive areas), the solution finite and
-// non-negative, and both identical for one and two threads.
+// non-negative, and both identical for one and two threads; every third scene is solved by the
+// hierarchical solver, the others by progressive refinement.
 
 #include <gtest/gtest.h>
 
@@ -91,8 +92,9 @@ Scene random_scene(uint64_t seed) {
   return scene;
 }
 
-Solution solve_with(const Scene& scene, int threads) {
+Solution solve_with(const Scene& scene, int threads, SolverKind solver) {
   SolverSettings settings;
+  settings.solver = solver;
   settings.mesh.elements = 400;
   settings.tolerance = 1e-2;
   settings.subdivision_levels = 1;
@@ -106,9 +108,11 @@ TEST(MesherFuzz, RandomSoupsMeshAndSolveDeterministically) {
   for (uint64_t seed = 0; seed < kSeeds; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const Scene scene = random_scene(seed);
+    // Every third scene goes to the hierarchical solver, the rest to progressive refinement.
+    const SolverKind solver = seed % 3 == 2 ? SolverKind::hierarchical : SolverKind::progressive;
     Solution one, two;
-    ASSERT_NO_THROW(one = solve_with(scene, 1));
-    ASSERT_NO_THROW(two = solve_with(scene, 2));
+    ASSERT_NO_THROW(one = solve_with(scene, 1, solver));
+    ASSERT_NO_THROW(two = solve_with(scene, 2, solver));
     const RadiosityMesh& mesh = one.mesh;
     elements += mesh.element_count();
     contacts += one.mesh_report.contact_edges;
