@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <map>
 #include <optional>
 #include <nlohmann/json.hpp>
 
@@ -173,13 +172,16 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
                  "Radiosity: bisect elements whose direct light spreads by more than this fraction (default 0.6)")
       ->check(CLI::Range(1e-3, 1.0))
       ->check(finite_number());
-  cmd.add_option("--solver", s.solver,
-                 "Radiosity: progressive, hierarchical, or auto (hierarchical from " +
-                     std::to_string(radiosity::kHierarchicalElements) + " elements; default)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, radiosity::SolverKind>{
-          {"auto", radiosity::SolverKind::automatic},
-          {"progressive", radiosity::SolverKind::progressive},
-          {"hierarchical", radiosity::SolverKind::hierarchical}}));
+  cmd.add_option_function<std::string>(
+         "--solver",
+         [&s](const std::string& name) {
+           s.solver = name == "progressive"    ? radiosity::SolverKind::progressive
+                      : name == "hierarchical" ? radiosity::SolverKind::hierarchical
+                                               : radiosity::SolverKind::automatic;
+         },
+         "Radiosity: progressive, hierarchical, or auto (hierarchical from " +
+             std::to_string(radiosity::kHierarchicalElements) + " elements; default)")
+      ->check(CLI::IsMember({"auto", "progressive", "hierarchical"}));
   cmd.add_option("--link-tolerance", s.hierarchical.link_tolerance,
                  "Hierarchical radiosity: accept a link when the power it may carry wrongly is below this fraction "
                  "of the reflected power (default 2e-6)")

@@ -156,6 +156,9 @@ std::vector<NumericFlag> radiosity_flags() {
       {"--exposure", {"inf"}, {"--exposure"}, "--elements 50 --srgb8"},
       {"--threads", {"nan"}, {"--threads"}, "--elements 50"},
       {"--seed", {"1e40"}, {"--seed"}, "--elements 50"},
+      {"--solver", {"bogus", "nan"}, {"--solver"}, "--elements 50"},
+      {"--link-tolerance", {"nan", "0", "2"}, {"--link-tolerance"}, "--elements 50 --solver hierarchical"},
+      {"--gather-tolerance", {"inf", "-1"}, {"--gather-tolerance"}, "--elements 50 --solver hierarchical"},
   };
 }
 
