@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "raytrace_core/bsdf.h"
+#include "raytrace_core/direct_light.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
@@ -165,25 +166,9 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   l += estimate_radiance(maps_.caustic, query, m, frame, wo, thread_scratch());
 
   // Direct light: one light sample, MIS-weighted against the gather rays as BSDF samples.
-  if (choice.size() > 0) {
-    const uint32_t li = choice.sample(ctx.rng.uniform());
-    const float pmf = choice.pmf(li);
-    const rc::LightSample ls = rc::sample_light(scene_, lights[li], si, ctx.rng.uniform2());
-    if (ls.pdf > 0.0f && !ls.radiance.is_black() && (glm::dot(ls.wi, si.ng) > 0.0f) == wo_above) {
-      const rc::Vec3 wi = frame.to_local(ls.wi);
-      const rc::Rgb f = rc::bsdf_eval(m, wo, wi) * std::fabs(wi.z);
-      if (!f.is_black()) {
-        ++ctx.rays;
-        if (!scene_.occluded(ls.shadow_ray)) {
-          const float p_light = ls.pdf * pmf;
-          const float w = ls.delta || gather == 0
-                              ? 1.0f
-                              : rc::power_heuristic(1.0f, p_light, float(gather), rc::bsdf_pdf(m, wo, wi));
-          l += f * ls.radiance * (w / p_light);
-        }
-      }
-    }
-  }
+  if (const rc::DirectSample ds = rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays);
+      !ds.value.is_black())
+    l += ds.value * (ds.delta || gather == 0 ? 1.0f : rc::power_heuristic(1.0f, ds.pdf, float(gather), rc::bsdf_pdf(m, wo, ds.wi)));
   if (gather == 0) {
     // Without a final gather the global map is read at x itself.
     l += estimate_radiance(maps_.global, query, m, frame, wo, thread_scratch());

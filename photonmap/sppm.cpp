@@ -11,6 +11,7 @@
 #include "photonmap/photon_index.h"
 #include "photonmap/photon_map.h"
 #include "raytrace_core/bsdf.h"
+#include "raytrace_core/direct_light.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
@@ -37,23 +38,6 @@ struct PixelState {
 };
 
 constexpr uint64_t kPhotonStream = 0xe000000000ull;
-
-/// Direct light at a visible point by one light sample (delta lights included).
-rc::Rgb direct_light(const rc::Scene& scene, const rc::SurfaceInteraction& si, const rc::Material& m,
-                     const rc::Frame& frame, const rc::Vec3& wo, bool wo_above, rc::Rng& rng, uint64_t& rays) {
-  const rc::Distribution1D& choice = scene.light_distribution();
-  if (choice.size() == 0) return rc::Rgb(0.0f);
-  const uint32_t li = choice.sample(rng.uniform());
-  const float pmf = choice.pmf(li);
-  const rc::LightSample ls = rc::sample_light(scene, scene.lights()[li], si, rng.uniform2());
-  if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) return rc::Rgb(0.0f);
-  const rc::Vec3 wi = frame.to_local(ls.wi);
-  const rc::Rgb f = rc::bsdf_eval(m, wo, wi) * std::fabs(wi.z);
-  if (f.is_black()) return rc::Rgb(0.0f);
-  ++rays;
-  if (scene.occluded(ls.shadow_ray)) return rc::Rgb(0.0f);
-  return f * ls.radiance / (ls.pdf * pmf);
-}
 
 }  // namespace
 
@@ -120,7 +104,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           const rc::Vec3 wo = frame.to_local(wo_world);
           const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
           if (!m.is_specular()) {
-            direct += beta * direct_light(scene, si, m, frame, wo, wo_above, rng, local_rays);
+            direct += beta * rc::sample_direct(scene, si, m, frame, wo, wo_above, rng, local_rays).value;
             ps.visible = true;
             ps.position = si.p;
             ps.lit_side = wo_above ? si.ng : -si.ng;

@@ -4,6 +4,7 @@
 #include "raytrace_core/path_tracer.h"
 
 #include "raytrace_core/bsdf.h"
+#include "raytrace_core/direct_light.h"
 
 namespace gilt::raytrace_core {
 
@@ -58,24 +59,11 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     const Vec3 wo = frame.to_local(wo_world);
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
 
-    // Next-event estimation towards one light chosen by power.
-    if (!m.is_specular() && light_choice.size() > 0) {
-      float pmf = 0.0f;
-      const uint32_t li = light_choice.sample(ctx.rng.uniform());
-      pmf = light_choice.pmf(li);
-      const LightSample ls = sample_light(scene, lights[li], si, ctx.rng.uniform2());
-      // Reflection only: the light must be on wo's side of the geometric surface (no leaks).
-      if (ls.pdf > 0.0f && !ls.radiance.is_black() && (glm::dot(ls.wi, si.ng) > 0.0f) == wo_above) {
-        const Vec3 wi = frame.to_local(ls.wi);
-        const Rgb f = bsdf_eval(m, wo, wi) * std::fabs(wi.z);
-        if (!f.is_black()) {
-          ++ctx.rays;
-          if (!scene.occluded(ls.shadow_ray)) {
-            const float weight = ls.delta ? 1.0f : power_heuristic(1.0f, ls.pdf * pmf, 1.0f, bsdf_pdf(m, wo, wi));
-            radiance += beta * f * ls.radiance * (weight / (ls.pdf * pmf));
-          }
-        }
-      }
+    // Next-event estimation, MIS-weighted against BSDF sampling.
+    if (!m.is_specular()) {
+      const DirectSample ds = sample_direct(scene, si, m, frame, wo, wo_above, ctx.rng, ctx.rays);
+      if (!ds.value.is_black())
+        radiance += beta * ds.value * (ds.delta ? 1.0f : power_heuristic(1.0f, ds.pdf, 1.0f, bsdf_pdf(m, wo, ds.wi)));
     }
 
     // Continue the path by sampling the BSDF.

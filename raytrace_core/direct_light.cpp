@@ -1,0 +1,30 @@
+#include "raytrace_core/direct_light.h"
+
+#include <cmath>
+
+#include "raytrace_core/bsdf.h"
+
+namespace gilt::raytrace_core {
+
+DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
+                           const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+  DirectSample out;
+  const Distribution1D& choice = scene.light_distribution();
+  if (choice.size() == 0) return out;
+  const uint32_t li = choice.sample(rng.uniform());
+  const float pmf = choice.pmf(li);
+  const LightSample ls = sample_light(scene, scene.lights()[li], si, rng.uniform2());
+  // Reflection only: the light must be on wo's side of the geometric surface (no leaks).
+  if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) return out;
+  out.wi = frame.to_local(ls.wi);
+  out.pdf = ls.pdf * pmf;
+  out.delta = ls.delta;
+  const Rgb f = bsdf_eval(m, wo, out.wi) * std::fabs(out.wi.z);
+  if (f.is_black()) return out;
+  ++rays;
+  if (scene.occluded(ls.shadow_ray)) return out;
+  out.value = f * ls.radiance / out.pdf;
+  return out;
+}
+
+}  // namespace gilt::raytrace_core
