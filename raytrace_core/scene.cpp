@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <string>
 
+#include "raytrace_core/closest_point.h"
 #include "raytrace_core/error.h"
 
 namespace gilt::raytrace_core {
@@ -304,6 +305,56 @@ std::optional<Hit> Scene::intersect(const Ray& ray) const {
   rtcIntersect1(impl_->scene, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
   return Hit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v};
+}
+
+namespace {
+
+/// State of one nearest_triangle query, handed to Embree's point-query callback.
+struct NearestQuery {
+  const TriangleMesh* mesh;
+  uint32_t geom_id;
+  Vec3 p, n;
+  float min_cosine;
+  Hit best;
+  float best_distance2;
+};
+
+bool nearest_triangle_callback(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<NearestQuery*>(args->userPtr);
+  if (args->geomID != q->geom_id) return false;
+  const uint32_t* idx = &q->mesh->indices[3 * size_t(args->primID)];
+  const Vec3 &a = q->mesh->positions[idx[0]], &b = q->mesh->positions[idx[1]], &c = q->mesh->positions[idx[2]];
+  const Vec3 normal = glm::cross(b - a, c - a);
+  const float length = glm::length(normal);
+  if (!(length > 0.0f) || !(glm::dot(normal, q->n) > q->min_cosine * length)) return false;
+  const Vec2 uv = closest_point_on_triangle(q->p, a, b, c);
+  const Vec3 x = (1.0f - uv.x - uv.y) * a + uv.x * b + uv.y * c;
+  const float d2 = glm::dot(x - q->p, x - q->p);
+  if (d2 > q->best_distance2 || (d2 == q->best_distance2 && args->primID > q->best.prim_id)) return false;
+  q->best = Hit{std::sqrt(d2), q->geom_id, args->primID, uv.x, uv.y};
+  q->best_distance2 = d2;
+  args->query->radius = std::sqrt(d2);
+  return true;
+}
+
+}  // namespace
+
+std::optional<Hit> Scene::nearest_triangle(uint32_t geom_id, const Vec3& p, float radius, const Vec3& n,
+                                           float min_cosine) const {
+  if (geom_id >= meshes.size() || !(radius > 0.0f)) return std::nullopt;
+  NearestQuery q{&meshes[geom_id], geom_id, p, n, min_cosine, Hit{}, sqr(radius)};
+  q.best.prim_id = ~0u;
+  RTCPointQuery query;
+  query.x = p.x;
+  query.y = p.y;
+  query.z = p.z;
+  query.time = 0.0f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(impl_->scene, &query, &context, nearest_triangle_callback, &q);
+  if (q.best.prim_id == ~0u) return std::nullopt;
+  return q.best;
 }
 
 bool Scene::occluded(const Ray& ray) const {

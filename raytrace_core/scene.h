@@ -104,6 +104,11 @@ class Scene {
   bool occluded(const Ray& ray) const;
   /// Surface details of a hit found along `ray`.
   SurfaceInteraction surface(const Ray& ray, const Hit& hit) const;
+  /// The point nearest to p, closer than `radius`, on a triangle of mesh `geom_id` whose
+  /// geometric normal has a cosine above `min_cosine` with the unit vector n; its distance is
+  /// the Hit's t and (u, v) its barycentrics. Ties go to the lower triangle index.
+  std::optional<Hit> nearest_triangle(uint32_t geom_id, const Vec3& p, float radius, const Vec3& n,
+                                      float min_cosine) const;
 
   /// All lights: one per emissive triangle and sphere, then the punctual lights.
   const std::vector<Light>& lights() const { return lights_; }
