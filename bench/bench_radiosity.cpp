@@ -307,7 +307,7 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
   // Untimed warm-up (thread pool, Embree), and the noise of a 16-spp display: the same solution
   // at 16 and at 1024 filtered spp differs only by where the pixel filter was sampled.
   const rad::Solution warm = rad::solve(scene, solver_settings(1000));
-  const rad::RadiosityView warm_view(scene, warm);
+  const rad::RadiosityView warm_view(scene, warm, rad::ViewMode::mesh);
   const double display_noise =
       rc::mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
                           radiosity_render(scene, warm_view, Pixels::filtered, kDisplaySpp));
@@ -351,7 +351,7 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
       sol = rad::solve(scene, solver_settings(requested));
       solve_times.push_back(seconds_since(start));
       const auto render_start = std::chrono::steady_clock::now();
-      view.emplace(scene, *sol);
+      view.emplace(scene, *sol, rad::ViewMode::mesh);
       image = radiosity_render(scene, *view, Pixels::filtered, kRadiositySpp);
       render_times.push_back(seconds_since(render_start));
     }

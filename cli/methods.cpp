@@ -50,14 +50,14 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
     radiance = [&mapper](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper->radiance(ray, ctx); };
     if (base.time_limit > 0.0) settings.time_limit = remaining();
   } else if (method == "radiosity") {
-    radiosity::SolverSettings solver = options.solver;
+    radiosity::SolverSettings solver = radiosity::solver_settings_for(options.radiosity_view, options.solver);
     solver.seed = settings.seed;
     solver.threads = settings.threads;
     solver.progress = settings.progress;
     if (base.time_limit > 0.0) solver.time_limit = 0.7 * base.time_limit;
     result.solution.emplace(radiosity::solve(scene, solver));
     result.notes = result.solution->mesh_report.warnings;
-    view.emplace(scene, *result.solution);
+    view.emplace(scene, *result.solution, options.radiosity_view);
     radiance = [&view](const rc::Ray& ray, rc::SampleContext& ctx) { return view->radiance(ray, ctx); };
     if (base.time_limit > 0.0) settings.time_limit = remaining();
   } else if (method == "path") {

@@ -10,6 +10,7 @@
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
 #include "radiosity/solver.h"
+#include "radiosity/view.h"
 #include "raytrace_core/camera.h"
 #include "raytrace_core/film.h"
 #include "raytrace_core/render.h"
@@ -22,6 +23,7 @@ inline const std::vector<std::string> kMethods = {"path", "photon", "sppm", "rad
 /// Every method's own settings; `max_depth` 0 keeps each method's default.
 struct MethodOptions {
   radiosity::SolverSettings solver;
+  radiosity::ViewMode radiosity_view = radiosity::ViewMode::two_pass;
   photonmap::PhotonMapperSettings photon;
   photonmap::SppmSettings sppm;
   int max_depth = 0;

@@ -43,6 +43,7 @@ struct RenderOptions {
   bool json = false;
   bool quiet = false;
   radiosity::SolverSettings solver;
+  radiosity::ViewMode radiosity_view = radiosity::ViewMode::two_pass;
   // Photon mapping (photon, sppm).
   std::optional<uint64_t> photons, caustic_photons;
   int k = 50;
@@ -105,6 +106,7 @@ void run_render(const RenderOptions& o) {
 
   MethodOptions mo;
   mo.solver = o.solver;
+  mo.radiosity_view = o.radiosity_view;
   if (o.photons) mo.photon.photons.global_photons = mo.sppm.photons_per_iteration = *o.photons;
   if (o.caustic_photons) mo.photon.photons.caustic_photons = *o.caustic_photons;
   mo.photon.k = o.k;
@@ -217,6 +219,14 @@ std::function<void()> add_render_command(CLI::App& app) {
       ->check(CLI::Range(1e-3f, 0.999f))
       ->check(finite_number());
   add_solver_options(*cmd, o->solver);
+  cmd->add_option_function<std::string>(
+         "--radiosity-view",
+         [o](const std::string& name) {
+           o->radiosity_view = name == "mesh" ? radiosity::ViewMode::mesh : radiosity::ViewMode::two_pass;
+         },
+         "Radiosity: two-pass (the input's surfaces, direct light per pixel, reflected light from the solution; "
+         "default) or mesh (the elements' radiance, as exported)")
+      ->check(CLI::IsMember({"two-pass", "mesh"}));
   auto* spp = cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's, 64)")
                   ->check(CLI::PositiveNumber);
   cmd->add_option("--time", o->time_limit, "Render whole passes until this many seconds are spent")

@@ -734,6 +734,12 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // Final gather: each vertex walks the tree from the root, taking a cluster whole when the
   // irradiance it may carry wrongly is below gather_tolerance of the vertex's own indirect
   // irradiance (at least 5 % of the scene's mean), and elements by Lambert's formula.
+  result.final_gather = false;
+  if (!settings.vertex_final_gather) {
+    result.shadow_rays = counters.rays;
+    result.form_factors = counters.form_factors;
+    return result;
+  }
   const TreeWalk walker{in, tree, radiosity, power, moment};
   std::atomic<bool> stopped{false};
   rc::parallel_for((nv + 63) / 64, [&](size_t chunk) {

@@ -30,6 +30,9 @@ struct HierarchicalSettings {
   int link_rays = 4;        ///< shadow rays per link (between random points of the two ends)
   double tolerance = 1e-3;  ///< stop iterating when the solution changes by less than this (relative)
   int max_iterations = 200;
+  /// Gather at every vertex from the hierarchy at the end; without it, a vertex takes the
+  /// area-weighted mean of its elements' gathered irradiance (for a view that gathers per pixel).
+  bool vertex_final_gather = true;
   uint64_t seed = 0;
 };
 
@@ -56,7 +59,8 @@ struct HierarchicalResult {
   double residual = 0.0;  ///< relative change of the last iteration
   uint64_t shadow_rays = 0, form_factors = 0;
   uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated
-  bool final_gather = true;   ///< false when time ran out before it (vertices then take their elements' mean)
+  bool final_gather = true;   ///< false when it was not asked for or time ran out before it (vertices then take
+                              ///< their elements' mean)
   double link_seconds = 0.0, iterate_seconds = 0.0, gather_seconds = 0.0;  ///< tree and links; iterations; final gather
 };
 

@@ -1,22 +1,58 @@
-// Two-pass display of a radiosity solution (Wallace, Cohen & Greenberg 1987): diffuse radiance
-// from the solution, specular transport by ray tracing.
+// Displays of a radiosity solution: the elements as exported (Wallace, Cohen & Greenberg 1987),
+// or the two-pass split of Chen, Rushmeier, Miller & Turner 1991, "A Progressive Multi-Pass
+// Method for Global Illumination": at each visible point of the input, direct light by a shadow
+// ray and the light reflected by other surfaces by a final-gather ray that reads the solution
+// where it lands (Lischinski, Tampieri & Greenberg 1993 gather at vertices; this at pixels).
+// Specular paths are ray traced.
 
 #include "radiosity/view.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "radiosity/element_scene.h"
 #include "raytrace_core/bsdf.h"
+#include "raytrace_core/direct_light.h"
+#include "raytrace_core/sampling.h"
 
 namespace gilt::radiosity {
 
-RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, bool ambient)
-    : scene_(scene), elements_(solution.mesh.elements) {
-  const RadiosityMesh& mesh = solution.mesh;
-  vertex_radiance_.resize(mesh.vertex_count());
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    vertex_radiance_[v] = solution.vertex_radiance(v);
-    if (ambient)
-      vertex_radiance_[v] += scene.materials[mesh.vertex_material[v]].albedo * solution.ambient * (1.0f / rc::kPi);
+const char* to_string(ViewMode mode) {
+  switch (mode) {
+    case ViewMode::two_pass: return "two-pass";
+    case ViewMode::mesh: return "mesh";
   }
+  return "?";
+}
+
+SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
+  if (mode == ViewMode::two_pass) {
+    settings.subdivision_levels = 0;
+    settings.hierarchical.vertex_final_gather = false;
+  }
+  return settings;
+}
+
+/// cos 60°: an element lit on the same side as the input point faces within 60° of it (the
+/// mesher splits vertices at sharper creases, so a steeper element belongs to another side).
+constexpr float kFacing = 0.5f;
+
+RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, ViewMode mode, bool ambient)
+    : scene_(scene), mode_(mode), elements_(solution.mesh.elements) {
+  const RadiosityMesh& mesh = solution.mesh;
+  const size_t nv = mesh.vertex_count();
+  vertex_radiance_.resize(nv);
+  vertex_irradiance_.resize(nv);
+  for (size_t v = 0; v < nv; ++v) {
+    const Rgb rho = scene.materials[mesh.vertex_material[v]].albedo;
+    vertex_radiance_[v] = solution.vertex_radiance(v);
+    if (ambient) vertex_radiance_[v] += rho * solution.ambient * (1.0f / rc::kPi);
+    vertex_irradiance_[v] = solution.vertex_irradiance[v] + (ambient ? solution.ambient : Rgb(0.0f));
+  }
+  // An input point lies within about an element's size of the element that stands for it
+  // (elements are chords of a curved input); twice the target edge leaves room for bisection
+  // and for input faces kept as they were.
+  reach_ = 2.0f * std::max(solution.mesh_report.max_edge, 1e-6f * glm::length(scene.bounds().diagonal()));
 
   // Geometry 0: every element; then the scene's specular meshes and spheres.
   display_ = element_scene(scene, mesh);
@@ -24,7 +60,55 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, b
     if (l.kind == rc::LightKind::environment) environment_ += l.radiance;
 }
 
-Rgb RadiosityView::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+Rgb RadiosityView::radiance(const rc::Ray& ray, rc::SampleContext& ctx) const {
+  return mode_ == ViewMode::mesh ? mesh_radiance(ray, ctx) : two_pass_radiance(ray, ctx);
+}
+
+Rgb RadiosityView::irradiance(const Vec3& p, const Vec3& n) const {
+  const std::optional<rc::Hit> near = display_.nearest_triangle(0, p, reach_, n, kFacing);
+  if (!near) return Rgb(0.0f);
+  const auto& e = elements_[near->prim_id];
+  return vertex_irradiance_[e[0]] * (1.0f - near->u - near->v) + vertex_irradiance_[e[1]] * near->u +
+         vertex_irradiance_[e[2]] * near->v;
+}
+
+Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
+                          rc::SampleContext& ctx) const {
+  // One cosine-distributed ray on the lit side: its estimate of the irradiance is the radiance
+  // it finds times π.
+  const Vec3 side = wo_above ? si.ng : -si.ng;
+  Vec3 wi = frame.to_world(rc::sample_cosine_hemisphere(ctx.rng.uniform2()));
+  if (!wo_above) wi = -wi;                            // the frame's z is the front's shading normal
+  if (glm::dot(wi, side) <= 0.0f) return Rgb(0.0f);  // the shading normal leans the ray through the surface
+  Rgb beta(rc::kPi);
+  rc::Ray ray = rc::spawn_ray(si, wi);
+  for (int depth = 0; depth < 64; ++depth) {
+    ++ctx.rays;
+    const std::optional<rc::Hit> hit = scene_.intersect(ray);
+    // Straight from x, emitters and the sky are next-event estimation's; through glass or a
+    // mirror, shadow rays cannot see them, and the gather ray is their only way in.
+    if (!hit) return depth > 0 ? beta * environment_ : Rgb(0.0f);
+    const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
+    const rc::Material& mj = scene_.materials[sj.material];
+    const Vec3 wo_world = -glm::normalize(ray.direction);
+    if (mj.kind == rc::MaterialKind::dielectric && !sj.front_face && !mj.absorption.is_black())
+      beta *= rc::exp(mj.absorption * (-hit->t * glm::length(ray.direction)));
+    Rgb found(0.0f);
+    if (depth > 0 && mj.is_emissive()) found += rc::emitted_radiance(mj, sj.ng, wo_world);
+    if (!mj.is_specular()) {
+      const bool above = glm::dot(wo_world, sj.ng) > 0.0f;
+      return beta * (found + mj.albedo * irradiance(sj.p, above ? sj.ng : -sj.ng) * (1.0f / rc::kPi));
+    }
+    const rc::Frame fj = rc::Frame::from_normal(sj.ns);
+    const auto bs = rc::bsdf_sample(mj, fj.to_local(wo_world), ctx.rng.uniform(), ctx.rng.uniform2());
+    if (!bs || !(bs->pdf > 0.0f)) return beta * found;
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+    ray = rc::spawn_ray(sj, fj.to_world(bs->wi));
+  }
+  return Rgb(0.0f);
+}
+
+Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
   Rgb beta(1.0f);
   rc::Ray ray = camera_ray;
   for (int depth = 0; depth < 64; ++depth) {
@@ -52,6 +136,38 @@ Rgb RadiosityView::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) c
     ray = rc::spawn_ray(si, frame.to_world(bs->wi));
   }
   return Rgb(0.0f);
+}
+
+Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+  Rgb radiance(0.0f), beta(1.0f);
+  rc::Ray ray = camera_ray;
+  for (int depth = 0; depth < 64; ++depth) {
+    ++ctx.rays;
+    const std::optional<rc::Hit> hit = scene_.intersect(ray);
+    if (!hit) return radiance + beta * environment_;
+    const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
+    const rc::Material& m = scene_.materials[si.material];
+    const Vec3 wo_world = -glm::normalize(ray.direction);
+    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+      beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+    // Only the camera and delta bounces lead here, so emission seen is never sampled twice.
+    if (m.is_emissive()) radiance += beta * rc::emitted_radiance(m, si.ng, wo_world);
+    const rc::Frame frame = rc::Frame::from_normal(si.ns);
+    const Vec3 wo = frame.to_local(wo_world);
+    const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
+    if (!m.is_specular()) {
+      // Direct light by one shadow ray (the whole BSDF, glossy lobe included), then the light
+      // the other surfaces reflect onto its Lambertian part, gathered from the solution.
+      radiance += beta * rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays).value;
+      return radiance + beta * m.albedo * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
+    }
+    const float u_lobe = ctx.rng.uniform();
+    const auto bs = rc::bsdf_sample(m, wo, u_lobe, ctx.rng.uniform2());
+    if (!bs || !(bs->pdf > 0.0f)) return radiance;
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+    ray = rc::spawn_ray(si, frame.to_world(bs->wi));
+  }
+  return radiance;
 }
 
 }  // namespace gilt::radiosity

@@ -1,29 +1,68 @@
 #pragma once
-// A radiosity solution seen through a camera: Gouraud-interpolated radiance over each element,
-// mirrors and glass ray traced against the solution (the classic two-pass method).
+// A radiosity solution seen through a camera, in one of two ways:
+// - the mesh view shows the solution as it is exported: radiance Gouraud-interpolated over the
+//   elements, with mirrors and glass ray traced against it (Wallace, Cohen & Greenberg 1987);
+// - the two-pass view traces the input's own surfaces, takes the direct light per pixel by
+//   shadow rays and the light reflected by other surfaces by one final-gather ray per sample
+//   that reads the solution where it lands (Chen, Rushmeier, Miller & Turner 1991). Sharp
+//   shadows and a sun patch then need no mesh to resolve them, a scanned or curved surface shows
+//   its own shape rather than its elements' chords, and the elements' own errors are blurred
+//   by the gather instead of showing as blotches.
+
+#include <array>
+#include <vector>
 
 #include "radiosity/solver.h"
 #include "raytrace_core/render.h"
 
 namespace gilt::radiosity {
 
+/// How the view shows a solution.
+enum class ViewMode {
+  two_pass,  ///< the input's surfaces: direct light per pixel, a final gather into the solution
+  mesh,      ///< the elements: the solution's radiance as exported
+};
+
+/// "two-pass" or "mesh".
+const char* to_string(ViewMode mode);
+
+/// The solver settings a view of the solution needs: the two-pass view takes the direct light
+/// and the last bounce per pixel, so its solve skips adaptive subdivision at shadow boundaries
+/// and the hierarchical solver's vertex final gather; the mesh view shows the vertices as they
+/// are and needs both.
+SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings);
+
 /// Display of a solution; radiance() is a RadianceFunction for raytrace_core::render_image.
 class RadiosityView {
  public:
-  /// Builds a scene of the solution's elements plus the specular primitives of `scene`. Both
-  /// arguments must outlive the view. With `ambient`, a partial solution is shown with each
-  /// vertex's reflectance times the solution's ambient term added (display only).
-  RadiosityView(const rc::Scene& scene, const Solution& solution, bool ambient = true);
+  /// Builds the display scenes. Both arguments must outlive the view. With `ambient`, a partial
+  /// solution is shown with each vertex's reflectance times the solution's ambient term added
+  /// (display only).
+  RadiosityView(const rc::Scene& scene, const Solution& solution, ViewMode mode = ViewMode::two_pass,
+                bool ambient = true);
 
-  /// Radiance along a camera ray: the interpolated vertex radiance where it meets an element's
-  /// front, through any chain of mirror and glass bounces (at most 64).
+  /// Radiance along a camera ray, through any chain of mirror and glass bounces (at most 64).
   Rgb radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
 
+  /// Irradiance (W·m⁻²) the solution gives a point of the input at p whose lit side faces along
+  /// the unit normal n: interpolated at the nearest point of an element that faces the same way
+  /// (within 60°) and lies within reach (twice the target edge); black where none does.
+  Rgb irradiance(const Vec3& p, const Vec3& n) const;
+
  private:
+  /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
+  /// cosine-distributed gather ray (through mirrors and glass) read against the solution, times π.
+  Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx) const;
+  Rgb mesh_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
+  Rgb two_pass_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
+
   const rc::Scene& scene_;
-  rc::Scene display_;
-  std::vector<Rgb> vertex_radiance_;
+  ViewMode mode_;
+  rc::Scene display_;                        ///< the elements (geometry 0) and the specular surfaces
+  std::vector<Rgb> vertex_radiance_;         ///< mesh view: W·sr⁻¹·m⁻²
+  std::vector<Rgb> vertex_irradiance_;       ///< two-pass view: W·m⁻², ambient term included
   std::vector<std::array<uint32_t, 3>> elements_;
+  float reach_ = 0.0f;                       ///< how far from an element the two-pass view looks it up
   Rgb environment_{0.0f};
 };
 
