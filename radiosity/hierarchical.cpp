@@ -491,8 +491,7 @@ struct TreeWalk {
   Rgb irradiance(size_t v, double epsilon, int rays, rc::Rng& rng, std::vector<uint32_t>& stack,
                  WalkCounts& counts) const {
     const RadiosityMesh& mesh = in.mesh;
-    const rc::SurfacePoint& at = in.vertex_point[v];
-    const Vec3 p = at.p, n = mesh.normals[v];
+    const Vec3 p = in.vertex_point[v].p, n = mesh.normals[v];
     Rgb sum(0.0f);
     stack.assign(1, 0u);
     while (!stack.empty()) {
@@ -539,8 +538,12 @@ struct TreeWalk {
         };
         auto open = [&](int count) {
           int hits = 0;
-          for (int i = 0; i < count; ++i)
+          // The vertex's visibility origins in turn, from a random one.
+          const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
+          for (int i = 0; i < count; ++i) {
+            const rc::SurfacePoint& at = in.visibility_origin[kVisibilityOrigins * v + (first + size_t(i)) % kVisibilityOrigins];
             hits += !in.geometry.occluded(rc::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
+          }
           counts.rays += uint64_t(count);
           return hits;
         };

@@ -36,6 +36,9 @@ struct HierarchicalSettings {
   uint64_t seed = 0;
 };
 
+/// How many points each vertex's visibility rays start from (see visibility_origins in solver.h).
+inline constexpr size_t kVisibilityOrigins = 4;
+
 /// What the pass needs to know of the scene: the mesh, the scene its visibility rays are traced
 /// against (element_scene()), where each vertex receives, each element's reflectance and each
 /// vertex's direct irradiance.
@@ -43,6 +46,7 @@ struct HierarchicalInput {
   const RadiosityMesh& mesh;
   const rc::Scene& geometry;
   std::span<const rc::SurfacePoint> vertex_point;  ///< per vertex: receiver point (see receiver_points)
+  std::span<const rc::SurfacePoint> visibility_origin;  ///< kVisibilityOrigins per vertex (see visibility_origins)
   std::span<const Rgb> albedo;                     ///< per element
   std::span<const Rgb> direct_irradiance;          ///< per vertex, W·m⁻²
   /// Whether a segment between the two boxes' contents may be blocked at all (false: no rays).

@@ -39,6 +39,20 @@ constexpr auto surface_point = mesh_surface_point;
 /// How many of five probes (along the normal and four directions 60° from it, each `reach`
 /// long) from a candidate receiver hit the back of a surface: a receiver that sees a back so
 /// close lies behind part of the mesh around it.
+/// The elements around each vertex: vertex v's are fan[offsets[v] .. offsets[v + 1]), in
+/// element order.
+std::pair<std::vector<uint32_t>, std::vector<uint32_t>> element_fans(const RadiosityMesh& mesh) {
+  const size_t nv = mesh.vertex_count();
+  std::vector<uint32_t> offsets(nv + 1, 0), fan(3 * mesh.element_count());
+  for (const auto& e : mesh.elements)
+    for (uint32_t v : e) ++offsets[v + 1];
+  for (size_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
+  std::vector<uint32_t> next(offsets.begin(), offsets.end() - 1);
+  for (uint32_t e = 0; e < mesh.element_count(); ++e)
+    for (uint32_t v : mesh.elements[e]) fan[next[v]++] = e;
+  return {std::move(offsets), std::move(fan)};
+}
+
 int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach) {
   const rc::SurfacePoint at = surface_point(p, n);
   const rc::Frame frame = rc::Frame::from_normal(n);
@@ -72,15 +86,7 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
 /// roof edge came out as a ragged black band.)
 std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh) {
   const size_t nv = mesh.vertex_count();
-  std::vector<uint32_t> offsets(nv + 1, 0), fan(3 * mesh.element_count());
-  for (const auto& e : mesh.elements)
-    for (uint32_t v : e) ++offsets[v + 1];
-  for (size_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
-  {
-    std::vector<uint32_t> next(offsets.begin(), offsets.end() - 1);
-    for (uint32_t e = 0; e < mesh.element_count(); ++e)
-      for (uint32_t v : mesh.elements[e]) fan[next[v]++] = e;
-  }
+  const auto [offsets, fan] = element_fans(mesh);
   std::vector<Vec3> origin(mesh.positions);
   rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
     for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
@@ -108,6 +114,40 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
     }
   });
   return origin;
+}
+
+std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, const RadiosityMesh& mesh,
+                                                 std::span<const Vec3> receivers) {
+  const size_t nv = mesh.vertex_count();
+  const auto [offsets, fan] = element_fans(mesh);
+  std::vector<rc::SurfacePoint> out(kVisibilityOrigins * nv);
+  rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+    for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
+      const Vec3 p = mesh.positions[v];
+      const size_t count = offsets[v + 1] - offsets[v];
+      auto centroid = [&](uint32_t e) {
+        const auto& el = mesh.elements[e];
+        return (mesh.positions[el[0]] + mesh.positions[el[1]] + mesh.positions[el[2]]) / 3.0f;
+      };
+      // The surface a vertex colour stands for: a disk half as wide as the distance to the
+      // nearest centroid of its elements (the radius check_against_path_tracer samples).
+      float radius = std::numeric_limits<float>::max();
+      for (uint32_t i = offsets[v]; i < offsets[v + 1]; ++i) radius = std::min(radius, 0.5f * glm::distance(centroid(fan[i]), p));
+      size_t taken = 0;
+      for (size_t j = 0; j < kVisibilityOrigins && j < count; ++j) {
+        const uint32_t e = fan[offsets[v] + j * count / std::min(count, kVisibilityOrigins)];
+        const Vec3 towards = centroid(e) - p;
+        const float size = glm::length(towards);
+        if (!(size > 0.0f)) continue;
+        const Vec3 n = mesh.element_normal[e];
+        const Vec3 q = p + towards * (radius / size) + (1e-3f * size) * n;
+        if (backs_seen(geometry, q, n, 2.0f * size) == 0) out[kVisibilityOrigins * v + taken++] = surface_point(q, n);
+      }
+      if (taken == 0) out[kVisibilityOrigins * v + taken++] = surface_point(receivers[v], mesh.normals[v]);
+      for (size_t k = taken; k < kVisibilityOrigins; ++k) out[kVisibilityOrigins * v + k] = out[kVisibilityOrigins * v + k % taken];
+    }
+  });
+  return out;
 }
 
 namespace {
@@ -250,10 +290,12 @@ Patches build_patches(const RadiosityMesh& mesh, int patch_elements) {
   return patches;
 }
 
-/// Irradiance at vertex v from a punctual or environment light of `scene`, with visibility traced
-/// against `geometry`.
+/// Irradiance at a vertex with unit normal n from a punctual or environment light of `scene`,
+/// with visibility traced against `geometry` from the vertex's visibility origins `from`.
 Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const rc::Light& light,
-                        const rc::SurfacePoint& at, const Vec3& n, rc::Rng& rng, int samples, uint64_t& rays) {
+                        std::span<const rc::SurfacePoint> from, const Vec3& n, rc::Rng& rng, int samples,
+                        uint64_t& rays) {
+  const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));  // rays take the origins in turn
   if (light.kind == rc::LightKind::environment) {
     // E = L ∫ V cos dω, by cosine-weighted stratified directions: π L · (fraction unblocked).
     const rc::Frame frame = rc::Frame::from_normal(n);
@@ -263,12 +305,13 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const
       for (int j = 0; j < side; ++j) {
         const rc::Vec2 u((i + rng.uniform()) / side, (j + rng.uniform()) / side);
         ++rays;
+        const rc::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
         open += !geometry.occluded(
             rc::spawn_shadow_ray_to_infinity(at, frame.to_world(rc::sample_cosine_hemisphere(u))));
       }
     return light.radiance * (kPi * float(open) / float(side * side));
   }
-  const rc::LightSample ls = rc::sample_light(scene, light, at, rng.uniform2());
+  const rc::LightSample ls = rc::sample_light(scene, light, from[first], rng.uniform2());
   const float cos_theta = glm::dot(ls.wi, n);
   if (!(cos_theta > 0.0f) || ls.radiance.is_black()) return Rgb(0.0f);
   ++rays;
@@ -346,7 +389,8 @@ struct Receivers {
   const RadiosityMesh& mesh;
   rc::Scene geometry;                       ///< what visibility rays are traced against (element_scene)
   std::vector<Vec3> origin;                 ///< per vertex, see receiver_points
-  std::vector<rc::SurfacePoint> point;      ///< per vertex, for spawning shadow rays
+  std::vector<rc::SurfacePoint> point;      ///< per vertex: origin as a surface point
+  std::vector<rc::SurfacePoint> spread;     ///< kVisibilityOrigins per vertex, where its shadow rays start
   std::vector<rc::Bounds3> occluders;
 
   Receivers(const rc::Scene& s, const RadiosityMesh& m) : scene(s), mesh(m), occluders(occluder_boxes(s, m)) {
@@ -357,6 +401,11 @@ struct Receivers {
     origin = receiver_points(geometry, mesh);
     point.resize(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) point[v] = surface_point(origin[v], mesh.normals[v]);
+    spread = visibility_origins(geometry, mesh, origin);
+  }
+  /// Vertex v's visibility origins.
+  std::span<const rc::SurfacePoint> origins(size_t v) const {
+    return std::span<const rc::SurfacePoint>(spread).subspan(kVisibilityOrigins * v, kVisibilityOrigins);
   }
 
   /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
@@ -411,6 +460,8 @@ struct Receivers {
     }
     // Stratified points on the patch, each drawn in proportion to what its element sends to v;
     // only when the probe is split between blocked and open (a penumbra) the full set decides.
+    const std::span<const rc::SurfacePoint> from = origins(v);
+    const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));  // rays take the origins in turn
     auto fraction_open = [&](int side) {
       int open = 0;
       for (int i = 0; i < side; ++i)
@@ -426,8 +477,9 @@ struct Receivers {
           const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
                          bary.y * mesh.positions[el[2]];
           ++counts.rays;
+          const rc::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
           open += !geometry.occluded(
-              rc::spawn_shadow_ray(point[v], surface_point(q, mesh.element_normal[src.elements[k]])));
+              rc::spawn_shadow_ray(at, surface_point(q, mesh.element_normal[src.elements[k]])));
         }
       return float(open) / float(side * side);
     };
@@ -565,7 +617,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv, first_vertex + chunk * 128 + 128); ++v) {
         for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
           rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
-          direct_punctual[v] += punctual_irradiance(scene, receivers.geometry, scene.punctual_lights[li], receivers.point[v],
+          direct_punctual[v] += punctual_irradiance(scene, receivers.geometry, scene.punctual_lights[li], receivers.origins(v),
                                                     mesh.normals[v], rng, settings.visibility_samples, counts.rays);
         }
         for (size_t q = 0; q < emitters.size(); ++q) {
@@ -582,7 +634,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       std::vector<Rgb> emission(mesh.element_count());
       for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
       const std::vector<Rgb> rho = element_albedo();
-      const HierarchicalInput input{mesh, receivers.geometry, receivers.point, rho, {}, may_be_blocked, {}};
+      const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, {}, may_be_blocked, {}};
       uint64_t tree_rays = 0;
       const std::vector<Rgb> e = emitted_irradiance(input, emission, first_vertex, hs, settings.visibility_samples, &tree_rays);
       for (size_t v = first_vertex; v < nv; ++v) direct_emitted[v] = e[v];
@@ -712,7 +764,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (hierarchical) {
     // Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex.
     const std::vector<Rgb> rho = element_albedo();
-    const HierarchicalInput input{mesh, receivers.geometry, receivers.point, rho, sol.vertex_irradiance, may_be_blocked,
+    const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, sol.vertex_irradiance, may_be_blocked,
                                   [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; }};
     if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
                     [](const Rgb& e) { return e.is_black(); }))

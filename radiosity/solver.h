@@ -6,6 +6,7 @@
 // shadow rays to stratified points on it.
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <string>
@@ -95,6 +96,16 @@ struct Solution {
 /// the mesh's other elements (see solver.cpp). `geometry` is element_scene() of the mesh, whose
 /// rays place the points.
 std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh);
+
+/// Where each vertex's visibility rays start: kVisibilityOrigins points per vertex (vertex v's at
+/// [v · kVisibilityOrigins, (v + 1) · kVisibilityOrigins)), towards the centroids of elements
+/// spread around its fan, half as far as the nearest centroid, just above those elements and in
+/// front of the mesh around them (the receiver point of receiver_points stands in where none is). A vertex colour
+/// stands for the surface around the vertex, and a ray from the vertex alone decides on a line:
+/// on Šibenik, vertices where a moulding meets a wall saw every light through the wall's edge
+/// and came out black while the surface on either side was lit.
+std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, const RadiosityMesh& mesh,
+                                                 std::span<const Vec3> receivers);
 
 /// The solver `settings` asks for on a mesh of `elements` elements, and why.
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why = nullptr);

@@ -13,12 +13,14 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "radiosity/element_scene.h"
 #include "radiosity/mesh.h"
 #include "radiosity/mesh_detail.h"
 #include "radiosity/solver.h"
@@ -322,6 +324,56 @@ TEST(MeshRobust, VerticesOnRoundedEdgesReceiveTheSunTheyFace) {
   note("rounded_box", fmt("%.0f vertices facing the sun, %.0f of them dark", double(lit), double(dark)));
   ASSERT_GT(lit, 50u);
   EXPECT_EQ(dark, 0u);
+}
+
+// Each vertex's visibility rays start from points spread over the surface it stands for: on its
+// own elements' side (just above the floor, by 10⁻³ of the distance to the element's centroid),
+// no farther from the vertex than half the distance to its nearest element centroid, and apart
+// from each other wherever the vertex has four or more elements.
+TEST(MeshRobust, VisibilityOriginsSpreadOverTheVertexsSurface) {
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+  TriangleMesh floor;
+  add_quad(floor, {Vec3(-2, 0, -2), Vec3(-2, 0, 2), Vec3(2, 0, 2), Vec3(2, 0, -2)});
+  scene.meshes.push_back(floor);
+  scene.commit();
+  MeshSettings settings;
+  settings.max_edge = 0.25f;
+  const RadiosityMesh mesh = build_mesh(scene, settings);
+  const rc::Scene geometry = element_scene(scene, mesh);
+  const std::vector<Vec3> receivers = receiver_points(geometry, mesh);
+  const std::vector<rc::SurfacePoint> origins = visibility_origins(geometry, mesh, receivers);
+  ASSERT_EQ(origins.size(), kVisibilityOrigins * mesh.vertex_count());
+  std::vector<float> radius(mesh.vertex_count(), std::numeric_limits<float>::max());
+  std::vector<int> fan(mesh.vertex_count(), 0);
+  float longest = 0.0f;
+  for (const auto& e : mesh.elements) {
+    const Vec3 c = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f;
+    for (uint32_t v : e) {
+      radius[v] = std::min(radius[v], 0.5f * glm::distance(c, mesh.positions[v]));
+      longest = std::max(longest, glm::distance(c, mesh.positions[v]));
+      ++fan[v];
+    }
+  }
+  size_t spread = 0, counted = 0;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    const Vec3 p = mesh.positions[v];
+    for (size_t k = 0; k < kVisibilityOrigins; ++k) {
+      const Vec3 q = origins[kVisibilityOrigins * v + k].p;
+      EXPECT_GT(q.y, 0.0f) << "vertex " << v;
+      EXPECT_LE(q.y, 1.01e-3f * longest) << "vertex " << v;
+      EXPECT_LE(glm::length(Vec3(q.x - p.x, 0.0f, q.z - p.z)), radius[v] * (1.0f + 1e-4f)) << "vertex " << v;
+    }
+    if (fan[v] < int(kVisibilityOrigins)) continue;
+    ++counted;
+    bool distinct = true;
+    for (size_t i = 0; i < kVisibilityOrigins; ++i)
+      for (size_t j = i + 1; j < kVisibilityOrigins; ++j)
+        distinct &= glm::distance(origins[kVisibilityOrigins * v + i].p, origins[kVisibilityOrigins * v + j].p) > 1e-6f;
+    spread += distinct;
+  }
+  ASSERT_GT(counted, 100u);
+  EXPECT_EQ(spread, counted) << "vertices with four or more elements whose visibility origins coincide";
 }
 
 }  // namespace
