@@ -50,6 +50,8 @@ constexpr float kPlaneSlack = 1e-4f;
 /// How many levels a far link's mixed end (elements facing both ways) is split into children
 /// that share its visibility.
 constexpr int kMixedDepth = 3;
+/// A partly visible cluster link is accepted when this many times its error is acceptable.
+constexpr double kPartialVisibility = 10.0;
 
 /// One vector per colour channel: Σ B A n and the irradiance vector W.
 struct RgbVec {
@@ -354,8 +356,16 @@ class Linker {
       if (receiving == Facing::front && sending == Facing::front)
         error *= std::min(1.0, std::pow(double(R.radius + S.radius) / gap, 2.0));
       if (error <= epsilon_) {
-        add(r, s, d / dist, 1.0f / (dist * dist), false, links);
-        return;
+        // A cluster link shares one visible fraction among all the receiver's elements that face
+        // the source. Where the source is partly hidden, the hidden and the open elements get the
+        // same share: light meant for a wall's inner face lands on its outer face and leaves the
+        // room. Such a link is kept only where a tenth of its error is still acceptable.
+        const float visible = visibility(r, s);
+        if (!(visible > 0.0f)) return;
+        if (visible >= 1.0f || error * kPartialVisibility <= epsilon_) {
+          split_mixed(r, s, 0, 0, visible, links);
+          return;
+        }
       }
     }
     // Split the larger end (a leaf cannot be split).
@@ -371,6 +381,18 @@ class Linker {
 
   /// Adds the link with its visible fraction (dropped when nothing is visible).
   void add(uint32_t r, uint32_t s, const Vec3& dir, float factor, bool exact, std::vector<Link>& links) {
+    const float visible = visibility(r, s);
+    if (!(visible > 0.0f)) return;
+    if (exact) {
+      links.push_back({r, s, dir, factor * visible, true});
+      return;
+    }
+    split_mixed(r, s, 0, 0, visible, links);
+  }
+
+  /// The visible fraction between nodes r and s, by link_rays shadow rays (1 when nothing can
+  /// block them).
+  float visibility(uint32_t r, uint32_t s) {
     const Node& R = tree_.nodes[r];
     const Node& S = tree_.nodes[s];
     rc::Bounds3 both = R.box;
@@ -394,12 +416,7 @@ class Linker {
       counters_.rays += uint64_t(n);
       visible = float(open) / float(n);
     }
-    if (!(visible > 0.0f)) return;
-    if (exact) {
-      links.push_back({r, s, dir, factor * visible, true});
-      return;
-    }
-    split_mixed(r, s, 0, 0, visible, links);
+    return visible;
   }
 
   /// Emits the far link (r, s), or, where an end has elements facing both ways (where the

@@ -677,6 +677,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
   sol.vertex_irradiance.resize(nv);
   for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
+  sol.vertex_direct = sol.vertex_irradiance;
   // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
   // and has not shot yet.
   auto shoot_progressive = [&] {

@@ -59,6 +59,7 @@ struct Solution {
   RadiosityMesh mesh;
   std::vector<Rgb> vertex_radiosity;   ///< B (W·m⁻²): emitted + reflected, leaving the front
   std::vector<Rgb> vertex_irradiance;  ///< E (W·m⁻²) arriving at the front
+  std::vector<Rgb> vertex_direct;      ///< the part of E straight from the lights and emitting surfaces
   std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
 
   // What the solve did.

@@ -7,6 +7,7 @@
 
 #include "radiosity/solver.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/rng.h"
 #include "raytrace_core/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -163,4 +164,68 @@ TEST(HierarchicalRadiosity, AutomaticChoosesByElementCount) {
   EXPECT_EQ(rad::choose_solver(s, rad::kHierarchicalElements, &why), rad::SolverKind::hierarchical);
   s.solver = rad::SolverKind::progressive;
   EXPECT_EQ(rad::choose_solver(s, 10 * rad::kHierarchicalElements), rad::SolverKind::progressive);
+}
+
+// A closed room crowded with a grid of boxes, lit by a lamp: many of the faces that turn towards
+// a source are partly hidden from it by their neighbours, and a cluster link shares one visible
+// fraction among all of its receiving elements that face the source. Partly visible cluster
+// links are therefore refined further (on Šibenik, accepting them left the solution 18 % dark
+// against the path tracer). Here, at a link tolerance a hundred times the default (where most
+// links are between clusters), the reflected light must still agree with progressive
+// refinement, which traces every vertex's own shadow rays, within 3 %. (At the default tolerance
+// the two agree here to 0.1 %; at this one the links' own error grows to 1–2 % either way, and
+// 3 % is well clear of it and well short of the 18 % a sharing error caused.) The vertex final
+// gather is off, so what the links deliver is what the vertices get.
+TEST(HierarchicalRadiosity, PartlyHiddenFacesAgreeWithProgressive) {
+  rc::Scene scene;
+  scene.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.7f)));
+  scene.materials.push_back(rc::Material::make_emitter("lamp", rc::Rgb(20.0f)));
+  rc::TriangleMesh room, boxes;
+  auto box = [](rc::TriangleMesh& m, rc::Vec3 lo, rc::Vec3 hi, bool inward) {
+    const rc::Vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {lo.x, hi.y, lo.z}, {hi.x, hi.y, lo.z},
+                           {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}};
+    const uint32_t base = uint32_t(m.positions.size());
+    for (const rc::Vec3& corner : c) m.positions.push_back(corner);
+    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads) {
+      if (inward)
+        m.indices.insert(m.indices.end(), {base + q[0], base + q[2], base + q[1], base + q[0], base + q[3], base + q[2]});
+      else
+        m.indices.insert(m.indices.end(), {base + q[0], base + q[1], base + q[2], base + q[0], base + q[2], base + q[3]});
+    }
+  };
+  box(room, {-3, 0, -3}, {3, 3, 3}, true);
+  rc::Rng rng(17);
+  for (int i = 0; i < 36; ++i) {
+    // A 6 × 6 grid of boxes, jittered but apart (at most 0.8 wide on a 0.9 pitch).
+    const rc::Vec3 c(-2.25f + 0.9f * float(i % 6) + 0.05f * (rng.uniform() - 0.5f), 0.0f,
+                     -2.25f + 0.9f * float(i / 6) + 0.05f * (rng.uniform() - 0.5f));
+    const rc::Vec3 half(0.15f + 0.25f * rng.uniform(), 0.2f + 0.8f * rng.uniform(), 0.15f + 0.25f * rng.uniform());
+    box(boxes, c - rc::Vec3(half.x, 0.0f, half.z), c + half * rc::Vec3(1.0f, 2.0f, 1.0f), false);
+  }
+  scene.meshes.push_back(room);
+  scene.meshes.push_back(boxes);
+  rc::TriangleMesh lamp;
+  lamp.material = 1;
+  lamp.positions = {{-0.4f, 2.99f, -0.4f}, {0.4f, 2.99f, -0.4f}, {0.4f, 2.99f, 0.4f}, {-0.4f, 2.99f, 0.4f}};
+  lamp.indices = {0, 1, 2, 0, 2, 3};
+  scene.meshes.push_back(lamp);
+  scene.commit();
+
+  rad::SolverSettings hs = settings(rad::SolverKind::hierarchical, 4000, 0);
+  hs.hierarchical.vertex_final_gather = false;
+  hs.hierarchical.link_tolerance = 2e-4;
+  const rad::Solution h = rad::solve(scene, hs);
+  const rad::Solution p = rad::solve(scene, settings(rad::SolverKind::progressive, 4000, 0));
+  std::printf("hierarchical: %zu links, %d iterations, residual %g\n", h.links, h.iterations, h.residual);
+  ASSERT_EQ(h.mesh.vertex_count(), p.mesh.vertex_count());
+  double sum_h = 0.0, sum_p = 0.0;
+  for (size_t v = 0; v < h.mesh.vertex_count(); ++v) {
+    if (h.mesh.vertex_material[v] != 0) continue;
+    sum_h += (h.vertex_irradiance[v] - h.vertex_direct[v]).average();
+    sum_p += (p.vertex_irradiance[v] - p.vertex_direct[v]).average();
+  }
+  std::printf("mean reflected irradiance: hierarchical %.4f, progressive %.4f (ratio %.4f)\n", sum_h, sum_p,
+              sum_h / sum_p);
+  EXPECT_NEAR(sum_h / sum_p, 1.0, 0.03);
 }
