@@ -50,6 +50,9 @@ constexpr float kPlaneSlack = 1e-4f;
 /// How many levels a far link's mixed end (elements facing both ways) is split into children
 /// that share its visibility.
 constexpr int kMixedDepth = 3;
+/// The most an element may reflect of what a unit radiosity everywhere sends it (see the
+/// iteration in solve_hierarchical).
+constexpr float kMaxReflectedGain = 0.99f;
 /// A partly visible cluster link is accepted when this many times its error is acceptable.
 constexpr double kPartialVisibility = 10.0;
 
@@ -679,15 +682,13 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       receivers.push_back(links[i].receiver), first_link.push_back(i);
   first_link.push_back(uint32_t(links.size()));
 
-  // Jacobi iteration: pull B up the tree, gather over the links, push the gathered irradiance
-  // down to the elements, and reflect it.
+  // One gathering step: pull B up the tree, gather over the links, push the gathered irradiance
+  // down to the elements.
   std::vector<Rgb> power, indirect(ne, Rgb(0.0f));
   std::vector<RgbVec> moment;
   std::vector<Gathered> gathered(tree.nodes.size());
-  std::vector<Rgb> next(ne);
-  for (int it = 0; it < settings.max_iterations; ++it) {
-    if (out_of_time()) break;
-    pull(tree, mesh, radiosity, power, moment);
+  auto gather = [&](std::span<const Rgb> from, std::vector<Rgb>& out) {
+    pull(tree, mesh, from, power, moment);
     std::fill(gathered.begin(), gathered.end(), Gathered{});
     rc::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
       for (size_t g = chunk * 64; g < std::min(receivers.size(), chunk * 64 + 64); ++g) {
@@ -718,11 +719,36 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         gathered[c].band1.add(gathered[i].band1);
       }
     }
+    for (const Node& node : tree.nodes)
+      if (node.leaf())
+        out[tree.element(node)] = irradiance_at(gathered[&node - tree.nodes.data()], mesh.element_normal[tree.element(node)]);
+  };
+
+  // Under a unit radiosity everywhere an element gathers at most 1 (a closed room's white
+  // furnace); the links' estimate scatters about that, by their visibility noise. Where they
+  // promise so much more that the element would reflect more than it gathers (ρ·c ≥ 1: surfaces
+  // a hair apart whose point-to-element factors overlap, clusters packed with area), the Jacobi
+  // iteration would grow without bound: a room of overlapping boxes lying 10⁻³ above the floor
+  // reached 10³³. Such an element's gathering is scaled so that ρ·c = 0.99, which bounds every
+  // row of the iteration below 1 and makes it a contraction; elsewhere nothing changes.
+  std::vector<float> gain(ne, 1.0f);
+  {
+    std::vector<Rgb> unit(ne, Rgb(1.0f)), capacity(ne);
+    gather(unit, capacity);
+    for (size_t e = 0; e < ne; ++e) {
+      const float reflected = in.albedo[e].max_component() * capacity[e].max_component();
+      if (reflected > kMaxReflectedGain) gain[e] = kMaxReflectedGain / reflected, ++result.clamped_elements;
+    }
+  }
+
+  // Jacobi iteration: gather, then reflect.
+  std::vector<Rgb> next(ne);
+  for (int it = 0; it < settings.max_iterations; ++it) {
+    if (out_of_time()) break;
+    gather(radiosity, indirect);
     double change = 0.0, total = 0.0;
-    for (const Node& node : tree.nodes) {
-      if (!node.leaf()) continue;
-      const uint32_t e = tree.element(node);
-      indirect[e] = irradiance_at(gathered[&node - tree.nodes.data()], mesh.element_normal[e]);
+    for (size_t e = 0; e < ne; ++e) {
+      indirect[e] *= gain[e];
       next[e] = in.albedo[e] * (direct[e] + indirect[e]);
       const Rgb delta = next[e] - radiosity[e];
       change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e];

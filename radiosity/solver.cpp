@@ -16,6 +16,7 @@
 #include <limits>
 #include <map>
 #include <span>
+#include <string>
 #include <unordered_map>
 
 #include "radiosity/element_scene.h"
@@ -775,6 +776,11 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.nodes = h.nodes;
     sol.links = h.links;
     sol.iterations = h.iterations;
+    if (h.clamped_elements > 0)
+      sol.mesh_report.warnings.push_back(std::to_string(h.clamped_elements) +
+                                         " elements were promised more reflected light than they can return "
+                                         "(surfaces a hair apart?); their gathering was scaled down to keep the "
+                                         "solution bounded");
     sol.residual = h.residual;
     sol.gather_nodes = h.gather_nodes;
     sol.final_gather = h.final_gather;
