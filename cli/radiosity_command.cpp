@@ -184,7 +184,7 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
       ->check(CLI::IsMember({"auto", "progressive", "hierarchical"}));
   cmd.add_option("--link-tolerance", s.hierarchical.link_tolerance,
                  "Hierarchical radiosity: accept a link when the power it may carry wrongly is below this fraction "
-                 "of the reflected power (default 2e-6)")
+                 "of the reflected power (default 2e-6; 2e-5 for gilt render's two-pass radiosity view)")
       ->check(CLI::Range(1e-12, 1.0))
       ->check(finite_number());
   cmd.add_option("--gather-tolerance", s.hierarchical.gather_tolerance,

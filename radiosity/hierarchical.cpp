@@ -669,8 +669,9 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   }
 
   // Links, grouped by receiver for gathering.
+  const double link_tolerance = settings.link_tolerance > 0.0 ? settings.link_tolerance : kDefaultLinkTolerance;
   std::vector<Link> links = Linker(in, tree, power_estimate, moment_estimate,
-                                   settings.link_tolerance * total_estimate, settings, counters)
+                                   link_tolerance * total_estimate, settings, counters)
                                 .link();
   std::stable_sort(links.begin(), links.end(),
                    [](const Link& a, const Link& b) { return a.receiver < b.receiver; });

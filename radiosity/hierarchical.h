@@ -19,11 +19,16 @@ namespace gilt::radiosity {
 
 using rc::Rgb;
 
+/// The link tolerance for solutions whose vertices are the answer (exports, the mesh view).
+inline constexpr double kDefaultLinkTolerance = 2e-6;
+
 /// Parameters of the hierarchical pass; the defaults are the documented defaults.
 struct HierarchicalSettings {
   /// A link is accepted when the power it may carry wrongly is below this fraction of the
   /// scene's reflected power (the BF·A oracle, with the point-source error (size/distance)²).
-  double link_tolerance = 2e-6;
+  /// 0 takes the default of the use: kDefaultLinkTolerance, or a two-pass view's own
+  /// (solver_settings_for in radiosity/view.h).
+  double link_tolerance = 0.0;
   /// A cluster stands in for its elements in the vertex final gather when the irradiance it may
   /// carry wrongly is below this fraction of the local indirect irradiance.
   double gather_tolerance = 0.02;
