@@ -17,14 +17,6 @@
 
 namespace gilt::radiosity {
 
-const char* to_string(ViewMode mode) {
-  switch (mode) {
-    case ViewMode::two_pass: return "two-pass";
-    case ViewMode::mesh: return "mesh";
-  }
-  return "?";
-}
-
 SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
   if (mode == ViewMode::two_pass) {
     settings.subdivision_levels = 0;
@@ -33,6 +25,29 @@ SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
   }
   return settings;
 }
+
+namespace {
+
+/// Beer–Lambert attenuation of the segment `ray` travelled inside a dielectric to reach `si`.
+void absorb(const rc::Material& m, const rc::SurfaceInteraction& si, const rc::Hit& hit, const rc::Ray& ray,
+            Rgb& beta) {
+  if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+    beta *= rc::exp(m.absorption * (-hit.t * glm::length(ray.direction)));
+}
+
+/// Continues a path through the mirror or glass at si (outgoing direction wo in `frame`):
+/// multiplies beta by the sample's weight and replaces `ray`. False when the path ends there.
+bool scatter_specular(const rc::Material& m, const rc::SurfaceInteraction& si, const rc::Frame& frame, const Vec3& wo,
+                      rc::Rng& rng, Rgb& beta, rc::Ray& ray) {
+  const float u_lobe = rng.uniform();
+  const auto bs = rc::bsdf_sample(m, wo, u_lobe, rng.uniform2());
+  if (!bs || !(bs->pdf > 0.0f)) return false;
+  beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
+  ray = rc::spawn_ray(si, frame.to_world(bs->wi));
+  return true;
+}
+
+}  // namespace
 
 /// cos 60°: an element lit on the same side as the input point faces within 60° of it (the
 /// mesher splits vertices at sharper creases, so a steeper element belongs to another side).
@@ -92,19 +107,16 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
     const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
     const rc::Material& mj = scene_.materials[sj.material];
     const Vec3 wo_world = -glm::normalize(ray.direction);
-    if (mj.kind == rc::MaterialKind::dielectric && !sj.front_face && !mj.absorption.is_black())
-      beta *= rc::exp(mj.absorption * (-hit->t * glm::length(ray.direction)));
+    absorb(mj, sj, *hit, ray, beta);
     Rgb found(0.0f);
     if (depth > 0 && mj.is_emissive()) found += rc::emitted_radiance(mj, sj.ng, wo_world);
     if (!mj.is_specular()) {
       const bool above = glm::dot(wo_world, sj.ng) > 0.0f;
       return beta * (found + mj.albedo * irradiance(sj.p, above ? sj.ng : -sj.ng) * (1.0f / rc::kPi));
     }
+    const Rgb seen = beta * found;
     const rc::Frame fj = rc::Frame::from_normal(sj.ns);
-    const auto bs = rc::bsdf_sample(mj, fj.to_local(wo_world), ctx.rng.uniform(), ctx.rng.uniform2());
-    if (!bs || !(bs->pdf > 0.0f)) return beta * found;
-    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    ray = rc::spawn_ray(sj, fj.to_world(bs->wi));
+    if (!scatter_specular(mj, sj, fj, fj.to_local(wo_world), ctx.rng, beta, ray)) return seen;
   }
   return Rgb(0.0f);
 }
@@ -126,15 +138,10 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
       return beta * l;
     }
     const rc::Material& m = display_.materials[si.material];
-    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
-      beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+    absorb(m, si, *hit, ray, beta);
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
-    const rc::Vec3 wo = frame.to_local(-glm::normalize(ray.direction));
-    const float u_lobe = ctx.rng.uniform();
-    const auto bs = rc::bsdf_sample(m, wo, u_lobe, ctx.rng.uniform2());
-    if (!bs || !(bs->pdf > 0.0f)) return Rgb(0.0f);
-    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    ray = rc::spawn_ray(si, frame.to_world(bs->wi));
+    if (!scatter_specular(m, si, frame, frame.to_local(-glm::normalize(ray.direction)), ctx.rng, beta, ray))
+      return Rgb(0.0f);
   }
   return Rgb(0.0f);
 }
@@ -149,8 +156,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
     const rc::Material& m = scene_.materials[si.material];
     const Vec3 wo_world = -glm::normalize(ray.direction);
-    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
-      beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
+    absorb(m, si, *hit, ray, beta);
     // Only the camera and delta bounces lead here, so emission seen is never sampled twice.
     if (m.is_emissive()) radiance += beta * rc::emitted_radiance(m, si.ng, wo_world);
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
@@ -162,11 +168,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
       radiance += beta * rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays).value;
       return radiance + beta * m.albedo * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
     }
-    const float u_lobe = ctx.rng.uniform();
-    const auto bs = rc::bsdf_sample(m, wo, u_lobe, ctx.rng.uniform2());
-    if (!bs || !(bs->pdf > 0.0f)) return radiance;
-    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    ray = rc::spawn_ray(si, frame.to_world(bs->wi));
+    if (!scatter_specular(m, si, frame, wo, ctx.rng, beta, ray)) return radiance;
   }
   return radiance;
 }

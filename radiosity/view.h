@@ -23,9 +23,6 @@ enum class ViewMode {
   mesh,      ///< the elements: the solution's radiance as exported
 };
 
-/// "two-pass" or "mesh".
-const char* to_string(ViewMode mode);
-
 /// The hierarchical link tolerance of the two-pass view when none is asked for: ten times the
 /// exports' (kDefaultLinkTolerance), since its per-pixel gather blurs what the links get wrong.
 /// On Šibenik at a 60-s budget it solves in 23 s instead of running out of time while linking.
