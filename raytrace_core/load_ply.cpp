@@ -9,6 +9,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -221,10 +222,12 @@ void check_body(std::istream& in, const PlyHeader& header, const std::string& fi
           const double v = values.next(p.type);
           if (coordinate && !std::isfinite(float(v)))
             values.fail("coordinate " + p.name + " is not a finite number");
-          if (indices && !(v >= 0.0 && v < double(vertex_count) && v == std::floor(v)))
-            values.fail("face refers to vertex " +
-                        std::to_string(std::isfinite(v) ? static_cast<long long>(v) : -1) + " of " +
-                        std::to_string(vertex_count));
+          if (indices && !(v >= 0.0 && v < double(vertex_count) && v == std::floor(v))) {
+            // Printed as the number it is: 2e62 does not fit a long long, and casting it is undefined.
+            char shown[32];
+            std::snprintf(shown, sizeof shown, "%.15g", v);
+            values.fail("face refers to vertex " + std::string(shown) + " of " + std::to_string(vertex_count));
+          }
         }
       }
     }
