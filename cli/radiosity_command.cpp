@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "radiosity/check.h"
 #include "radiosity/export.h"
+#include "radiosity/onto_input.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
@@ -21,7 +22,7 @@ namespace rc = gilt::raytrace_core;
 namespace {
 
 struct RadiosityOptions {
-  std::string scene, output, quantity = "radiance";
+  std::string scene, output, quantity = "radiance", onto = "elements", fit = "least-squares";
   radiosity::SolverSettings solver;
   radiosity::CheckSettings check;
   int check_points = 0;  ///< 0: no check
@@ -44,11 +45,14 @@ void run_radiosity(RadiosityOptions& o) {
   ex.quantity = radiosity::parse_quantity(o.quantity);
   ex.srgb8 = o.srgb8;
   ex.exposure = o.exposure;
-  if (o.srgb8 && std::filesystem::path(o.output).extension() != ".ply")
-    throw rc::InputError("--srgb8 applies to .ply output only");
+  const bool onto_input = o.onto == "input";
+  if (o.srgb8 && (onto_input || std::filesystem::path(o.output).extension() != ".ply"))
+    throw rc::InputError("--srgb8 applies to .ply output of --onto elements only");
+  if (o.fit != "least-squares" && !onto_input) throw rc::InputError("--fit applies to --onto input only");
   const auto start = std::chrono::steady_clock::now();
   const rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
+  if (onto_input) radiosity::check_onto_output(o.output, scene);
   o.solver.progress = !o.quiet && !o.json;
   // --time covers the whole command: loading has used some of it.
   if (o.solver.time_limit > 0.0)
@@ -56,7 +60,14 @@ void run_radiosity(RadiosityOptions& o) {
         1e-3, o.solver.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   const radiosity::Solution sol = radiosity::solve(scene, o.solver);
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
-  radiosity::write_solution(o.output, scene, sol, ex);
+  std::optional<radiosity::InputColours> onto;
+  if (onto_input) {
+    onto = radiosity::fit_input_colours(
+        scene, sol, o.fit == "point" ? radiosity::VertexFit::point : radiosity::VertexFit::least_squares, ex.quantity);
+    radiosity::write_onto_input(o.output, scene, *onto, ex);
+  } else {
+    radiosity::write_solution(o.output, scene, sol, ex);
+  }
   std::optional<radiosity::CheckResult> check;
   if (o.check_points > 0) {
     o.check.points = o.check_points;
@@ -104,7 +115,14 @@ void run_radiosity(RadiosityOptions& o) {
                           {"shooting", sol.shoot_seconds}}},
                         {"threads", threads},
                         {"quantity", o.quantity},
+                        {"onto", o.onto},
                         {"output", o.output}};
+    if (onto)
+      j["fit"] = {{"method", o.fit},
+                  {"samples", onto->stats.samples},
+                  {"samples_without_solution", onto->stats.missing},
+                  {"iterations", onto->stats.iterations},
+                  {"seconds", onto->seconds}};
     if (check)
       j["check"] = {{"points", check->points},
                     {"samples", o.check.samples},
@@ -149,6 +167,10 @@ void run_radiosity(RadiosityOptions& o) {
                 "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
                 100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
+  if (onto)
+    std::printf("  onto:    %s fit to the input's vertices: %llu samples (%llu without a solution), %.3g s\n",
+                o.fit.c_str(), static_cast<unsigned long long>(onto->stats.samples),
+                static_cast<unsigned long long>(onto->stats.missing), onto->seconds);
   std::printf("  wrote %s (%s)\n", o.output.c_str(), o.quantity.c_str());
 }
 
@@ -205,8 +227,17 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
       ->check(finite_number());
   cmd->add_option("--quantity", o->quantity, "Vertex colour: radiance (default), irradiance or radiosity")
       ->check(CLI::IsMember({"radiance", "irradiance", "radiosity"}));
+  cmd->add_option("--onto", o->onto,
+                  "elements: export gilt's element mesh (default); input: the input model file itself, with "
+                  "vertex colours added (glTF/GLB)")
+      ->check(CLI::IsMember({"elements", "input"}));
+  cmd->add_option("--fit", o->fit,
+                  "With --onto input: least-squares (default) fits the colours to the solution over each face; "
+                  "point takes the solution at each vertex")
+      ->check(CLI::IsMember({"least-squares", "point"}));
   cmd->add_flag("--srgb8", o->srgb8, "PLY: 8-bit sRGB colours instead of linear float");
-  cmd->add_option("--exposure", o->exposure, "With --srgb8: scale by 2^exposure")
+  cmd->add_option("--exposure", o->exposure,
+                  "Scale by 2^exposure: with --srgb8, and for glTF COLOR_0 with --onto input")
       ->check(CLI::Range(-64.0f, 64.0f))
       ->check(finite_number());
   cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));

@@ -80,9 +80,9 @@ Rgb RadiosityView::radiance(const rc::Ray& ray, rc::SampleContext& ctx) const {
   return mode_ == ViewMode::mesh ? mesh_radiance(ray, ctx) : two_pass_radiance(ray, ctx);
 }
 
-Rgb RadiosityView::irradiance(const Vec3& p, const Vec3& n) const {
+std::optional<Rgb> RadiosityView::irradiance(const Vec3& p, const Vec3& n) const {
   const std::optional<rc::Hit> near = display_.nearest_triangle(0, p, reach_, n, kFacing);
-  if (!near) return Rgb(0.0f);
+  if (!near) return std::nullopt;
   const auto& e = elements_[near->prim_id];
   return vertex_irradiance_[e[0]] * (1.0f - near->u - near->v) + vertex_irradiance_[e[1]] * near->u +
          vertex_irradiance_[e[2]] * near->v;
@@ -112,7 +112,7 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
     if (depth > 0 && mj.is_emissive()) found += rc::emitted_radiance(mj, sj.ng, wo_world);
     if (!mj.is_specular()) {
       const bool above = glm::dot(wo_world, sj.ng) > 0.0f;
-      return beta * (found + mj.albedo * irradiance(sj.p, above ? sj.ng : -sj.ng) * (1.0f / rc::kPi));
+      return beta * (found + mj.albedo * irradiance(sj.p, above ? sj.ng : -sj.ng).value_or(Rgb(0.0f)) * (1.0f / rc::kPi));
     }
     const Rgb seen = beta * found;
     const rc::Frame fj = rc::Frame::from_normal(sj.ns);

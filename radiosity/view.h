@@ -10,6 +10,7 @@
 //   by the gather instead of showing as blotches.
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "radiosity/solver.h"
@@ -48,8 +49,9 @@ class RadiosityView {
 
   /// Irradiance (W·m⁻²) the solution gives a point of the input at p whose lit side faces along
   /// the unit normal n: interpolated at the nearest point of an element that faces the same way
-  /// (within 60°) and lies within reach (twice the target edge); black where none does.
-  Rgb irradiance(const Vec3& p, const Vec3& n) const;
+  /// (within 60°) and lies within reach (twice the target edge); nothing where none does (the
+  /// surface was buried, or is a mirror or glass).
+  std::optional<Rgb> irradiance(const Vec3& p, const Vec3& n) const;
 
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one

@@ -103,6 +103,8 @@ class GltfLoader {
           required != "KHR_texture_transform")
         fail("requires extension " + required + ", which gilt does not support");
     first_material_ = static_cast<uint32_t>(scene_.materials.size());
+    file_index_ = int32_t(scene_.model_files.size());
+    scene_.model_files.push_back(file_);
     bool textures = false;
     for (size_t i = 0; i < model_.materials.size(); ++i) {
       const tinygltf::Material& gm = model_.materials[i];
@@ -166,9 +168,18 @@ class GltfLoader {
         fail("node " + std::to_string(index) + ": no mesh " + std::to_string(node.mesh));
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
       const std::string name = mesh.name.empty() ? "mesh" + std::to_string(node.mesh) : mesh.name;
-      for (size_t p = 0; p < mesh.primitives.size(); ++p)
+      for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+        const size_t before = scene_.meshes.size();
         add_primitive(mesh.primitives[p], world, name + "#" + std::to_string(p),
                       "mesh '" + name + "' primitive " + std::to_string(p));
+        if (scene_.meshes.size() > before) {
+          MeshOrigin& origin = scene_.meshes.back().origin;
+          origin.file = file_index_;
+          origin.node = index;
+          origin.mesh = node.mesh;
+          origin.primitive = int32_t(p);
+        }
+      }
     }
     if (node.camera >= 0) add_camera(node.camera, world);
     const tinygltf::Value& light = extension(node.extensions, "KHR_lights_punctual");
@@ -372,6 +383,7 @@ class GltfLoader {
   std::vector<bool> on_path_;  // nodes on the current root-to-node path, to catch cycles
   uint32_t first_material_ = 0;
   int default_material_ = -1;
+  int32_t file_index_ = -1;
   bool camera_done_ = false;
 };
 

@@ -216,7 +216,10 @@ class JsonSceneReader {
     const auto offset = static_cast<uint32_t>(scene_.materials.size());
     if (!override_material)
       for (Material& m : part.materials) scene_.materials.push_back(std::move(m));
+    const auto file_offset = int32_t(scene_.model_files.size());
+    for (std::string& f : part.model_files) scene_.model_files.push_back(std::move(f));
     for (TriangleMesh& mesh : part.meshes) {
+      if (mesh.origin.file >= 0) mesh.origin.file += file_offset;
       mesh.material = override_material ? material : mesh.material + offset;
       transform_mesh(mesh, transform);
       scene_.meshes.push_back(std::move(mesh));

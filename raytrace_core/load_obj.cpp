@@ -261,9 +261,12 @@ void load_obj(const fs::path& path, Scene& scene) {
   }
 
   const std::string stem = path.stem().string();
+  const auto file_index = int32_t(scene.model_files.size());
+  scene.model_files.push_back(file);
   if (corners_of.empty()) scene.warnings.push_back(file + ": no faces");
   for (const auto& [material, corners] : corners_of) {
     TriangleMesh mesh;
+    mesh.origin.file = file_index;
     if (material >= 0) {
       mesh.material = first_material + uint32_t(material);
       mesh.name = stem + ":" + mtls[size_t(material)].name;
@@ -292,6 +295,7 @@ void load_obj(const fs::path& path, Scene& scene) {
                            ": a face refers to a vertex, normal or texture coordinate that does not exist");
         mesh.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
                                     attrib.vertices[3 * v + 2]);
+        mesh.origin.vertex.push_back(uint32_t(v));
         if (has_normals)
           mesh.normals.emplace_back(attrib.normals[3 * n], attrib.normals[3 * n + 1],
                                     attrib.normals[3 * n + 2]);

@@ -6,6 +6,7 @@
 // (ascii) or the element (binary); then OpenMesh reads the mesh, its error stream captured.
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -265,7 +267,7 @@ class CaptureOpenMeshErrors {
 
 void load_ply(const fs::path& path, Scene& scene) {
   const std::string file = path.string();
-  size_t declared_faces = 0;
+  size_t declared_faces = 0, declared_vertices = 0;
   bool has_colours = false;
   {
     std::ifstream in(path, std::ios::binary);
@@ -274,6 +276,7 @@ void load_ply(const fs::path& path, Scene& scene) {
     check_body(in, header, file);
     for (const PlyElement& e : header.elements) {
       if (e.name == "face") declared_faces = e.count;
+      if (e.name == "vertex") declared_vertices = e.count;
       for (const PlyProperty& p : e.properties)
         has_colours = has_colours || (e.name == "vertex" && (p.name == "red" || p.name == "diffuse_red"));
     }
@@ -298,10 +301,28 @@ void load_ply(const fs::path& path, Scene& scene) {
 
   TriangleMesh mesh;
   mesh.name = path.stem().string();
+  mesh.origin.file = int32_t(scene.model_files.size());
+  scene.model_files.push_back(file);
   mesh.positions.reserve(om.n_vertices());
   for (const auto& v : om.vertices()) {
     const auto& p = om.point(v);
     mesh.positions.emplace_back(p[0], p[1], p[2]);
+  }
+  // OpenMesh reads the file's vertices in order and appends the copies it makes for non-manifold
+  // faces; each copy is traced back to the file's vertex at the same position.
+  if (mesh.positions.size() > declared_vertices) {
+    std::map<std::array<float, 3>, uint32_t> file_vertex;
+    for (uint32_t v = 0; v < declared_vertices && v < mesh.positions.size(); ++v)
+      file_vertex.try_emplace({mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z}, v);
+    mesh.origin.vertex.resize(mesh.positions.size());
+    for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
+      if (v < declared_vertices) {
+        mesh.origin.vertex[v] = v;
+        continue;
+      }
+      const auto it = file_vertex.find({mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z});
+      mesh.origin.vertex[v] = it != file_vertex.end() ? it->second : 0;  // a copy always has an original
+    }
   }
   if (options.check(OpenMesh::IO::Options::VertexNormal))
     for (const auto& v : om.vertices()) {

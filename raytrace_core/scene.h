@@ -21,9 +21,22 @@
 
 namespace gilt::raytrace_core {
 
+/// Where a mesh came from in the model file it was read from, so that results computed on the
+/// scene (baked colours) can be written back onto that file's own vertices.
+struct MeshOrigin {
+  int32_t file = -1;       ///< index into Scene::model_files; -1: built by code, not read from a file
+  int32_t node = -1;       ///< glTF: the node that placed this instance of the mesh
+  int32_t mesh = -1;       ///< glTF: the mesh
+  int32_t primitive = -1;  ///< glTF: the primitive; its vertex i is this mesh's vertex i
+  /// OBJ and PLY: the file's vertex (OBJ: its `v` line, from 0) of each mesh vertex; empty when
+  /// vertex i is the file's vertex i.
+  std::vector<uint32_t> vertex;
+};
+
 /// An indexed triangle mesh of one material.
 struct TriangleMesh {
   std::string name;
+  MeshOrigin origin;
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;     ///< per-vertex shading normals, empty or one per position
   std::vector<Vec2> uvs;         ///< per-vertex texture coordinates, empty or one per position
@@ -89,6 +102,7 @@ class Scene {
   std::optional<Camera> camera;        ///< the scene's own camera, if it has one
   RenderDefaults render;
   std::vector<std::string> warnings;   ///< non-fatal problems found while loading or committing
+  std::vector<std::string> model_files;  ///< the mesh files read, as given (see MeshOrigin::file)
 
   /// Validates the description (throws InputError naming the mesh and field on NaN or infinite
   /// coordinates, bad indices or material references), drops degenerate triangles with a

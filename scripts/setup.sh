@@ -19,7 +19,7 @@ jobs=${JOBS:-$(nproc)}
 packages=(
   cmake g++ ninja-build pkg-config
   libglm-dev libembree-dev libtbb-dev libopenimageio-dev
-  libcgal-dev libgmp-dev libmpfr-dev libboost-dev libopenmesh-dev libflann-dev liblz4-dev
+  libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev libboost-dev libopenmesh-dev libflann-dev liblz4-dev
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev
   libgtest-dev libbenchmark-dev
 )

@@ -1,0 +1,59 @@
+#pragma once
+// A radiosity solution written onto the user's own model (`gilt radiosity --onto input`): the
+// model file the scene was read from comes back with its structure, geometry and everything
+// else as it was, plus one colour per vertex fitted to the solution over its faces
+// (radiosity/vertex_fit.h). The other export (radiosity/export.h) writes gilt's element mesh.
+//
+// glTF (.gltf or .glb in, either out): every primitive the solution covers gets
+//   COLOR_0     float VEC3, the quantity × 2^exposure clamped to [0, 1] (display-referred
+//               linear, as the glTF specification requires of COLOR_0; viewers multiply the
+//               material's base colour by it);
+//   _RADIANCE, _IRRADIANCE or _RADIOSITY  float VEC3, the quantity itself (HDR);
+// nodes, meshes, primitives, materials, textures, animations, skins and extensions are kept, and
+// so are the accessors and buffers the input had, byte for byte. A mesh placed by several nodes
+// is split, one copy per node, since each instance is lit differently (Blender's bake does the
+// same). Relative URIs of the input's buffers and images are rewritten to reach the same files
+// from the output's folder. A .gltf output's new data go in a .bin beside it, named after it.
+
+#include <string>
+#include <vector>
+
+#include "radiosity/export.h"
+#include "radiosity/solver.h"
+#include "radiosity/vertex_fit.h"
+
+namespace gilt::radiosity {
+
+/// Colours for the vertices of the meshes read from one model file.
+struct InputColours {
+  int32_t file = -1;                        ///< index into Scene::model_files
+  std::vector<std::vector<Rgb>> per_mesh;   ///< per scene mesh, one per vertex; empty: not baked
+  FitStats stats;
+  double seconds = 0.0;
+};
+
+/// The model file `--onto input` writes onto: the scene's only model file. Throws InputError
+/// when the scene was not read from one, or from several.
+int32_t onto_input_file(const rc::Scene& scene);
+
+/// Fits the solution's `quantity` onto the vertices of every non-specular mesh read from the
+/// model file (onto_input_file): irradiance by `fit` over each mesh's faces, at a quadrature
+/// spacing of half the solution's target edge, then turned into the quantity by the mesh's
+/// material (B = π·Le + ρ·E, L = B/π).
+InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity);
+
+/// Throws InputError unless write_onto_input can write `path` for the scene: called before
+/// solving, so a mistyped output does not cost a solve.
+void check_onto_output(const std::string& path, const rc::Scene& scene);
+
+/// Writes the model file with the colours added; the format follows the output's extension and
+/// must be the input's (.gltf and .glb are interchangeable). Throws InputError for a format
+/// that does not match, or an output that would overwrite an input file.
+void write_onto_input(const std::string& path, const rc::Scene& scene, const InputColours& colours,
+                      const ExportSettings& settings);
+
+/// glTF writer behind write_onto_input (radiosity/onto_gltf.cpp).
+void write_onto_gltf(const std::string& input, const std::string& output, const rc::Scene& scene,
+                     const InputColours& colours, const ExportSettings& settings);
+
+}  // namespace gilt::radiosity

@@ -1,0 +1,299 @@
+// `gilt radiosity --onto input` on glTF: the output is the input model with colours added. A
+// model written here (a floor, a panel placed by two nodes, an animation, buffers in a .bin) and,
+// when ../shared/scenes is beside the checkout, the milk truck and AnimateAll go in; the test
+// compares the output's node tree, meshes, primitives, attribute sets, accessors and the bytes of
+// every position and index buffer with the input's, and checks the bad cases.
+
+#include <gtest/gtest.h>
+#include <tiny_gltf.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tests/support/cli_run.h"
+
+namespace gilt::test {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+const std::string kGilt = GILT_BINARY_PATH;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("gilt-onto-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool no_images(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+tinygltf::Model load(const fs::path& path) {
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(no_images, nullptr);
+  std::string err, warn;
+  const bool ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
+                                             : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
+  EXPECT_TRUE(ok) << path << ": " << err;
+  return model;
+}
+
+/// The bytes of an accessor's elements, tightly packed.
+std::string accessor_bytes(const tinygltf::Model& m, int index) {
+  const tinygltf::Accessor& a = m.accessors.at(size_t(index));
+  const tinygltf::BufferView& v = m.bufferViews.at(size_t(a.bufferView));
+  const size_t element = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) *
+                                tinygltf::GetNumComponentsInType(uint32_t(a.type)));
+  const size_t stride = v.byteStride ? v.byteStride : element;
+  const unsigned char* base = m.buffers.at(size_t(v.buffer)).data.data() + v.byteOffset + a.byteOffset;
+  std::string out;
+  for (size_t i = 0; i < a.count; ++i) out.append(reinterpret_cast<const char*>(base + i * stride), element);
+  return out;
+}
+
+std::vector<float> floats(const tinygltf::Model& m, int index) {
+  const std::string bytes = accessor_bytes(m, index);
+  std::vector<float> out(bytes.size() / 4);
+  std::memcpy(out.data(), bytes.data(), out.size() * 4);
+  return out;
+}
+
+/// Compares an --onto input output with its input; returns how many meshes the output split off.
+size_t expect_same_structure(const tinygltf::Model& in, const tinygltf::Model& out, const std::string& quantity_attr) {
+  EXPECT_EQ(out.nodes.size(), in.nodes.size());
+  EXPECT_EQ(out.scenes.size(), in.scenes.size());
+  EXPECT_EQ(out.materials.size(), in.materials.size());
+  EXPECT_EQ(out.textures.size(), in.textures.size());
+  EXPECT_EQ(out.images.size(), in.images.size());
+  EXPECT_EQ(out.animations.size(), in.animations.size());
+  EXPECT_EQ(out.skins.size(), in.skins.size());
+  EXPECT_EQ(out.extensionsUsed, in.extensionsUsed);
+  EXPECT_EQ(out.extensionsRequired, in.extensionsRequired);
+  EXPECT_GE(out.meshes.size(), in.meshes.size());
+  for (size_t s = 0; s < std::min(in.scenes.size(), out.scenes.size()); ++s)
+    EXPECT_EQ(out.scenes[s].nodes, in.scenes[s].nodes);
+  for (size_t a = 0; a < std::min(in.animations.size(), out.animations.size()); ++a) {
+    EXPECT_EQ(out.animations[a].channels.size(), in.animations[a].channels.size());
+    for (size_t s = 0; s < std::min(in.animations[a].samplers.size(), out.animations[a].samplers.size()); ++s) {
+      EXPECT_EQ(accessor_bytes(out, out.animations[a].samplers[s].input),
+                accessor_bytes(in, in.animations[a].samplers[s].input));
+      EXPECT_EQ(accessor_bytes(out, out.animations[a].samplers[s].output),
+                accessor_bytes(in, in.animations[a].samplers[s].output));
+    }
+  }
+  std::set<int> split;
+  for (size_t n = 0; n < std::min(in.nodes.size(), out.nodes.size()); ++n) {
+    const tinygltf::Node &a = in.nodes[n], &b = out.nodes[n];
+    EXPECT_EQ(b.children, a.children) << "node " << n;
+    EXPECT_EQ(b.matrix, a.matrix) << "node " << n;
+    EXPECT_EQ(b.translation, a.translation) << "node " << n;
+    EXPECT_EQ(b.rotation, a.rotation) << "node " << n;
+    EXPECT_EQ(b.scale, a.scale) << "node " << n;
+    EXPECT_EQ(b.skin, a.skin) << "node " << n;
+    EXPECT_EQ(b.camera, a.camera) << "node " << n;
+    EXPECT_EQ(b.mesh < 0, a.mesh < 0) << "node " << n;
+    if (a.mesh < 0 || b.mesh < 0) continue;
+    if (b.mesh != a.mesh) {
+      EXPECT_GE(size_t(b.mesh), in.meshes.size()) << "node " << n << " moved to another input mesh";
+      split.insert(b.mesh);
+    }
+    const tinygltf::Mesh &ma = in.meshes[size_t(a.mesh)], &mb = out.meshes.at(size_t(b.mesh));
+    EXPECT_EQ(mb.primitives.size(), ma.primitives.size());
+    EXPECT_EQ(mb.weights, ma.weights);
+    for (size_t p = 0; p < std::min(ma.primitives.size(), mb.primitives.size()); ++p) {
+      const tinygltf::Primitive &pa = ma.primitives[p], &pb = mb.primitives[p];
+      EXPECT_EQ(pb.material, pa.material);
+      EXPECT_EQ(pb.mode, pa.mode);
+      EXPECT_EQ(pb.indices, pa.indices);
+      EXPECT_EQ(pb.targets, pa.targets);
+      if (pa.indices >= 0) {
+        EXPECT_EQ(accessor_bytes(out, pb.indices), accessor_bytes(in, pa.indices));
+      }
+      std::set<std::string> added;
+      for (const auto& [name, accessor] : pb.attributes) {
+        const auto it = pa.attributes.find(name);
+        if (it == pa.attributes.end() || name == "COLOR_0") {
+          added.insert(name);
+          continue;
+        }
+        EXPECT_EQ(accessor, it->second) << name;
+        EXPECT_EQ(accessor_bytes(out, accessor), accessor_bytes(in, it->second)) << name;  // positions included
+      }
+      for (const auto& [name, accessor] : pa.attributes) EXPECT_TRUE(pb.attributes.count(name)) << name;
+      if (added.empty()) continue;  // a mirror or glass primitive is not baked
+      EXPECT_EQ(added, (std::set<std::string>{"COLOR_0", quantity_attr})) << "node " << n << " primitive " << p;
+      const size_t count = out.accessors.at(size_t(pb.attributes.at("POSITION"))).count;
+      const std::vector<float> colour = floats(out, pb.attributes.at("COLOR_0"));
+      const std::vector<float> hdr = floats(out, pb.attributes.at(quantity_attr));
+      EXPECT_EQ(colour.size(), 3 * count);
+      EXPECT_EQ(hdr.size(), 3 * count);
+      for (float c : colour) EXPECT_TRUE(c >= 0.0f && c <= 1.0f) << c;
+      for (float c : hdr) EXPECT_TRUE(std::isfinite(c) && c >= 0.0f) << c;
+    }
+  }
+  EXPECT_EQ(out.meshes.size(), in.meshes.size() + split.size());
+  return split.size();
+}
+
+void write_file(const fs::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary) << bytes;
+}
+
+/// A floor (mesh 0) under a panel (mesh 1) placed by two nodes, one of them animated; the
+/// geometry lives in data.bin. Lit from the JSON wrapper scene.json by a sun and a sky.
+fs::path write_model(const fs::path& dir) {
+  std::string bin;
+  const auto put = [&bin](std::initializer_list<float> xs) {
+    for (float x : xs) bin.append(reinterpret_cast<const char*>(&x), 4);
+  };
+  put({-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2});                       // floor, 48 bytes
+  put({-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f});  // panel, 48 bytes
+  for (uint16_t i : {0, 1, 2, 0, 2, 3}) bin.append(reinterpret_cast<const char*>(&i), 2);  // 12 bytes
+  put({0.0f, 1.0f});                                                     // animation times, 8 bytes
+  put({0, 1, 0, 0, 1.5f, 0});                                            // translations, 24 bytes
+  write_file(dir / "data.bin", bin);
+  Json model = Json::parse(R"({
+    "asset": {"version": "2.0"},
+    "scene": 0,
+    "scenes": [{"nodes": [0]}],
+    "nodes": [
+      {"name": "root", "children": [1, 2, 3]},
+      {"name": "floor", "mesh": 0},
+      {"name": "panel A", "mesh": 1, "translation": [0, 1, 0]},
+      {"name": "panel B", "mesh": 1, "translation": [2.5, 1.2, 0], "scale": [0.5, 0.5, 0.5]}],
+    "meshes": [
+      {"name": "floor", "primitives": [{"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]},
+      {"name": "panel", "primitives": [{"attributes": {"POSITION": 1}, "indices": 2, "material": 0}]}],
+    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}}],
+    "animations": [{
+      "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}],
+      "samplers": [{"input": 3, "output": 4, "interpolation": "LINEAR"}]}],
+    "accessors": [
+      {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
+      {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, 0, -0.5], "max": [0.5, 0, 0.5]},
+      {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"},
+      {"bufferView": 3, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+      {"bufferView": 4, "componentType": 5126, "count": 2, "type": "VEC3"}],
+    "bufferViews": [
+      {"buffer": 0, "byteOffset": 0, "byteLength": 48, "target": 34962},
+      {"buffer": 0, "byteOffset": 48, "byteLength": 48, "target": 34962},
+      {"buffer": 0, "byteOffset": 96, "byteLength": 12, "target": 34963},
+      {"buffer": 0, "byteOffset": 108, "byteLength": 8},
+      {"buffer": 0, "byteOffset": 116, "byteLength": 24}],
+    "buffers": [{"uri": "data.bin"}]})");
+  model["buffers"][0]["byteLength"] = bin.size();
+  write_file(dir / "model.gltf", model.dump(2));
+  write_file(dir / "scene.json", R"({
+    "meshes": [{"file": "model.gltf"}],
+    "lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2},
+               {"type": "environment", "radiance": 0.3}]})");
+  return dir / "scene.json";
+}
+
+/// The path in single quotes for the shell (appended piecewise: GCC 12 warns falsely about
+/// `"'" + path.string()`).
+std::string quoted(const fs::path& p) {
+  std::string s(1, '\'');
+  s += p.string();
+  s += '\'';
+  return s;
+}
+
+std::string run(const std::string& args, const fs::path& dir) {
+  const CliResult r = run_command(kGilt + " radiosity " + args + " -q", dir);
+  EXPECT_EQ(r.code, 0) << args << "\n" << r.err;
+  return r.out;
+}
+
+TEST(OntoInput, AWrittenModelComesBackWhole) {
+  const fs::path dir = fresh_dir("model");
+  const fs::path scene = write_model(dir);
+  const std::string model_before = slurp(dir / "model.gltf"), bin_before = slurp(dir / "data.bin");
+  fs::create_directories(dir / "out");
+  for (const char* name : {"out/baked.gltf", "out/baked.glb"}) {
+    run(quoted(scene) + " --onto input --elements 400 -o " + quoted(dir / name), dir);
+    const tinygltf::Model in = load(dir / "model.gltf"), out = load(dir / name);
+    EXPECT_EQ(expect_same_structure(in, out, "_RADIANCE"), 1u) << name;  // panel B's own copy of the panel
+    EXPECT_EQ(out.nodes[2].mesh, 1);
+    EXPECT_EQ(out.nodes[3].mesh, 2);
+    // The two panels are lit alike from above (no occluder over either): their colours agree.
+    const auto a = floats(out, out.meshes[1].primitives[0].attributes.at("_RADIANCE"));
+    const auto b = floats(out, out.meshes[2].primitives[0].attributes.at("_RADIANCE"));
+    // Open to the sky and the sun: L = ρ/π (E_sun cos θ + π L_sky) on the panel's top, ρ = 0.5.
+    const double expected = 0.5 / M_PI * (2.0 / std::sqrt(1.0 + 0.09 + 0.04) + M_PI * 0.3);
+    for (size_t k = 0; k < a.size(); ++k) {
+      EXPECT_NEAR(a[k], expected, 0.02 * expected) << k;
+      EXPECT_NEAR(b[k], expected, 0.02 * expected) << k;
+    }
+  }
+  // The .gltf's new buffer sits beside it, and the input's buffer is reached from out/.
+  EXPECT_TRUE(fs::exists(dir / "out/baked.bin"));
+  const Json written = Json::parse(slurp(dir / "out/baked.gltf"));
+  EXPECT_EQ(written["buffers"][0]["uri"], "../data.bin");
+  EXPECT_EQ(slurp(dir / "model.gltf"), model_before);
+  EXPECT_EQ(slurp(dir / "data.bin"), bin_before);
+  fs::remove_all(dir);
+}
+
+TEST(OntoInput, BadRequestsAreRefusedBeforeSolving) {
+  const fs::path dir = fresh_dir("bad");
+  const fs::path scene = write_model(dir);
+  const std::string q = quoted(scene) + " --onto input --elements 100 -q ";
+  const struct {
+    std::string args, message;
+  } cases[] = {
+      {q + "-o " + quoted(dir / "model.gltf"), "is the input model"},
+      {q + "-o " + quoted(dir / "data.gltf"), "would overwrite the input's"},
+      {q + "-o " + quoted(dir / "x.obj"), "writes the input's own format"},
+      {q + "-o " + quoted(dir / "x.ply"), "writes the input's own format"},
+      {"cornell --onto input -o " + quoted(dir / "x.glb"), "use --onto elements"},
+      {q + "--srgb8 -o " + quoted(dir / "x.glb"), "--srgb8 applies"},
+      {"cornell --fit point -o " + quoted(dir / "x.ply"), "--fit applies to --onto input only"},
+  };
+  const std::string before = slurp(dir / "model.gltf"), bin = slurp(dir / "data.bin");
+  for (const auto& c : cases) {
+    const CliResult r = run_command(kGilt + " radiosity " + c.args, dir);
+    EXPECT_NE(r.code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
+  }
+  EXPECT_EQ(slurp(dir / "model.gltf"), before);
+  EXPECT_EQ(slurp(dir / "data.bin"), bin);
+  EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  fs::remove_all(dir);
+}
+
+TEST(OntoInput, SharedScenesKeepTheirStructure) {
+  const fs::path scenes = fs::path(GILT_SOURCE_DIR) / ".." / "shared" / "scenes";
+  if (!fs::is_directory(scenes)) GTEST_SKIP() << scenes << " is not beside the checkout";
+  const fs::path dir = fresh_dir("shared");
+  const struct {
+    fs::path scene, model;
+  } cases[] = {
+      {scenes / "wrap" / "truck-lit.json", scenes / "milk-truck" / "CesiumMilkTruck.gltf"},
+      {scenes / "animate-all" / "24_animation_pointer.gltf", scenes / "animate-all" / "24_animation_pointer.gltf"},
+  };
+  for (const auto& c : cases) {
+    if (!fs::exists(c.model)) continue;
+    for (const char* ext : {".gltf", ".glb"}) {
+      const fs::path out = dir / (c.model.stem().string() + ext);
+      run(quoted(c.scene) + " --onto input --elements 2000 --quantity irradiance -o " + quoted(out), dir);
+      expect_same_structure(load(c.model), load(out), "_IRRADIANCE");
+    }
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace gilt::test
