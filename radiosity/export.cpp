@@ -81,17 +81,6 @@ void require_folder(const fs::path& destination) {
 
 // --- What gets written ----------------------------------------------------------------------
 
-const char* quantity_name(Quantity quantity) {
-  switch (quantity) {
-    case Quantity::radiance:
-      return "radiance";
-    case Quantity::irradiance:
-      return "irradiance";
-    case Quantity::radiosity:
-      return "radiosity";
-  }
-  return "?";
-}
 
 const char* quantity_units(Quantity quantity) {
   return quantity == Quantity::radiance ? "W/(sr m^2)" : "W/m^2";
@@ -124,7 +113,7 @@ std::vector<Rgb> vertex_colours(const Solution& solution, Quantity quantity) {
   const std::vector<Rgb>& source =
       quantity == Quantity::irradiance ? solution.vertex_irradiance : solution.vertex_radiosity;
   if (source.size() != n) {
-    throw std::logic_error(std::string("write_solution: ") + quantity_name(quantity) + " is not per vertex");
+    throw std::logic_error(std::string("write_solution: ") + to_string(quantity) + " is not per vertex");
   }
   std::vector<Rgb> colours(n);
   for (size_t v = 0; v < n; ++v) {
@@ -140,7 +129,7 @@ std::vector<Rgb> vertex_colours(const Solution& solution, Quantity quantity) {
         break;
     }
     if (!colours[v].is_finite()) {
-      throw std::logic_error("write_solution: " + std::string(quantity_name(quantity)) + " of vertex " +
+      throw std::logic_error("write_solution: " + std::string(to_string(quantity)) + " of vertex " +
                              std::to_string(v) + " is not finite");
     }
   }
@@ -291,7 +280,7 @@ std::string encode_obj(const RadiosityMesh& mesh, const std::vector<Rgb>& colour
   std::string out;
   out.reserve(96 * mesh.vertex_count() + 40 * mesh.element_count());
   out += "# gilt radiosity export: vertex colours are linear ";
-  out += quantity_name(quantity);
+  out += to_string(quantity);
   out += " in ";
   out += quantity_units(quantity);
   out += "\nmtllib " + mtl_name + "\n";
@@ -459,6 +448,18 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
 }
 
 }  // namespace
+
+const char* to_string(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::radiance:
+      return "radiance";
+    case Quantity::irradiance:
+      return "irradiance";
+    case Quantity::radiosity:
+      return "radiosity";
+  }
+  return "?";
+}
 
 Quantity parse_quantity(const std::string& name) {
   if (name == "radiance") return Quantity::radiance;

@@ -22,6 +22,9 @@ struct ExportSettings {
   float exposure = 0.0f;   ///< with srgb8
 };
 
+/// "radiance", "irradiance" or "radiosity".
+const char* to_string(Quantity quantity);
+
 /// Quantity from its name ("radiance", "irradiance", "radiosity"); throws InputError otherwise.
 Quantity parse_quantity(const std::string& name);
 

@@ -32,20 +32,51 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
   const auto start = std::chrono::steady_clock::now();
   InputColours out;
   out.file = onto_input_file(scene);
-  out.per_mesh.resize(scene.meshes.size());
+  const std::string ext = rc::lower_extension(scene.model_files[size_t(out.file)]);
+  const bool per_file_vertex = ext == ".obj" || ext == ".ply";
   const RadiosityView view(scene, solution, ViewMode::mesh, /*ambient=*/false);
-  const SurfaceField field = [&view](const Vec3& p, const Vec3& n) { return view.irradiance(p, n); };
   const float spacing = 0.5f * solution.mesh_report.max_edge;
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const rc::TriangleMesh& mesh = scene.meshes[m];
-    const rc::Material& material = scene.materials[mesh.material];
-    if (mesh.origin.file != out.file || material.is_specular()) continue;
-    std::vector<Rgb> colours = fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats);
-    for (Rgb& c : colours) {
-      const Rgb radiosity = material.emission * rc::kPi + material.albedo * c;
-      c = quantity == Quantity::irradiance ? c : quantity == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
+  const auto value = [&view, quantity](const rc::Material& m, const Vec3& p, const Vec3& n) -> std::optional<Rgb> {
+    const std::optional<Rgb> e = view.irradiance(p, n);
+    if (!e) return std::nullopt;
+    const Rgb radiosity = m.emission * rc::kPi + m.albedo * *e;
+    return quantity == Quantity::irradiance ? *e : quantity == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
+  };
+  const auto baked = [&](const rc::TriangleMesh& mesh) {
+    return mesh.origin.file == out.file && !scene.materials[mesh.material].is_specular();
+  };
+
+  if (!per_file_vertex) {  // glTF: each primitive instance on its own
+    out.per_mesh.resize(scene.meshes.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const rc::TriangleMesh& mesh = scene.meshes[m];
+      if (!baked(mesh)) continue;
+      const rc::Material& material = scene.materials[mesh.material];
+      const SurfaceField field = [&](const Vec3& p, const Vec3& n, size_t) { return value(material, p, n); };
+      out.per_mesh[m] = fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats);
     }
-    out.per_mesh[m] = std::move(colours);
+  } else {  // OBJ, PLY: the file's vertices, shared by the meshes of its materials
+    std::vector<Vec3> positions;
+    std::vector<uint32_t> indices;
+    std::vector<uint32_t> face_material;
+    for (const rc::TriangleMesh& mesh : scene.meshes) {
+      if (mesh.origin.file != out.file) continue;
+      const auto file_vertex = [&mesh](uint32_t v) { return mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]; };
+      for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
+        const uint32_t f = file_vertex(v);
+        if (f >= positions.size()) positions.resize(size_t(f) + 1, Vec3(0.0f));
+        positions[f] = mesh.positions[v];
+      }
+      if (!baked(mesh)) continue;
+      for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+        for (int k = 0; k < 3; ++k) indices.push_back(file_vertex(mesh.indices[3 * t + size_t(k)]));
+        face_material.push_back(mesh.material);
+      }
+    }
+    const SurfaceField field = [&](const Vec3& p, const Vec3& n, size_t face) {
+      return value(scene.materials[face_material[face]], p, n);
+    };
+    out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
@@ -61,8 +92,8 @@ void check_onto_output(const std::string& path, const rc::Scene& scene) {
   if (in_gltf != out_gltf || (!in_gltf && in_ext != out_ext))
     throw InputError("-o " + path + ": --onto input writes the input's own format, and the input is " + input +
                      (in_gltf ? " (use .gltf or .glb)" : " (use " + in_ext + ")"));
-  if (!in_gltf)
-    throw InputError("--onto input: " + in_ext + " models are not supported yet (glTF and GLB are); use --onto elements");
+  if (in_ext == ".ply")
+    throw InputError("--onto input: PLY models are not supported yet (glTF, GLB and OBJ are); use --onto elements");
 }
 
 void write_onto_input(const std::string& path, const rc::Scene& scene, const InputColours& colours,
@@ -70,7 +101,11 @@ void write_onto_input(const std::string& path, const rc::Scene& scene, const Inp
   check_onto_output(path, scene);
   if (colours.file < 0 || size_t(colours.file) >= scene.model_files.size())
     throw std::logic_error("write_onto_input: no model file");
-  write_onto_gltf(scene.model_files[size_t(colours.file)], path, scene, colours, settings);
+  const std::string& input = scene.model_files[size_t(colours.file)];
+  if (rc::lower_extension(input) == ".obj")
+    write_onto_obj(input, path, colours, settings);
+  else
+    write_onto_gltf(input, path, scene, colours, settings);
 }
 
 }  // namespace gilt::radiosity

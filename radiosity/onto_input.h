@@ -14,6 +14,9 @@
 // is split, one copy per node, since each instance is lit differently (Blender's bake does the
 // same). Relative URIs of the input's buffers and images are rewritten to reach the same files
 // from the output's folder. A .gltf output's new data go in a .bin beside it, named after it.
+//
+// OBJ in, OBJ out: every line as it was, `v` lines with a colour after the position's own text
+// (radiosity/onto_obj.cpp).
 
 #include <string>
 #include <vector>
@@ -27,7 +30,11 @@ namespace gilt::radiosity {
 /// Colours for the vertices of the meshes read from one model file.
 struct InputColours {
   int32_t file = -1;                        ///< index into Scene::model_files
-  std::vector<std::vector<Rgb>> per_mesh;   ///< per scene mesh, one per vertex; empty: not baked
+  /// glTF: per scene mesh (one per primitive placed by a node), one per vertex; empty: not baked.
+  std::vector<std::vector<Rgb>> per_mesh;
+  /// OBJ and PLY: one per vertex of the file (its `v` lines, its vertex element), fitted over the
+  /// faces of every material at once, since the file has one colour per vertex.
+  std::vector<Rgb> per_file_vertex;
   FitStats stats;
   double seconds = 0.0;
 };
@@ -37,9 +44,10 @@ struct InputColours {
 int32_t onto_input_file(const rc::Scene& scene);
 
 /// Fits the solution's `quantity` onto the vertices of every non-specular mesh read from the
-/// model file (onto_input_file): irradiance by `fit` over each mesh's faces, at a quadrature
-/// spacing of half the solution's target edge, then turned into the quantity by the mesh's
-/// material (B = π·Le + ρ·E, L = B/π).
+/// model file (onto_input_file), by `fit` over the faces, at a quadrature spacing of half the
+/// solution's target edge. Each point's irradiance E is turned into the quantity by its face's
+/// material (B = π·Le + ρ·E, L = B/π) before fitting, so a vertex shared by two materials gets
+/// the colour nearest both.
 InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity);
 
 /// Throws InputError unless write_onto_input can write `path` for the scene: called before
@@ -51,6 +59,11 @@ void check_onto_output(const std::string& path, const rc::Scene& scene);
 /// that does not match, or an output that would overwrite an input file.
 void write_onto_input(const std::string& path, const rc::Scene& scene, const InputColours& colours,
                       const ExportSettings& settings);
+
+/// OBJ writer behind write_onto_input (radiosity/onto_obj.cpp): `v x y z r g b`, the quantity
+/// × 2^exposure clamped to [0, 1] as linear floats (OBJ has no place for the HDR values).
+void write_onto_obj(const std::string& input, const std::string& output, const InputColours& colours,
+                    const ExportSettings& settings);
 
 /// glTF writer behind write_onto_input (radiosity/onto_gltf.cpp).
 void write_onto_gltf(const std::string& input, const std::string& output, const rc::Scene& scene,

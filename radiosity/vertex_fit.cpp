@@ -32,7 +32,8 @@ struct FaceTerms {
   uint32_t samples = 0, missing = 0;
 };
 
-FaceTerms face_terms(const Vec3& p0, const Vec3& p1, const Vec3& p2, const SurfaceField& field, float spacing) {
+FaceTerms face_terms(const Vec3& p0, const Vec3& p1, const Vec3& p2, size_t face, const SurfaceField& field,
+                     float spacing) {
   FaceTerms t;
   const Vec3 cross = glm::cross(p1 - p0, p2 - p0);
   const double area = 0.5 * double(glm::length(cross));
@@ -45,7 +46,7 @@ FaceTerms face_terms(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Surfa
     const double bary[3] = {1.0 - u - v, u, v};
     const Vec3 p = float(bary[0]) * p0 + float(bary[1]) * p1 + float(bary[2]) * p2;
     ++t.samples;
-    const std::optional<Rgb> f = field(p, n);
+    const std::optional<Rgb> f = field(p, n, face);
     if (!f) {
       ++t.missing;
       return;
@@ -78,17 +79,26 @@ std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const 
                                const SurfaceField& field, FitStats& stats) {
   // The vertex's normal: its faces' normals weighted by area.
   std::vector<Vec3> normal(positions.size(), Vec3(0.0f));
+  std::vector<size_t> face_of(positions.size(), 0);  // the largest face around the vertex
+  std::vector<float> largest(positions.size(), 0.0f);
   for (size_t f = 0; f + 2 < indices.size(); f += 3) {
     const Vec3 cross = glm::cross(positions[indices[f + 1]] - positions[indices[f]],
                                   positions[indices[f + 2]] - positions[indices[f]]);
-    for (int k = 0; k < 3; ++k) normal[indices[f + size_t(k)]] += cross;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = indices[f + size_t(k)];
+      normal[v] += cross;
+      if (glm::length(cross) > largest[v]) {
+        largest[v] = glm::length(cross);
+        face_of[v] = f / 3;
+      }
+    }
   }
   std::vector<Rgb> out(positions.size(), Rgb(0.0f));
   std::vector<uint8_t> missing(positions.size(), 0);
   rc::parallel_for(positions.size(), [&](size_t v) {
     const float len = glm::length(normal[v]);
     if (!(len > 0.0f)) return;  // no face uses it, or only degenerate ones
-    const std::optional<Rgb> f = field(positions[v], normal[v] / len);
+    const std::optional<Rgb> f = field(positions[v], normal[v] / len, face_of[v]);
     if (f) out[v] = *f;
     missing[v] = !f;
   });
@@ -110,7 +120,7 @@ std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<c
   const size_t faces = indices.size() / 3;
   std::vector<FaceTerms> terms(faces);
   rc::parallel_for(faces, [&](size_t f) {
-    terms[f] = face_terms(positions[indices[3 * f]], positions[indices[3 * f + 1]], positions[indices[3 * f + 2]],
+    terms[f] = face_terms(positions[indices[3 * f]], positions[indices[3 * f + 1]], positions[indices[3 * f + 2]], f,
                           field, spacing);
   });
 

@@ -33,9 +33,11 @@ enum class VertexFit : uint8_t {
 /// "least-squares" or "point".
 const char* to_string(VertexFit fit);
 
-/// The field at surface point p of a face whose front has unit normal n; nothing where it is
-/// unknown (such points do not count in the fit). Called from several threads at once.
-using SurfaceField = std::function<std::optional<Rgb>(const Vec3& p, const Vec3& n)>;
+/// The field at surface point p of face `face` (its index in the index list, divided by three),
+/// whose front has unit normal n; nothing where it is unknown (such points do not count in the
+/// fit). At a vertex (point fit) `face` is one of the vertex's faces. Called from several
+/// threads at once.
+using SurfaceField = std::function<std::optional<Rgb>(const Vec3& p, const Vec3& n, size_t face)>;
 
 /// Weight of the smoothness term against the fit: the squared colour difference along each edge
 /// of a face counts kFitSmoothness times a third of the face's area. Small enough that a sharp

@@ -80,7 +80,7 @@ double integral(const Grid&, const std::function<double(const Vec3&)>& f) {
 }
 
 SurfaceField scalar_field(std::function<float(const Vec3&)> f) {
-  return [f](const Vec3& p, const Vec3&) -> std::optional<Rgb> { return Rgb(f(p)); };
+  return [f](const Vec3& p, const Vec3&, size_t) -> std::optional<Rgb> { return Rgb(f(p)); };
 }
 
 TEST(VertexFit, ALinearFieldIsReproducedExactlyByBothFits) {
@@ -144,7 +144,7 @@ TEST(VertexFit, PointsWithoutAValueAreLeftOut) {
   // The field is known on the right half only (say the left half was buried); there it is 2. The
   // left vertices follow their neighbours through the smoothness term instead of turning black.
   const Grid g = grid(4);
-  const SurfaceField half = [](const Vec3& p, const Vec3&) -> std::optional<Rgb> {
+  const SurfaceField half = [](const Vec3& p, const Vec3&, size_t) -> std::optional<Rgb> {
     if (p.x < 0.5f) return std::nullopt;
     return Rgb(2.0f);
   };
