@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "radiosity/element_scene.h"
+#include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
@@ -108,6 +109,108 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
   result.mean_relative_error = error / (3.0 * double(used));
   result.reference_noise = noise / (3.0 * double(used));
   result.relative_mean_absolute_error = total > 0.0 ? absolute / total : 0.0;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
+                                       const CheckSettings& settings) {
+  settings.validate();
+  const auto start = std::chrono::steady_clock::now();
+  // The faces the colours cover, weighted by area (faces whose material the check cannot invert
+  // weigh nothing).
+  struct Face {
+    uint32_t mesh, triangle;
+  };
+  std::vector<Face> faces;
+  std::vector<float> area;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const rc::TriangleMesh& mesh = scene.meshes[m];
+    const bool covered = mesh.origin.file == irradiance.file &&
+                         (irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty()
+                                                      : !irradiance.per_mesh[m].empty());
+    const rc::Material& mat = scene.materials[mesh.material];
+    if (!covered || mat.kind != rc::MaterialKind::diffuse || !(std::min({mat.albedo.r, mat.albedo.g, mat.albedo.b}) > 0.0f))
+      continue;
+    for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      const Vec3 &a = mesh.positions[mesh.indices[3 * t]], &b = mesh.positions[mesh.indices[3 * t + 1]],
+                 &c = mesh.positions[mesh.indices[3 * t + 2]];
+      faces.push_back({m, t});
+      area.push_back(0.5f * glm::length(glm::cross(b - a, c - a)));
+    }
+  }
+  SurfaceCheckResult result;
+  const rc::Distribution1D pick(area);
+  if (pick.size() == 0) return result;
+  const float step = 1e-4f * glm::length(scene.bounds().diagonal());
+  const size_t count = size_t(settings.points);
+  std::vector<Rgb> baked(count), mean(count), variance(count);
+  std::vector<char> usable(count, 0);
+  const rc::PathSettings path;
+  rc::parallel_for(count, [&](size_t i) {
+    rc::Rng rng = rc::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
+    const Face f = faces[pick.sample(rng.uniform())];
+    const rc::TriangleMesh& mesh = scene.meshes[f.mesh];
+    const rc::Material& m = scene.materials[mesh.material];
+    const uint32_t* corner = &mesh.indices[3 * size_t(f.triangle)];
+    const rc::Vec2 uv = rc::sample_uniform_triangle(rng.uniform2());
+    const float w[3] = {1.0f - uv.x - uv.y, uv.x, uv.y};
+    Vec3 p(0.0f);
+    Rgb value(0.0f);
+    for (int k = 0; k < 3; ++k) {
+      p += w[k] * mesh.positions[corner[k]];
+      const uint32_t v = corner[k];
+      value += w[k] * (irradiance.per_mesh.empty()
+                           ? irradiance.per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]]
+                           : irradiance.per_mesh[f.mesh][v]);
+    }
+    const Vec3 n = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
+                                             mesh.positions[corner[2]] - mesh.positions[corner[0]]));
+    Rgb sum(0.0f), sum_squares(0.0f);
+    int taken = 0;
+    for (int s = 0; s < settings.samples; ++s) {
+      rc::SampleContext ctx{rc::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s)), 0};
+      const rc::Ray ray{p + step * n, -n, 2.0f * step};
+      const std::optional<rc::Hit> hit = scene.intersect(ray);
+      if (!hit || hit->geom_id != f.mesh) return;  // something lies on top of the point
+      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / m.albedo;
+      sum += e;
+      sum_squares += e * e;
+      ++taken;
+    }
+    if (sum.is_black()) {  // no light at all: inside a closed solid, where no one looks
+      usable[i] = 2;
+      return;
+    }
+    const float ns = float(taken);
+    mean[i] = sum / ns;
+    for (int c = 0; c < 3; ++c)
+      variance[i][c] = std::max(0.0f, (sum_squares[c] - sum[c] * sum[c] / ns) / (ns - 1.0f)) / ns;
+    baked[i] = value;
+    usable[i] = 1;
+  });
+  double reference_mean = 0.0;
+  size_t used = 0;
+  for (size_t i = 0; i < count; ++i) {
+    if (usable[i] == 1) reference_mean += mean[i].average(), ++used;
+    if (usable[i] == 2) ++result.unlit;
+  }
+  if (used == 0) return result;
+  const double floor = 0.01 * reference_mean / double(used);
+  double squared = 0.0, share = 0.0, relative = 0.0;
+  for (size_t i = 0; i < count; ++i) {
+    if (usable[i] != 1) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double r = mean[i][c], d = double(baked[i][c]) - r;
+      squared += d * d / (r * r + floor * floor);
+      share += double(variance[i][c]) / (r * r + floor * floor);
+      relative += std::abs(d) / (r + floor);
+    }
+  }
+  result.points = used;
+  result.relative_mse = squared / (3.0 * double(used));
+  result.reference_share = share / (3.0 * double(used));
+  result.mean_relative_error = relative / (3.0 * double(used));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

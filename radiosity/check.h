@@ -40,4 +40,29 @@ struct CheckResult {
 /// count.
 CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings);
 
+struct InputColours;  // radiosity/onto_input.h
+
+/// How colours baked onto the input model (`--onto input`) compare with the path tracer at random
+/// points inside the input's faces, where the baked colour is its face's corners interpolated.
+struct SurfaceCheckResult {
+  size_t points = 0;           ///< points compared
+  size_t unlit = 0;            ///< points left out because no path-traced sample found any light
+  double relative_mse = 0.0;   ///< mean (E_baked − E_path)² / (E_path² + (0.01 Ē_path)²)
+  double reference_share = 0.0;  ///< what the estimates' own variance adds to it (same mean of se²)
+  double mean_relative_error = 0.0;  ///< mean |E_baked − E_path| / (E_path + 0.01 Ē_path)
+  double seconds = 0.0;
+};
+
+/// Draws `settings.points` points uniformly by area over the faces that `irradiance` (an
+/// InputColours fitted with Quantity::irradiance) covers, from `settings.seed`, and compares
+/// the interpolated colours with path-traced irradiance there: the path tracer looks straight
+/// down the face normal at the point, E = π (L − Le) / ρ, `settings.samples` samples per point.
+/// Surfaces that are not diffuse or have an albedo with a zero channel are not drawn from, and
+/// a point with something lying on it (the path tracer's ray hits another surface) is left out,
+/// and so is a point no path-traced sample brings any light to: the input's faces inside closed
+/// solids (buried: the solver removed them), whose colour no one sees, and which the fit colours
+/// from the nearest element facing the same way.
+SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
+                                       const CheckSettings& settings);
+
 }  // namespace gilt::radiosity

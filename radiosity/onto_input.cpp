@@ -92,8 +92,6 @@ void check_onto_output(const std::string& path, const rc::Scene& scene) {
   if (in_gltf != out_gltf || (!in_gltf && in_ext != out_ext))
     throw InputError("-o " + path + ": --onto input writes the input's own format, and the input is " + input +
                      (in_gltf ? " (use .gltf or .glb)" : " (use " + in_ext + ")"));
-  if (in_ext == ".ply")
-    throw InputError("--onto input: PLY models are not supported yet (glTF, GLB and OBJ are); use --onto elements");
 }
 
 void write_onto_input(const std::string& path, const rc::Scene& scene, const InputColours& colours,
@@ -104,6 +102,8 @@ void write_onto_input(const std::string& path, const rc::Scene& scene, const Inp
   const std::string& input = scene.model_files[size_t(colours.file)];
   if (rc::lower_extension(input) == ".obj")
     write_onto_obj(input, path, colours, settings);
+  else if (rc::lower_extension(input) == ".ply")
+    write_onto_ply(input, path, colours, settings);
   else
     write_onto_gltf(input, path, scene, colours, settings);
 }

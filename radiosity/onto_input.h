@@ -16,7 +16,8 @@
 // from the output's folder. A .gltf output's new data go in a .bin beside it, named after it.
 //
 // OBJ in, OBJ out: every line as it was, `v` lines with a colour after the position's own text
-// (radiosity/onto_obj.cpp).
+// (radiosity/onto_obj.cpp). PLY in, PLY out: every element and property as it was, with colour
+// properties added to the vertices (radiosity/onto_ply.cpp).
 
 #include <string>
 #include <vector>
@@ -63,6 +64,12 @@ void write_onto_input(const std::string& path, const rc::Scene& scene, const Inp
 /// OBJ writer behind write_onto_input (radiosity/onto_obj.cpp): `v x y z r g b`, the quantity
 /// × 2^exposure clamped to [0, 1] as linear floats (OBJ has no place for the HDR values).
 void write_onto_obj(const std::string& input, const std::string& output, const InputColours& colours,
+                    const ExportSettings& settings);
+
+/// PLY writer behind write_onto_input (radiosity/onto_ply.cpp): the input's own format, with
+/// uchar red/green/blue (8-bit sRGB after exposure) and float <quantity>_red/_green/_blue added
+/// to the vertex element.
+void write_onto_ply(const std::string& input, const std::string& output, const InputColours& colours,
                     const ExportSettings& settings);
 
 /// glTF writer behind write_onto_input (radiosity/onto_gltf.cpp).

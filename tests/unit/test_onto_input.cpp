@@ -8,6 +8,7 @@
 #include <tiny_gltf.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -19,12 +20,15 @@
 #include <string>
 #include <vector>
 
+#include "raytrace_core/ply_header.h"
+#include "raytrace_core/scene_io.h"
 #include "tests/support/cli_run.h"
 
 namespace gilt::test {
 namespace {
 
 namespace fs = std::filesystem;
+namespace rc = gilt::raytrace_core;
 using Json = nlohmann::json;
 
 const std::string kGilt = GILT_BINARY_PATH;
@@ -343,6 +347,97 @@ TEST(OntoInput, AnObjComesBackLineForLine) {
   fs::remove_all(dir);
 }
 
+/// A PLY of a floor and a raised panel (8 vertices, 4 faces) with a `quality` property and
+/// colours the bake replaces, in the given format. Positions have 4 bytes each in both formats.
+std::string ply_model(const std::string& format) {
+  const float p[8][3] = {{-2, 0, 2},  {2, 0, 2},  {2, 0, -2},  {-2, 0, -2},
+                         {-0.5f, 1, 0.5f}, {0.5f, 1, 0.5f}, {0.5f, 1, -0.5f}, {-0.5f, 1, -0.5f}};
+  const int f[4][3] = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+  std::string s = "ply\nformat " + format + " 1.0\ncomment test model\nelement vertex 8\n"
+                  "property float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+                  "property uchar green\nproperty uchar blue\nproperty float quality\n"
+                  "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  const bool big = format == "binary_big_endian";
+  const auto put = [&](const void* x, size_t n) {
+    std::string b(static_cast<const char*>(x), n);
+    if (big) std::reverse(b.begin(), b.end());
+    s += b;
+  };
+  for (int v = 0; v < 8; ++v) {
+    const float quality = 0.25f * float(v);
+    if (format == "ascii") {
+      s += std::to_string(p[v][0]) + " " + std::to_string(p[v][1]) + " " + std::to_string(p[v][2]) + " 9 9 9 " +
+           std::to_string(quality) + "\n";
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) put(&p[v][k], 4);
+    s += std::string(3, char(9));
+    put(&quality, 4);
+  }
+  for (const auto& face : f) {
+    if (format == "ascii") {
+      s += "3 " + std::to_string(face[0]) + " " + std::to_string(face[1]) + " " + std::to_string(face[2]) + "\n";
+      continue;
+    }
+    s += char(3);
+    for (int k = 0; k < 3; ++k) put(&face[k], 4);
+  }
+  return s;
+}
+
+TEST(OntoInput, APlyKeepsItsPropertiesAndGainsColours) {
+  for (const std::string format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+    const fs::path dir = fresh_dir("ply-" + format);
+    const std::string in = ply_model(format);
+    write_file(dir / "model.ply", in);
+    write_file(dir / "scene.json", R"({
+      "meshes": [{"file": "model.ply"}],
+      "lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2},
+                 {"type": "environment", "radiance": 0.3}]})");
+    run(quoted(dir / "scene.json") + " --onto input --elements 400 --quantity irradiance -o " +
+            quoted(dir / "baked.ply"),
+        dir);
+    const std::string out = slurp(dir / "baked.ply");
+    const size_t in_body = in.find("end_header\n") + 11, out_body = out.find("end_header\n") + 11;
+    const std::string header = out.substr(0, out_body);
+    // The properties in order: the input's, less its colours, then the new ones.
+    std::vector<std::string> properties;
+    for (const std::string& line : lines_of(header))
+      if (line.rfind("property", 0) == 0) properties.push_back(line);
+    EXPECT_EQ(properties, (std::vector<std::string>{
+                              "property float x", "property float y", "property float z", "property float quality",
+                              "property uchar red", "property uchar green", "property uchar blue",
+                              "property float irradiance_red", "property float irradiance_green",
+                              "property float irradiance_blue", "property list uchar int vertex_indices"}))
+        << format;
+    EXPECT_NE(header.find("comment test model"), std::string::npos);
+    if (format == "ascii") {
+      const std::vector<std::string> a = lines_of(in.substr(in_body)), b = lines_of(out.substr(out_body));
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t v = 0; v < 8; ++v) {
+        const std::vector<std::string> ta = rc::tokens_of(a[v]), tb = rc::tokens_of(b[v]);
+        ASSERT_EQ(tb.size(), 10u);
+        EXPECT_EQ(std::vector<std::string>(tb.begin(), tb.begin() + 3), std::vector<std::string>(ta.begin(), ta.begin() + 3));
+        EXPECT_EQ(tb[3], ta[6]);  // quality
+        // Lit from above: E ≈ 2 cos θ + π 0.3 ≈ 2.8 on the tops, as float and as sRGB 255 (clamped).
+        EXPECT_GT(std::stof(tb[7]), 1.0f) << b[v];
+        EXPECT_EQ(tb[4], "255");
+      }
+      for (size_t k = 8; k < a.size(); ++k) EXPECT_EQ(b[k], a[k]);
+    } else {
+      // Each vertex: the input's 12 position bytes and 4 quality bytes, then 3 + 12 new bytes.
+      ASSERT_EQ(out.size() - out_body, 8 * (16 + 15) + 4 * 13u);
+      for (size_t v = 0; v < 8; ++v) {
+        const std::string a = in.substr(in_body + v * 19, 19), b = out.substr(out_body + v * 31, 31);
+        EXPECT_EQ(b.substr(0, 12), a.substr(0, 12)) << format << " vertex " << v;
+        EXPECT_EQ(b.substr(12, 4), a.substr(15, 4)) << format << " vertex " << v;
+      }
+      EXPECT_EQ(out.substr(out_body + 8 * 31), in.substr(in_body + 8 * 19));  // faces byte for byte
+    }
+    fs::remove_all(dir);
+  }
+}
+
 TEST(OntoInput, SharedScenesKeepTheirStructure) {
   const fs::path scenes = fs::path(GILT_SOURCE_DIR) / ".." / "shared" / "scenes";
   if (!fs::is_directory(scenes)) GTEST_SKIP() << scenes << " is not beside the checkout";
@@ -353,6 +448,21 @@ TEST(OntoInput, SharedScenesKeepTheirStructure) {
       {scenes / "wrap" / "truck-lit.json", scenes / "milk-truck" / "CesiumMilkTruck.gltf"},
       {scenes / "animate-all" / "24_animation_pointer.gltf", scenes / "animate-all" / "24_animation_pointer.gltf"},
   };
+  // The bunny (PLY): read back by gilt's own loader (OpenMesh), the same vertices at the same
+  // positions, in the same faces.
+  if (fs::exists(scenes / "bunny")) {
+    const fs::path out = dir / "bunny.ply";
+    run(quoted(scenes / "wrap" / "bunny-lit.json") + " --onto input --elements 2000 -o " + quoted(out), dir);
+    const rc::Scene in_scene = rc::load_scene((scenes / "wrap" / "bunny-lit.json").string());
+    const rc::Scene out_scene = rc::load_scene(out.string());
+    ASSERT_EQ(out_scene.meshes.size(), 1u);
+    const rc::TriangleMesh &a = in_scene.meshes[0], &b = out_scene.meshes[0];
+    EXPECT_EQ(b.indices, a.indices);
+    ASSERT_EQ(b.positions.size(), a.positions.size());
+    // The wrapper may move the model: compare the output with the input file's own positions.
+    const rc::Scene raw = rc::load_scene(in_scene.model_files.at(0));
+    for (size_t v = 0; v < b.positions.size(); ++v) ASSERT_EQ(b.positions[v], raw.meshes[0].positions[v]) << v;
+  }
   const fs::path sibenik = scenes / "sibenik" / "sibenik.obj";
   if (fs::exists(sibenik)) {
     const fs::path out = dir / "sibenik.obj";
