@@ -132,6 +132,7 @@ void run_radiosity(RadiosityOptions& o) {
       j["fit"] = {{"method", o.fit},
                   {"samples", onto->stats.samples},
                   {"samples_without_solution", onto->stats.missing},
+                  {"buried_faces_left_out", onto->buried_faces},
                   {"iterations", onto->stats.iterations},
                   {"seconds", onto->seconds}};
     if (surface_check)
@@ -188,9 +189,10 @@ void run_radiosity(RadiosityOptions& o) {
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
                 100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
   if (onto)
-    std::printf("  onto:    %s fit to the input's vertices: %llu samples (%llu without a solution), %.3g s\n",
+    std::printf("  onto:    %s fit to the input's vertices: %llu samples (%llu without a solution; %zu buried "
+                "faces left out), %.3g s\n",
                 o.fit.c_str(), static_cast<unsigned long long>(onto->stats.samples),
-                static_cast<unsigned long long>(onto->stats.missing), onto->seconds);
+                static_cast<unsigned long long>(onto->stats.missing), onto->buried_faces, onto->seconds);
   if (surface_check)
     std::printf("  check:   irradiance at %zu random points inside the input's faces against the path tracer (%d "
                 "samples each; %zu points no light reaches left out): relMSE %.4g (of which the reference's own "

@@ -166,13 +166,18 @@ SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColour
     }
     const Vec3 n = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
                                              mesh.positions[corner[2]] - mesh.positions[corner[0]]));
+    if (input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]], mesh.positions[corner[2]])) {
+      usable[i] = 2;  // inside a solid or under an object: the fit leaves it out too
+      return;
+    }
     Rgb sum(0.0f), sum_squares(0.0f);
     int taken = 0;
     for (int s = 0; s < settings.samples; ++s) {
       rc::SampleContext ctx{rc::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s)), 0};
       const rc::Ray ray{p + step * n, -n, 2.0f * step};
       const std::optional<rc::Hit> hit = scene.intersect(ray);
-      if (!hit || hit->geom_id != f.mesh) return;  // something lies on top of the point
+      // Something lies on the point, or coincides with its face (a duplicate, facing either way).
+      if (!hit || hit->geom_id != f.mesh || hit->prim_id != f.triangle) return;
       const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / m.albedo;
       sum += e;
       sum_squares += e * e;

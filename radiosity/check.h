@@ -46,7 +46,7 @@ struct InputColours;  // radiosity/onto_input.h
 /// points inside the input's faces, where the baked colour is its face's corners interpolated.
 struct SurfaceCheckResult {
   size_t points = 0;           ///< points compared
-  size_t unlit = 0;            ///< points left out because no path-traced sample found any light
+  size_t unlit = 0;            ///< points left out: on buried faces, or no path-traced sample found light
   double relative_mse = 0.0;   ///< mean (E_baked − E_path)² / (E_path² + (0.01 Ē_path)²)
   double reference_share = 0.0;  ///< what the estimates' own variance adds to it (same mean of se²)
   double mean_relative_error = 0.0;  ///< mean |E_baked − E_path| / (E_path + 0.01 Ē_path)
@@ -59,9 +59,9 @@ struct SurfaceCheckResult {
 /// down the face normal at the point, E = π (L − Le) / ρ, `settings.samples` samples per point.
 /// Surfaces that are not diffuse or have an albedo with a zero channel are not drawn from, and
 /// a point with something lying on it (the path tracer's ray hits another surface) is left out,
-/// and so is a point no path-traced sample brings any light to: the input's faces inside closed
-/// solids (buried: the solver removed them), whose colour no one sees, and which the fit colours
-/// from the nearest element facing the same way.
+/// and so is a point on a buried face (input_triangle_buried: inside a closed solid or under an
+/// object; the fit leaves those out) or one no path-traced sample brings any light to: no one
+/// sees their colour.
 SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings);
 

@@ -451,6 +451,10 @@ size_t remove_triangles(SplitSurface& surface, const std::vector<char>& remove) 
 }  // namespace
 }  // namespace detail
 
+bool input_triangle_buried(const rc::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return detail::triangle_buried(scene, rc::DVec3(a), rc::DVec3(b), rc::DVec3(c));
+}
+
 float target_edge_length(const rc::Scene& scene, const MeshSettings& settings) {
   if (!std::isfinite(settings.max_edge) || settings.max_edge < 0.0f)
     throw rc::InputError("mesh: max_edge must be a finite length ≥ 0, not " +

@@ -72,6 +72,12 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
 /// elements are appended. Returns the number of vertices added.
 size_t split_longest_edges(RadiosityMesh& mesh, const std::vector<uint32_t>& elements, float min_edge);
 
+/// Whether the triangle (a, b, c) of the committed scene, seen from its front (counter-clockwise),
+/// is buried as build_mesh removes input faces: from its centroid and three points near its
+/// corners, every test ray over the front hemisphere first hits the back of an opaque surface (it
+/// lies inside a closed solid or under an object standing on it), and the camera does not see it.
+bool input_triangle_buried(const rc::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c);
+
 /// The edge length `settings` asks for on this scene (resolving `elements` and the default).
 float target_edge_length(const rc::Scene& scene, const MeshSettings& settings);
 

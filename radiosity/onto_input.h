@@ -37,6 +37,7 @@ struct InputColours {
   /// faces of every material at once, since the file has one colour per vertex.
   std::vector<Rgb> per_file_vertex;
   FitStats stats;
+  size_t buried_faces = 0;  ///< input faces left out of the fit: inside closed solids or under objects
   double seconds = 0.0;
 };
 

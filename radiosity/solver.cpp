@@ -596,6 +596,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   // refined: elements whose vertices disagree steeply are bisected and only the new vertices
   // gather. Vertex indices are stable under refinement, so the arrays just grow.
   std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
+  std::vector<Rgb> direct_delta;  // the part of direct_punctual from point, spot and directional lights
   auto gather_direct = [&](size_t first_vertex) {
     const Patches patches = build_patches(mesh, settings.patch_elements);
     std::vector<ShootingPatch> emitters;
@@ -611,6 +612,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     }
     const size_t nv = mesh.vertex_count();
     direct_punctual.resize(nv, Rgb(0.0f));
+    direct_delta.resize(nv, Rgb(0.0f));
     direct_emitted.resize(nv, Rgb(0.0f));
     const size_t count = nv - first_vertex;
     rc::parallel_for((count + 127) / 128, [&](size_t chunk) {
@@ -618,8 +620,11 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv, first_vertex + chunk * 128 + 128); ++v) {
         for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
           rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
-          direct_punctual[v] += punctual_irradiance(scene, receivers.geometry, scene.punctual_lights[li], receivers.origins(v),
-                                                    mesh.normals[v], rng, settings.visibility_samples, counts.rays);
+          const rc::Light& light = scene.punctual_lights[li];
+          const Rgb e = punctual_irradiance(scene, receivers.geometry, light, receivers.origins(v), mesh.normals[v], rng,
+                                            settings.visibility_samples, counts.rays);
+          direct_punctual[v] += e;
+          if (light.kind != rc::LightKind::environment) direct_delta[v] += e;
         }
         for (size_t q = 0; q < emitters.size(); ++q) {
           // Keyed by the emitter's first element, which refinement never renumbers.
@@ -679,6 +684,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   sol.vertex_irradiance.resize(nv);
   for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
   sol.vertex_direct = sol.vertex_irradiance;
+  sol.vertex_punctual = direct_delta;
   // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
   // and has not shot yet.
   auto shoot_progressive = [&] {

@@ -60,6 +60,7 @@ struct Solution {
   std::vector<Rgb> vertex_radiosity;   ///< B (W·m⁻²): emitted + reflected, leaving the front
   std::vector<Rgb> vertex_irradiance;  ///< E (W·m⁻²) arriving at the front
   std::vector<Rgb> vertex_direct;      ///< the part of E straight from the lights and emitting surfaces
+  std::vector<Rgb> vertex_punctual;    ///< the part of E straight from point, spot and directional lights
   std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
 
   // What the solve did.

@@ -80,12 +80,18 @@ Rgb RadiosityView::radiance(const rc::Ray& ray, rc::SampleContext& ctx) const {
   return mode_ == ViewMode::mesh ? mesh_radiance(ray, ctx) : two_pass_radiance(ray, ctx);
 }
 
-std::optional<Rgb> RadiosityView::irradiance(const Vec3& p, const Vec3& n) const {
+std::optional<RadiosityView::Location> RadiosityView::locate(const Vec3& p, const Vec3& n) const {
   const std::optional<rc::Hit> near = display_.nearest_triangle(0, p, reach_, n, kFacing);
   if (!near) return std::nullopt;
-  const auto& e = elements_[near->prim_id];
-  return vertex_irradiance_[e[0]] * (1.0f - near->u - near->v) + vertex_irradiance_[e[1]] * near->u +
-         vertex_irradiance_[e[2]] * near->v;
+  return Location{near->prim_id, near->u, near->v, near->t};
+}
+
+std::optional<Rgb> RadiosityView::irradiance(const Vec3& p, const Vec3& n) const {
+  const std::optional<Location> at = locate(p, n);
+  if (!at) return std::nullopt;
+  const auto& e = elements_[at->element];
+  return vertex_irradiance_[e[0]] * (1.0f - at->u - at->v) + vertex_irradiance_[e[1]] * at->u +
+         vertex_irradiance_[e[2]] * at->v;
 }
 
 Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,

@@ -53,6 +53,15 @@ class RadiosityView {
   /// surface was buried, or is a mirror or glass).
   std::optional<Rgb> irradiance(const Vec3& p, const Vec3& n) const;
 
+  /// Where irradiance() reads the solution for a point of the input at p with lit side along n:
+  /// the element's index and the barycentrics of its second and third vertex.
+  struct Location {
+    uint32_t element;
+    float u, v;
+    float distance;  ///< from p to the element
+  };
+  std::optional<Location> locate(const Vec3& p, const Vec3& n) const;
+
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
   /// cosine-distributed gather ray (through mirrors and glass) read against the solution, times π.
