@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -276,6 +277,34 @@ TEST(OntoInput, BadRequestsAreRefusedBeforeSolving) {
   EXPECT_EQ(slurp(dir / "model.gltf"), before);
   EXPECT_EQ(slurp(dir / "data.bin"), bin);
   EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  fs::remove_all(dir);
+}
+
+TEST(OntoInput, OutputsPassTheKhronosValidator) {
+  // scripts/setup.sh test installs the validator into the build folder from npm.
+  const fs::path modules = fs::path(GILT_BUILD_DIR) / "gltf-validator" / "node_modules";
+  if (!fs::exists(modules / "gltf-validator") || std::system("node --version >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "node or the gltf-validator npm package is missing (scripts/setup.sh test installs them)";
+  const fs::path dir = fresh_dir("validator");
+  const fs::path scene = write_model(dir);
+  std::vector<fs::path> outputs = {dir / "baked.gltf", dir / "baked.glb"};
+  for (const fs::path& out : outputs) run(quoted(scene) + " --onto input --elements 400 -o " + quoted(out), dir);
+  const fs::path scenes = fs::path(GILT_SOURCE_DIR) / ".." / "shared" / "scenes";
+  if (fs::exists(scenes / "wrap" / "truck-lit.json")) {
+    outputs.push_back(dir / "truck.glb");
+    run(quoted(scenes / "wrap" / "truck-lit.json") + " --onto input --elements 2000 -o " + quoted(outputs.back()), dir);
+  }
+  std::string command = "NODE_PATH=";
+  command += quoted(modules);
+  command += " node ";
+  command += quoted(fs::path(GILT_SOURCE_DIR) / "scripts" / "gltf_validate.js");
+  for (const fs::path& out : outputs) {
+    command += ' ';
+    command += quoted(out);
+  }
+  const CliResult r = run_command(command, dir);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  for (const fs::path& out : outputs) EXPECT_NE(r.out.find(out.string() + ": 0 errors"), std::string::npos) << r.out;
   fs::remove_all(dir);
 }
 
