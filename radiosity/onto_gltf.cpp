@@ -149,6 +149,73 @@ void align4(std::string& bytes, char pad) {
   while (bytes.size() % 4 != 0) bytes += pad;
 }
 
+std::string read_bytes(const fs::path& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(what + ": cannot read " + path.string());
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// For a GLB output: moves the buffers and images the input keeps in files beside it into the
+/// binary chunk (buffer 0), so the GLB stands alone as GLB files are expected to. Buffer views
+/// are redirected with their offsets; images get a buffer view and a MIME type (PNG, JPEG, WebP
+/// and KTX2 by extension; others keep their URI).
+void pack_into_binary_chunk(GltfFile& file, const fs::path& in_folder, const std::string& input) {
+  Json& j = file.json;
+  Json& buffers = array(j, "buffers");
+  Json& views = array(j, "bufferViews");
+  if (!file.has_bin) {  // buffer 0 becomes the binary chunk
+    buffers.insert(buffers.begin(), Json{{"byteLength", 0}});
+    for (Json& v : views)
+      if (v.contains("buffer") && v["buffer"].is_number_integer()) v["buffer"] = v["buffer"].get<int64_t>() + 1;
+    file.has_bin = true;
+  }
+  std::vector<int64_t> moved_to(buffers.size(), 0);
+  std::vector<size_t> offset(buffers.size(), 0);
+  Json kept = Json::array();
+  kept.push_back(buffers[0]);
+  for (size_t k = 1; k < buffers.size(); ++k) {
+    const Json& b = buffers[k];
+    const std::string uri = b.contains("uri") && b["uri"].is_string() ? b["uri"].get<std::string>() : "";
+    if (!is_relative_uri(uri)) {
+      moved_to[k] = int64_t(kept.size());
+      kept.push_back(b);
+      continue;
+    }
+    align4(file.bin, '\0');
+    offset[k] = file.bin.size();
+    file.bin += read_bytes(in_folder / percent_decode(uri), input + ": buffer " + std::to_string(k));
+  }
+  for (Json& v : views) {
+    if (!v.contains("buffer") || !v["buffer"].is_number_integer()) continue;
+    const auto b = size_t(v["buffer"].get<int64_t>());
+    if (b >= moved_to.size() || b == 0) continue;
+    v["buffer"] = moved_to[b];
+    if (moved_to[b] == 0) v["byteOffset"] = v.value("byteOffset", size_t(0)) + offset[b];
+  }
+  buffers = std::move(kept);
+  if (!j.contains("images") || !j["images"].is_array()) return;
+  for (Json& image : j["images"]) {
+    if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
+    const std::string uri = image["uri"];
+    if (!is_relative_uri(uri)) continue;
+    const std::string ext = rc::lower_extension(percent_decode(uri));
+    const char* mime = ext == ".png"                      ? "image/png"
+                       : ext == ".jpg" || ext == ".jpeg" ? "image/jpeg"
+                       : ext == ".webp"                  ? "image/webp"
+                       : ext == ".ktx2"                  ? "image/ktx2"
+                                                         : nullptr;
+    if (mime == nullptr) continue;
+    align4(file.bin, '\0');
+    const size_t at = file.bin.size();
+    file.bin += read_bytes(in_folder / percent_decode(uri), input + ": image " + uri);
+    views.push_back({{"buffer", 0}, {"byteOffset", at}, {"byteLength", file.bin.size() - at}});
+    image.erase("uri");
+    image["bufferView"] = views.size() - 1;
+    image["mimeType"] = mime;
+  }
+  buffers[0]["byteLength"] = file.bin.size();
+}
+
 const char* attribute_name(Quantity q) {
   return q == Quantity::irradiance ? "_IRRADIANCE" : q == Quantity::radiosity ? "_RADIOSITY" : "_RADIANCE";
 }
@@ -164,6 +231,7 @@ void write_onto_gltf(const std::string& input, const std::string& output, const 
   const fs::path out_folder = out_path.parent_path();
   const fs::path in_folder = fs::absolute(input).lexically_normal().parent_path();
 
+  if (glb_out) pack_into_binary_chunk(file, in_folder, input);
   std::vector<fs::path> input_files;
   rebase_uris(j, in_folder, out_folder, input_files);
 

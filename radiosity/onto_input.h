@@ -12,8 +12,10 @@
 // nodes, meshes, primitives, materials, textures, animations, skins and extensions are kept, and
 // so are the accessors and buffers the input had, byte for byte. A mesh placed by several nodes
 // is split, one copy per node, since each instance is lit differently (Blender's bake does the
-// same). Relative URIs of the input's buffers and images are rewritten to reach the same files
-// from the output's folder. A .gltf output's new data go in a .bin beside it, named after it.
+// same). A .glb output stands alone: the input's buffers and images that live in files beside it
+// move into its binary chunk. A .gltf output keeps them where they are, its relative URIs
+// rewritten to reach the same files from the output's folder, and its new data go in a .bin
+// beside it, named after it.
 //
 // OBJ in, OBJ out: every line as it was, `v` lines with a colour after the position's own text
 // (radiosity/onto_obj.cpp). PLY in, PLY out: every element and property as it was, with colour

@@ -244,6 +244,10 @@ TEST(OntoInput, AWrittenModelComesBackWhole) {
       EXPECT_NEAR(b[k], expected, 0.02 * expected) << k;
     }
   }
+  // The .glb stands alone: the input's data.bin moved into its binary chunk.
+  const tinygltf::Model glb = load(dir / "out/baked.glb");
+  for (const tinygltf::Buffer& b : glb.buffers) EXPECT_TRUE(b.uri.empty()) << b.uri;
+  EXPECT_EQ(glb.buffers.size(), 1u);
   // The .gltf's new buffer sits beside it, and the input's buffer is reached from out/.
   EXPECT_TRUE(fs::exists(dir / "out/baked.bin"));
   const Json written = Json::parse(slurp(dir / "out/baked.gltf"));
