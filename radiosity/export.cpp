@@ -163,19 +163,6 @@ std::vector<std::string> material_names(const std::vector<Material>& materials) 
   return names;
 }
 
-// --- sRGB -----------------------------------------------------------------------------------
-
-/// The sRGB transfer function (IEC 61966-2-1), linear [0, 1] to encoded [0, 1].
-float srgb_encode(float linear) {
-  return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
-}
-
-/// Linear value to an 8-bit sRGB code: exposure scale, transfer function, clamp, round.
-uint8_t to_srgb8(float linear, float scale) {
-  const float encoded = std::clamp(srgb_encode(linear * scale), 0.0f, 1.0f);
-  return static_cast<uint8_t>(std::lround(encoded * 255.0f));
-}
-
 // --- PLY ------------------------------------------------------------------------------------
 
 /// Appends the raw little-endian bytes of `value`.
@@ -448,6 +435,13 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
 }
 
 }  // namespace
+
+uint8_t to_srgb8(float linear, float scale) {
+  // The sRGB transfer function (IEC 61966-2-1) of the clamped value.
+  const float x = std::clamp(linear * scale, 0.0f, 1.0f);
+  const float encoded = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+  return static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255.0f));
+}
 
 const char* to_string(Quantity quantity) {
   switch (quantity) {

@@ -2,6 +2,7 @@
 // Writing a radiosity solution as a mesh with one colour per vertex, for game engines, Blender
 // and MeshLab. Files are written atomically (temporary file, then rename).
 
+#include <cstdint>
 #include <string>
 
 #include "radiosity/solver.h"
@@ -21,6 +22,9 @@ struct ExportSettings {
   bool srgb8 = false;      ///< PLY only: 8-bit sRGB colours (after 2^exposure) instead of float
   float exposure = 0.0f;   ///< with srgb8
 };
+
+/// Linear value to an 8-bit sRGB code: scaled, clamped to [0, 1], encoded (IEC 61966-2-1), rounded.
+uint8_t to_srgb8(float linear, float scale);
 
 /// "radiance", "irradiance" or "radiosity".
 const char* to_string(Quantity quantity);

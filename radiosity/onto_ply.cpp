@@ -26,12 +26,6 @@ using rc::InputError;
 
 namespace {
 
-uint8_t srgb8(float linear) {
-  const float x = std::clamp(linear, 0.0f, 1.0f);
-  const float encoded = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255.0f));
-}
-
 /// An unsigned integer of `size` bytes in the file's byte order.
 uint64_t read_count(const std::string& bytes, size_t at, size_t size, bool big_endian) {
   unsigned char raw[8] = {};
@@ -128,8 +122,8 @@ void write_onto_ply(const std::string& input, const std::string& output, const I
         out += kept;
         const Rgb c = colour(item);
         char buffer[96];
-        std::snprintf(buffer, sizeof buffer, " %d %d %d %.9g %.9g %.9g", int(srgb8(c.r * scale)),
-                      int(srgb8(c.g * scale)), int(srgb8(c.b * scale)), double(c.r), double(c.g), double(c.b));
+        std::snprintf(buffer, sizeof buffer, " %d %d %d %.9g %.9g %.9g", int(to_srgb8(c.r, scale)),
+                      int(to_srgb8(c.g, scale)), int(to_srgb8(c.b, scale)), double(c.r), double(c.g), double(c.b));
         out += buffer;
         out += '\n';
       }
@@ -166,7 +160,7 @@ void write_onto_ply(const std::string& input, const std::string& output, const I
           continue;
         }
         const Rgb c = colour(item);
-        for (int k = 0; k < 3; ++k) out += char(srgb8(c[k] * scale));
+        for (int k = 0; k < 3; ++k) out += char(to_srgb8(c[k], scale));
         for (int k = 0; k < 3; ++k) append_float(out, c[k], big);
       }
     out.append(bytes, at, std::string::npos);
