@@ -63,11 +63,12 @@ void run_radiosity(RadiosityOptions& o) {
   const radiosity::VertexFit fit =
       o.fit == "point" ? radiosity::VertexFit::point : radiosity::VertexFit::least_squares;
   std::optional<radiosity::InputColours> onto;
+  radiosity::SnapStats snap;
   if (onto_input) {
     onto = radiosity::fit_input_colours(scene, sol, fit, ex.quantity);
     radiosity::write_onto_input(o.output, scene, *onto, ex);
   } else {
-    radiosity::write_solution(o.output, scene, sol, ex);
+    radiosity::write_solution(o.output, scene, sol, ex, &snap);
   }
   std::optional<radiosity::CheckResult> check;
   std::optional<radiosity::SurfaceCheckResult> surface_check;
@@ -127,6 +128,9 @@ void run_radiosity(RadiosityOptions& o) {
                         {"threads", threads},
                         {"quantity", o.quantity},
                         {"onto", o.onto},
+                        {"vertices_moved_onto_input_far", snap.moved_far},
+                        {"vertices_left_off_input", snap.not_moved},
+                        {"largest_move_onto_input", snap.largest},
                         {"output", o.output}};
     if (onto)
       j["fit"] = {{"method", o.fit},

@@ -32,6 +32,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -40,6 +41,7 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
 #include "raytrace_core/staged_file.h"
 
 namespace gilt::radiosity {
@@ -436,6 +438,63 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
 
 }  // namespace
 
+RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats) {
+  RadiosityMesh out = mesh;
+  // The input meshes each vertex's elements were meshed from (a few at most: surfaces meet at
+  // contact lines, where the mesher splits vertices by side anyway).
+  constexpr size_t kMaxSurfaces = 4;
+  std::vector<std::array<uint32_t, kMaxSurfaces>> surfaces(mesh.vertex_count());
+  std::vector<uint8_t> count(mesh.vertex_count(), 0);
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const uint32_t s = mesh.element_surface[e];
+    if (s >= scene.meshes.size()) continue;  // a sphere: its tessellation lies on it already
+    for (uint32_t v : mesh.elements[e]) {
+      const auto first = surfaces[v].begin(), last = first + count[v];
+      if (std::find(first, last, s) == last && count[v] < kMaxSurfaces) surfaces[v][count[v]++] = s;
+    }
+  }
+  std::vector<float> moved(mesh.vertex_count(), -1.0f);
+  rc::parallel_for(mesh.vertex_count(), [&](size_t v) {
+    std::optional<rc::Hit> best;
+    for (uint8_t k = 0; k < count[v]; ++k) {
+      const std::optional<rc::Hit> h =
+          scene.nearest_triangle(surfaces[v][k], mesh.positions[v], best ? best->t : reach, mesh.normals[v], 0.5f);
+      if (h && (!best || h->t < best->t)) best = h;
+    }
+    if (!best) return;
+    const rc::TriangleMesh& m = scene.meshes[best->geom_id];
+    const uint32_t* c = &m.indices[3 * size_t(best->prim_id)];
+    out.positions[v] = (1.0f - best->u - best->v) * m.positions[c[0]] + best->u * m.positions[c[1]] +
+                       best->v * m.positions[c[2]];
+    moved[v] = best->t;
+  });
+  // A vertex whose move turns one of its elements over goes back: the export must not fold.
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const auto& el = mesh.elements[e];
+    const Vec3 n = glm::cross(out.positions[el[1]] - out.positions[el[0]], out.positions[el[2]] - out.positions[el[0]]);
+    if (glm::dot(n, mesh.element_normal[e]) > 0.0f) continue;
+    for (uint32_t v : el) {
+      out.positions[v] = mesh.positions[v];
+      moved[v] = -1.0f;
+      if (stats) ++stats->kept_to_avoid_folds;
+    }
+  }
+  if (stats) {
+    const float diagonal = glm::length(scene.bounds().diagonal());
+    const size_t folds = stats->kept_to_avoid_folds;
+    *stats = SnapStats{};
+    stats->kept_to_avoid_folds = folds;
+    for (float d : moved) {
+      if (d < 0.0f)
+        ++stats->not_moved;
+      else
+        stats->largest = std::max(stats->largest, double(d));
+      if (d > 1e-3f * diagonal) ++stats->moved_far;
+    }
+  }
+  return out;
+}
+
 uint8_t to_srgb8(float linear, float scale) {
   // The sRGB transfer function (IEC 61966-2-1) of the clamped value.
   const float x = std::clamp(linear * scale, 0.0f, 1.0f);
@@ -463,7 +522,7 @@ Quantity parse_quantity(const std::string& name) {
 }
 
 void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,
-                    const ExportSettings& settings) {
+                    const ExportSettings& settings, SnapStats* snap) {
   const fs::path destination(path);
   const Format format = format_of(destination);
   if (format == Format::unsupported) {
@@ -471,7 +530,9 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
                      destination.extension().string() + "' (expected .ply, .obj, .gltf or .glb)");
   }
   require_folder(destination);
-  const RadiosityMesh& mesh = solution.mesh;
+  // Vertices on the input's own surface: remeshing, contact imprints and repairs leave some a
+  // little off it, and a viewer shows the model, not gilt's approximation of it.
+  const RadiosityMesh mesh = snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap);
   check_mesh(mesh, scene.materials.size());
   const std::vector<Rgb> colours = vertex_colours(solution, settings.quantity);
   const auto groups = elements_by_material(mesh, scene.materials.size());

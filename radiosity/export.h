@@ -32,12 +32,28 @@ const char* to_string(Quantity quantity);
 /// Quantity from its name ("radiance", "irradiance", "radiosity"); throws InputError otherwise.
 Quantity parse_quantity(const std::string& name);
 
+/// What snapped_to_input did.
+struct SnapStats {
+  size_t not_moved = 0;            ///< vertices left in place (none of their input within reach, or a fold)
+  size_t kept_to_avoid_folds = 0;  ///< of which moves taken back because an element would turn over
+  size_t moved_far = 0;            ///< vertices moved by more than 10⁻³ of the scene's bounding-box diagonal
+  double largest = 0.0;            ///< the longest move, scene units
+};
+
+/// The mesh with every vertex moved to the nearest point of the input meshes its elements were
+/// meshed from, on triangles facing within 60° of the vertex normal and within `reach`; vertices
+/// with none keep their place, and so do the vertices of an element the moves would turn over.
+/// write_solution exports this.
+RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach,
+                               SnapStats* stats = nullptr);
+
 /// Writes the mesh with per-vertex colours by extension: .ply (binary little-endian, float
 /// `red green blue` by default, uchar with srgb8), .obj (`v x y z r g b` with linear colours,
 /// materials in a .mtl beside it), .gltf / .glb (COLOR_0 as linear float RGB, materials as
-/// baseColorFactor / emissive). Throws InputError for an unsupported extension or an unwritable
-/// destination.
+/// baseColorFactor / emissive). The vertices are snapped_to_input first (within half the
+/// solution's target edge); `snap` receives what that did. Throws InputError for an unsupported
+/// extension or an unwritable destination.
 void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,
-                    const ExportSettings& settings);
+                    const ExportSettings& settings, SnapStats* snap = nullptr);
 
 }  // namespace gilt::radiosity

@@ -26,6 +26,7 @@
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/scene_io.h"
+#include "tests/support/test_scenes.h"
 
 namespace gilt::radiosity {
 namespace {
@@ -653,6 +654,47 @@ TEST_F(ExportTest, MaterialsLoadBackIntoGiltAsTheSameKind) {
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(glb.materials[i].emission[c], scene_.materials[i].emission[c], 1e-5);
   }
+}
+
+}  // namespace
+}  // namespace gilt::radiosity
+
+namespace gilt::radiosity {
+namespace {
+
+TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
+  // A sphere of 1,280 flat facets, remeshed into fewer, larger elements whose vertices lie on
+  // it; bisecting elements (as adaptive subdivision does at shadow edges) puts new vertices at
+  // the middle of chords, inside the sphere, and the export moves them back onto it.
+  rc::Scene scene;
+  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+  scene.meshes.push_back(test::icosphere(3));
+  rc::Light sky;
+  sky.kind = rc::LightKind::environment;
+  sky.radiance = rc::Rgb(1.0f);
+  scene.punctual_lights.push_back(sky);
+  scene.commit();
+  SolverSettings settings;
+  settings.mesh.elements = 300;
+  settings.progress = false;
+  const Solution solution = solve(scene, settings);
+  // How far a point is from the input surface (within 0.1), along a normal-facing search.
+  const auto off = [&scene](const Vec3& p, const Vec3& n) {
+    const std::optional<rc::Hit> h = scene.nearest_triangle(0, p, 0.1f, n, 0.5f);
+    return h ? h->t : 1.0f;
+  };
+  RadiosityMesh raw = solution.mesh;
+  std::vector<uint32_t> all(raw.element_count());
+  for (uint32_t e = 0; e < all.size(); ++e) all[e] = e;
+  ASSERT_GT(split_longest_edges(raw, all, 0.0f), 0u);
+  float raw_worst = 0.0f;
+  for (size_t v = 0; v < raw.vertex_count(); ++v) raw_worst = std::max(raw_worst, off(raw.positions[v], raw.normals[v]));
+  EXPECT_GT(raw_worst, 1e-4f) << "the remeshed vertices already lie on the input: nothing to test";
+  SnapStats stats;
+  const RadiosityMesh snapped = snapped_to_input(scene, raw, 0.5f * solution.mesh_report.max_edge, &stats);
+  EXPECT_EQ(stats.not_moved, 0u);
+  // On the surface within float rounding: a few ulps of coordinates of size 1.
+  for (size_t v = 0; v < snapped.vertex_count(); ++v) EXPECT_LE(off(snapped.positions[v], snapped.normals[v]), 1e-6f) << v;
 }
 
 }  // namespace
