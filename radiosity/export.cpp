@@ -440,6 +440,12 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
 
 RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats) {
   RadiosityMesh out = mesh;
+  if (mesh.element_surface.size() != mesh.element_count() || mesh.element_normal.size() != mesh.element_count() ||
+      mesh.normals.size() != mesh.vertex_count()) {
+    // A mesh built by hand without its surfaces: nothing tells where its vertices belong.
+    if (stats) *stats = SnapStats{mesh.vertex_count(), 0, 0, 0.0};
+    return out;
+  }
   // The input meshes each vertex's elements were meshed from (a few at most: surfaces meet at
   // contact lines, where the mesher splits vertices by side anyway).
   constexpr size_t kMaxSurfaces = 4;

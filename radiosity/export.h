@@ -42,7 +42,8 @@ struct SnapStats {
 
 /// The mesh with every vertex moved to the nearest point of the input meshes its elements were
 /// meshed from, on triangles facing within 60° of the vertex normal and within `reach`; vertices
-/// with none keep their place, and so do the vertices of an element the moves would turn over.
+/// with none keep their place, and so do the vertices of an element the moves would turn over
+/// (and every vertex of a mesh without element_surface and element_normal for each element).
 /// write_solution exports this.
 RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach,
                                SnapStats* stats = nullptr);
