@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "radiosity/check.h"
 #include "radiosity/export.h"
+#include "radiosity/lightmap.h"
 #include "radiosity/onto_input.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/error.h"
@@ -26,6 +27,8 @@ struct RadiosityOptions {
   radiosity::SolverSettings solver;
   radiosity::CheckSettings check;
   int check_points = 0;  ///< 0: no check
+  int lightmap = 0;      ///< 0: no lightmap
+  bool onto_given = false, fit_given = false;
   bool srgb8 = false, json = false, quiet = false;
   float exposure = 0.0f;
 };
@@ -45,6 +48,11 @@ void run_radiosity(RadiosityOptions& o) {
   ex.quantity = radiosity::parse_quantity(o.quantity);
   ex.srgb8 = o.srgb8;
   ex.exposure = o.exposure;
+  const bool lightmap = o.lightmap > 0;
+  if (lightmap && o.onto_given && o.onto != "input")
+    throw rc::InputError("--lightmap bakes onto the input model, in its UVs: it cannot go with --onto " + o.onto);
+  if (lightmap && o.fit_given) throw rc::InputError("--fit applies to vertex colours, not to --lightmap's texels");
+  if (lightmap) o.onto = "input";
   const bool onto_input = o.onto == "input";
   if (o.srgb8 && (onto_input || std::filesystem::path(o.output).extension() != ".ply"))
     throw rc::InputError("--srgb8 applies to .ply output of --onto elements only");
@@ -52,7 +60,10 @@ void run_radiosity(RadiosityOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
-  if (onto_input) radiosity::check_onto_output(o.output, scene);
+  if (lightmap)
+    radiosity::check_lightmap_output(o.output, scene);
+  else if (onto_input)
+    radiosity::check_onto_output(o.output, scene);
   o.solver.progress = !o.quiet && !o.json;
   // --time covers the whole command: loading has used some of it.
   if (o.solver.time_limit > 0.0)
@@ -64,7 +75,11 @@ void run_radiosity(RadiosityOptions& o) {
       o.fit == "point" ? radiosity::VertexFit::point : radiosity::VertexFit::least_squares;
   std::optional<radiosity::InputColours> onto;
   radiosity::SnapStats snap;
-  if (onto_input) {
+  std::optional<radiosity::Lightmap> atlas;
+  if (lightmap) {
+    atlas = radiosity::bake_lightmap(scene, sol, ex.quantity, o.lightmap);
+    radiosity::write_lightmap(o.output, scene, *atlas, ex);
+  } else if (onto_input) {
     onto = radiosity::fit_input_colours(scene, sol, fit, ex.quantity);
     radiosity::write_onto_input(o.output, scene, *onto, ex);
   } else {
@@ -76,7 +91,12 @@ void run_radiosity(RadiosityOptions& o) {
     o.check.points = o.check_points;
     o.check.seed = o.solver.seed;
     const rc::ThreadLimit limit(o.solver.threads);
-    if (onto_input) {
+    if (lightmap) {
+      const radiosity::Lightmap e = ex.quantity == radiosity::Quantity::irradiance
+                                        ? *atlas
+                                        : radiosity::bake_lightmap(scene, sol, radiosity::Quantity::irradiance, o.lightmap);
+      surface_check = radiosity::check_lightmap(scene, e, o.check);
+    } else if (onto_input) {
       // The colours as irradiance, at random points inside the input's faces.
       const radiosity::InputColours e =
           ex.quantity == radiosity::Quantity::irradiance
@@ -139,6 +159,16 @@ void run_radiosity(RadiosityOptions& o) {
                   {"buried_faces_left_out", onto->buried_faces},
                   {"iterations", onto->stats.iterations},
                   {"seconds", onto->seconds}};
+    if (atlas)
+      j["lightmap"] = {{"size", atlas->size},
+                       {"image", radiosity::lightmap_image_path(o.output)},
+                       {"charts", atlas->stats.charts},
+                       {"faces", atlas->stats.faces},
+                       {"buried_faces_left_out", atlas->stats.buried_faces},
+                       {"texels", atlas->stats.texels},
+                       {"texels_per_unit", atlas->stats.texels_per_metre},
+                       {"layout_seconds", atlas->stats.layout_seconds},
+                       {"bake_seconds", atlas->stats.bake_seconds}};
     if (surface_check)
       j["check"] = {{"points", surface_check->points},
                     {"samples", o.check.samples},
@@ -197,6 +227,13 @@ void run_radiosity(RadiosityOptions& o) {
                 "faces left out), %.3g s\n",
                 o.fit.c_str(), static_cast<unsigned long long>(onto->stats.samples),
                 static_cast<unsigned long long>(onto->stats.missing), onto->buried_faces, onto->seconds);
+  if (atlas)
+    std::printf("  lightmap: %d x %d, %zu charts over %zu faces (%zu buried left out), %zu texels (%.3g %%) at %.4g "
+                "per unit; layout %.3g s, bake %.3g s\n             wrote %s\n",
+                atlas->size, atlas->size, atlas->stats.charts, atlas->stats.faces, atlas->stats.buried_faces,
+                atlas->stats.texels, 100.0 * double(atlas->stats.texels) / (double(atlas->size) * atlas->size),
+                atlas->stats.texels_per_metre, atlas->stats.layout_seconds, atlas->stats.bake_seconds,
+                radiosity::lightmap_image_path(o.output).c_str());
   if (surface_check)
     std::printf("  check:   irradiance at %zu random points inside the input's faces against the path tracer (%d "
                 "samples each; %zu points no light reaches left out): relMSE %.4g (of which the reference's own "
@@ -260,11 +297,15 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
       ->check(finite_number());
   cmd->add_option("--quantity", o->quantity, "Vertex colour: radiance (default), irradiance or radiosity")
       ->check(CLI::IsMember({"radiance", "irradiance", "radiosity"}));
-  cmd->add_option("--onto", o->onto,
+  cmd->add_option("--lightmap", o->lightmap,
+                  "Bake the solution into a SIZE x SIZE half-float EXR atlas in a UV set laid out for it, and write "
+                  "the input model as glTF with that UV set (implies --onto input)")
+      ->check(CLI::Range(16, 16384));
+  CLI::Option* onto = cmd->add_option("--onto", o->onto,
                   "elements: export gilt's element mesh (default); input: the input model file itself, with "
                   "vertex colours added (glTF/GLB)")
       ->check(CLI::IsMember({"elements", "input"}));
-  cmd->add_option("--fit", o->fit,
+  CLI::Option* fit = cmd->add_option("--fit", o->fit,
                   "With --onto input: least-squares (default) fits the colours to the solution over each face; "
                   "point takes the solution at each vertex")
       ->check(CLI::IsMember({"least-squares", "point"}));
@@ -284,7 +325,11 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
       ->check(CLI::Range(2, 100000000));
   cmd->add_flag("--json", o->json, "Print the statistics as one JSON object");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
-  return [o] { run_radiosity(*o); };
+  return [o, onto, fit] {
+    o->onto_given = onto->count() > 0;
+    o->fit_given = fit->count() > 0;
+    run_radiosity(*o);
+  };
 }
 
 }  // namespace gilt::cli

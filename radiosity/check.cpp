@@ -9,6 +9,10 @@
 
 #include "radiosity/check.h"
 
+#include <functional>
+
+#include "radiosity/lightmap.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -113,8 +117,13 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
   return result;
 }
 
-SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
-                                       const CheckSettings& settings) {
+namespace {
+
+/// The check behind check_input_colours and check_lightmap: `covered(m)` says whether scene mesh
+/// m was baked, `baked(m, t, w)` is the baked irradiance at barycentrics w of its face t.
+SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::function<bool(size_t)>& covered_mesh,
+                               const std::function<Rgb(size_t, size_t, const float*)>& baked_at,
+                               const CheckSettings& settings) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
   // The faces the colours cover, weighted by area (faces whose material the check cannot invert
@@ -126,9 +135,7 @@ SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColour
   std::vector<float> area;
   for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
     const rc::TriangleMesh& mesh = scene.meshes[m];
-    const bool covered = mesh.origin.file == irradiance.file &&
-                         (irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty()
-                                                      : !irradiance.per_mesh[m].empty());
+    const bool covered = mesh.origin.file == file && covered_mesh(m);
     const rc::Material& mat = scene.materials[mesh.material];
     if (!covered || mat.kind != rc::MaterialKind::diffuse || !(std::min({mat.albedo.r, mat.albedo.g, mat.albedo.b}) > 0.0f))
       continue;
@@ -156,14 +163,8 @@ SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColour
     const rc::Vec2 uv = rc::sample_uniform_triangle(rng.uniform2());
     const float w[3] = {1.0f - uv.x - uv.y, uv.x, uv.y};
     Vec3 p(0.0f);
-    Rgb value(0.0f);
-    for (int k = 0; k < 3; ++k) {
-      p += w[k] * mesh.positions[corner[k]];
-      const uint32_t v = corner[k];
-      value += w[k] * (irradiance.per_mesh.empty()
-                           ? irradiance.per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]]
-                           : irradiance.per_mesh[f.mesh][v]);
-    }
+    for (int k = 0; k < 3; ++k) p += w[k] * mesh.positions[corner[k]];
+    const Rgb value = baked_at(f.mesh, f.triangle, w);
     const Vec3 n = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
                                              mesh.positions[corner[2]] - mesh.positions[corner[0]]));
     if (input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]], mesh.positions[corner[2]])) {
@@ -218,6 +219,33 @@ SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColour
   result.mean_relative_error = relative / (3.0 * double(used));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+}  // namespace
+
+SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
+                                       const CheckSettings& settings) {
+  const auto covered = [&](size_t m) {
+    return irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty() : !irradiance.per_mesh[m].empty();
+  };
+  const auto baked = [&](size_t m, size_t t, const float* w) {
+    const rc::TriangleMesh& mesh = scene.meshes[m];
+    Rgb value(0.0f);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = mesh.indices[3 * t + size_t(k)];
+      value += w[k] * (irradiance.per_mesh.empty()
+                           ? irradiance.per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]]
+                           : irradiance.per_mesh[m][v]);
+    }
+    return value;
+  };
+  return check_baked(scene, irradiance.file, covered, baked, settings);
+}
+
+SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings) {
+  return check_baked(
+      scene, irradiance.file, [&](size_t m) { return !irradiance.corner_uv[m].empty(); },
+      [&](size_t m, size_t t, const float* w) { return irradiance.at(m, t, w[1], w[2]); }, settings);
 }
 
 }  // namespace gilt::radiosity

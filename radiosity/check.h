@@ -65,4 +65,10 @@ struct SurfaceCheckResult {
 SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings);
 
+struct Lightmap;  // radiosity/lightmap.h
+
+/// The same check for a lightmap of irradiance (`--lightmap`): the baked value at each point is
+/// the atlas read bilinearly at the point's UV, as a viewer reads it.
+SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings);
+
 }  // namespace gilt::radiosity

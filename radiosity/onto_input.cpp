@@ -32,58 +32,65 @@ int32_t onto_input_file(const rc::Scene& scene) {
   return 0;
 }
 
+SolutionAtInput::SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity)
+    : scene_(scene), solution_(solution), view_(scene, solution, ViewMode::mesh, /*ambient=*/false),
+      quantity_(quantity) {
+  // Point, spot and directional lights reach each point by its own shadow ray against the input,
+  // so a sun patch or a sharp shadow falls as it does on the input's faces, not as the elements'
+  // vertices caught it; the rest (sky, emitting surfaces, interreflection) is the solution's,
+  // interpolated over the nearest element facing the same way.
+  for (const rc::Light& l : scene.punctual_lights)
+    if (l.kind != rc::LightKind::environment) delta_lights_.push_back(&l);
+  exact_direct_ = !delta_lights_.empty() && solution.vertex_punctual.size() == solution.mesh.vertex_count();
+}
+
+std::optional<Rgb> SolutionAtInput::operator()(const rc::Material& m, const Vec3& p, const Vec3& n) const {
+  const std::optional<RadiosityView::Location> at = view_.locate(p, n);
+  if (!at) return std::nullopt;
+  const auto& corner = solution_.mesh.elements[at->element];
+  const auto interpolate = [&](const std::vector<Rgb>& per_vertex) {
+    return per_vertex[corner[0]] * (1.0f - at->u - at->v) + per_vertex[corner[1]] * at->u +
+           per_vertex[corner[2]] * at->v;
+  };
+  Rgb e = interpolate(solution_.vertex_irradiance);
+  if (exact_direct_) {
+    e = rc::clamp(e - interpolate(solution_.vertex_punctual), 0.0f, std::numeric_limits<float>::max());
+    const rc::SurfacePoint sp = mesh_surface_point(p, n);
+    for (const rc::Light* light : delta_lights_) {
+      const rc::LightSample ls = rc::sample_light(scene_, *light, sp, rc::Vec2(0.5f));
+      const float cos_theta = glm::dot(ls.wi, n);
+      if (cos_theta > 0.0f && !ls.radiance.is_black() && !scene_.occluded(ls.shadow_ray)) e += ls.radiance * cos_theta;
+    }
+  }
+  const Rgb radiosity = m.emission * rc::kPi + m.albedo * e;
+  return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
+}
+
+std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec3> positions,
+                                     std::span<const uint32_t> indices) {
+  std::vector<char> buried(indices.size() / 3, 0);
+  rc::parallel_for(buried.size(), [&](size_t f) {
+    buried[f] = input_triangle_buried(scene, positions[indices[3 * f]], positions[indices[3 * f + 1]],
+                                      positions[indices[3 * f + 2]]);
+  });
+  return buried;
+}
+
 InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity) {
   const auto start = std::chrono::steady_clock::now();
   InputColours out;
   out.file = onto_input_file(scene);
   const std::string ext = rc::lower_extension(scene.model_files[size_t(out.file)]);
   const bool per_file_vertex = ext == ".obj" || ext == ".ply";
-  const RadiosityView view(scene, solution, ViewMode::mesh, /*ambient=*/false);
   const float spacing = 0.5f * solution.mesh_report.max_edge;
-  // Point, spot and directional lights reach each sample point by its own shadow ray against the
-  // input, so a sun patch or a sharp shadow is fitted as it falls on the input's faces, not as
-  // the elements' vertices caught it; the rest (sky, emitting surfaces, interreflection) is the
-  // solution's, interpolated over the nearest element facing the same way.
-  std::vector<const rc::Light*> delta_lights;
-  for (const rc::Light& l : scene.punctual_lights)
-    if (l.kind != rc::LightKind::environment) delta_lights.push_back(&l);
-  const RadiosityMesh& elements = solution.mesh;
-  const bool exact_direct = !delta_lights.empty() && solution.vertex_punctual.size() == elements.vertex_count();
-  const auto value = [&](const rc::Material& m, const Vec3& p, const Vec3& n) -> std::optional<Rgb> {
-    const std::optional<RadiosityView::Location> at = view.locate(p, n);
-    if (!at) return std::nullopt;
-    const auto& corner = elements.elements[at->element];
-    const auto interpolate = [&](const std::vector<Rgb>& per_vertex) {
-      return per_vertex[corner[0]] * (1.0f - at->u - at->v) + per_vertex[corner[1]] * at->u +
-             per_vertex[corner[2]] * at->v;
-    };
-    Rgb e = interpolate(solution.vertex_irradiance);
-    if (exact_direct) {
-      e = rc::clamp(e - interpolate(solution.vertex_punctual), 0.0f, std::numeric_limits<float>::max());
-      const rc::SurfacePoint sp = mesh_surface_point(p, n);
-      for (const rc::Light* light : delta_lights) {
-        const rc::LightSample ls = rc::sample_light(scene, *light, sp, rc::Vec2(0.5f));
-        const float cos_theta = glm::dot(ls.wi, n);
-        if (cos_theta > 0.0f && !ls.radiance.is_black() && !scene.occluded(ls.shadow_ray)) e += ls.radiance * cos_theta;
-      }
-    }
-    const Rgb radiosity = m.emission * rc::kPi + m.albedo * e;
-    return quantity == Quantity::irradiance ? e : quantity == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
-  };
+  const SolutionAtInput at_input(scene, solution, quantity);
+  const auto value = [&](const rc::Material& m, const Vec3& p, const Vec3& n) { return at_input(m, p, n); };
   const auto baked = [&](const rc::TriangleMesh& mesh) {
     return mesh.origin.file == out.file && !scene.materials[mesh.material].is_specular();
   };
 
-  // Faces inside closed solids or under objects standing on them (as the mesher finds them) are
-  // left out of the fit: no one sees them, and the nearest element facing their way belongs to
-  // another surface, whose light would pull the colours of the vertices they share with visible
-  // faces. (On Šibenik such points made 98 % of the check's squared error.)
   const auto buried_faces = [&](std::span<const Vec3> positions, std::span<const uint32_t> indices) {
-    std::vector<char> buried(indices.size() / 3, 0);
-    rc::parallel_for(buried.size(), [&](size_t f) {
-      buried[f] = input_triangle_buried(scene, positions[indices[3 * f]], positions[indices[3 * f + 1]],
-                                        positions[indices[3 * f + 2]]);
-    });
+    std::vector<char> buried = input_faces_buried(scene, positions, indices);
     for (char b : buried) out.buried_faces += size_t(b);
     return buried;
   };

@@ -21,12 +21,15 @@
 // (radiosity/onto_obj.cpp). PLY in, PLY out: every element and property as it was, with colour
 // properties added to the vertices (radiosity/onto_ply.cpp).
 
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "radiosity/export.h"
 #include "radiosity/solver.h"
 #include "radiosity/vertex_fit.h"
+#include "radiosity/view.h"
 
 namespace gilt::radiosity {
 
@@ -46,6 +49,32 @@ struct InputColours {
 /// The model file `--onto input` writes onto: the scene's only model file. Throws InputError
 /// when the scene was not read from one, or from several.
 int32_t onto_input_file(const rc::Scene& scene);
+
+/// The solution's `quantity` at a point of the input model: irradiance read from the nearest
+/// element facing the same way (RadiosityView::locate), with the direct light of point, spot and
+/// directional lights replaced by its own shadow ray from the point, turned into the quantity by
+/// the point's material (B = π·Le + ρ·E, L = B/π). Nothing where no element is near. Safe to call
+/// from several threads at once; scene and solution must outlive it.
+class SolutionAtInput {
+ public:
+  SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity);
+  std::optional<Rgb> operator()(const rc::Material& m, const Vec3& p, const Vec3& n) const;
+
+ private:
+  const rc::Scene& scene_;
+  const Solution& solution_;
+  RadiosityView view_;
+  Quantity quantity_;
+  std::vector<const rc::Light*> delta_lights_;
+  bool exact_direct_ = false;
+};
+
+/// For each face of `indices` (three per face): 1 when the mesher's burial test finds it inside a
+/// closed solid or under an object standing on it (input_triangle_buried). Bakes leave those out:
+/// no one sees them, and the nearest element facing their way belongs to another surface. (On
+/// Šibenik such points made 98 % of the check's squared error.)
+std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec3> positions,
+                                     std::span<const uint32_t> indices);
 
 /// Fits the solution's `quantity` onto the vertices of every non-specular mesh read from the
 /// model file (onto_input_file), by `fit` over the faces, at a quadrature spacing of half the

@@ -82,7 +82,7 @@ std::string encode_with_oiio(const fs::path& path, const OIIO::ImageSpec& spec, 
   if (!out) return OIIO::geterror();
   if (!out->set_ioproxy(&memory)) return "this format cannot be encoded in memory";
   if (!out->open(path.string(), spec)) return out->geterror();
-  if (!out->write_image(spec.format, pixels)) {
+  if (!out->write_image(spec.format == OIIO::TypeDesc::HALF ? OIIO::TypeDesc(OIIO::TypeDesc::FLOAT) : spec.format, pixels)) {
     std::string message = out->geterror();
     out->close();
     return message;
@@ -95,7 +95,7 @@ std::string encode_with_oiio(const fs::path& path, const OIIO::ImageSpec& spec, 
 
 bool is_supported_image_path(const std::string& path) { return format_of(path) != Format::unsupported; }
 
-void write_image(const std::string& path, const Image& image, float exposure) {
+void write_image(const std::string& path, const Image& image, float exposure, bool half_float) {
   const Format format = format_of(path);
   if (format == Format::unsupported) {
     throw InputError("cannot write '" + path + "': unsupported image format '" +
@@ -136,6 +136,11 @@ void write_image(const std::string& path, const Image& image, float exposure) {
     }
     if (format == Format::exr) spec.attribute("compression", "zip");
     data = linear.data();
+    if (format == Format::exr && half_float) {
+      // OIIO converts the float pixels as it writes; values past half's range become infinite.
+      for (float& x : linear) x = std::clamp(x, -65504.0f, 65504.0f);
+      spec.set_format(OIIO::TypeDesc::HALF);
+    }
   }
   // OpenImageIO stamps EXR files with the current time (capDate) unless told a DateTime; a fixed
   // one keeps files bit-identical across runs, so equal images give equal files.

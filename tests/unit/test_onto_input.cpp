@@ -24,6 +24,7 @@
 #include "raytrace_core/ply_header.h"
 #include "raytrace_core/scene_io.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/model_files.h"
 
 namespace gilt::test {
 namespace {
@@ -34,27 +35,9 @@ using Json = nlohmann::json;
 
 const std::string kGilt = GILT_BINARY_PATH;
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("gilt-onto-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& name) { return test::fresh_dir("gilt-onto", name); }
 
-bool no_images(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
-  return true;
-}
-
-tinygltf::Model load(const fs::path& path) {
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(no_images, nullptr);
-  std::string err, warn;
-  const bool ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
-                                             : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
-  EXPECT_TRUE(ok) << path << ": " << err;
-  return model;
-}
+tinygltf::Model load(const fs::path& path) { return load_gltf_model(path); }
 
 /// The bytes of an accessor's elements, tightly packed.
 std::string accessor_bytes(const tinygltf::Model& m, int index) {
@@ -153,10 +136,6 @@ size_t expect_same_structure(const tinygltf::Model& in, const tinygltf::Model& o
   return split.size();
 }
 
-void write_file(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary) << bytes;
-}
-
 /// A floor (mesh 0) under a panel (mesh 1) placed by two nodes, one of them animated; the
 /// geometry lives in data.bin. Lit from the JSON wrapper scene.json by a sun and a sky.
 fs::path write_model(const fs::path& dir) {
@@ -206,15 +185,6 @@ fs::path write_model(const fs::path& dir) {
     "lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2},
                {"type": "environment", "radiance": 0.3}]})");
   return dir / "scene.json";
-}
-
-/// The path in single quotes for the shell (appended piecewise: GCC 12 warns falsely about
-/// `"'" + path.string()`).
-std::string quoted(const fs::path& p) {
-  std::string s(1, '\'');
-  s += p.string();
-  s += '\'';
-  return s;
 }
 
 std::string run(const std::string& args, const fs::path& dir) {
@@ -309,10 +279,17 @@ TEST(OntoInput, OutputsPassTheKhronosValidator) {
   const fs::path scene = write_model(dir);
   std::vector<fs::path> outputs = {dir / "baked.gltf", dir / "baked.glb"};
   for (const fs::path& out : outputs) run(quoted(scene) + " --onto input --elements 400 -o " + quoted(out), dir);
+  // The same model with a lightmap: vertices split, a UV set and an index buffer added.
+  for (const char* name : {"lightmapped.gltf", "lightmapped.glb"}) {
+    outputs.push_back(dir / name);
+    run(quoted(scene) + " --lightmap 64 --elements 400 -o " + quoted(outputs.back()), dir);
+  }
   const fs::path scenes = fs::path(GILT_SOURCE_DIR) / ".." / "shared" / "scenes";
   if (fs::exists(scenes / "wrap" / "truck-lit.json")) {
     outputs.push_back(dir / "truck.glb");
     run(quoted(scenes / "wrap" / "truck-lit.json") + " --onto input --elements 2000 -o " + quoted(outputs.back()), dir);
+    outputs.push_back(dir / "truck-lightmap.glb");
+    run(quoted(scenes / "wrap" / "truck-lit.json") + " --lightmap 256 --elements 2000 -o " + quoted(outputs.back()), dir);
   }
   std::string command = "NODE_PATH=";
   command += quoted(modules);

@@ -1,0 +1,449 @@
+// Lightmap layout (charts, projection, packing) and baking; see lightmap.h.
+
+#include "radiosity/lightmap.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <unordered_map>
+
+#include "radiosity/onto_input.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
+
+namespace gilt::radiosity {
+
+using rc::InputError;
+using rc::Vec2;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Faces of one mesh that lie in one plane of projection.
+struct Chart {
+  uint32_t mesh = 0;
+  std::vector<uint32_t> faces;
+  std::vector<Vec2> corner;  ///< three per face, in the chart's plane (scene units), later its rectangle's frame
+  Vec2 extent{0.0f};         ///< the rectangle, from the origin, width ≥ height
+  // Where packing put it, in texels: the rectangle's corner.
+  double x = 0.0, y = 0.0;
+};
+
+/// Positions made equal by bits share an id, so faces whose vertices were split (for normals or
+/// UVs) are still neighbours.
+std::vector<uint32_t> weld(const std::vector<Vec3>& positions) {
+  struct Key {
+    uint32_t b[3];
+    bool operator==(const Key& o) const { return std::memcmp(b, o.b, sizeof b) == 0; }
+  };
+  struct Hash {
+    size_t operator()(const Key& k) const {
+      return (size_t(k.b[0]) * 0x9e3779b97f4a7c15ull) ^ (size_t(k.b[1]) * 0xc2b2ae3d27d4eb4full) ^
+             (size_t(k.b[2]) * 0x165667b19e3779f9ull);
+    }
+  };
+  std::unordered_map<Key, uint32_t, Hash> ids;
+  ids.reserve(positions.size());
+  std::vector<uint32_t> id(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) {
+    Key k;
+    std::memcpy(k.b, &positions[v], sizeof k.b);
+    id[v] = ids.emplace(k, uint32_t(ids.size())).first->second;
+  }
+  return id;
+}
+
+/// Do two triangles' interiors overlap by more than eps (separating axes of their six edges)?
+bool triangles_overlap(const Vec2* a, const Vec2* b, float eps) {
+  const auto separated_along = [&](const Vec2* t, int e) {
+    const Vec2 d = t[(e + 1) % 3] - t[e];
+    const Vec2 axis(-d.y, d.x);
+    float a_lo = rc::kInfinity, a_hi = -rc::kInfinity, b_lo = rc::kInfinity, b_hi = -rc::kInfinity;
+    for (int k = 0; k < 3; ++k) {
+      const float pa = glm::dot(a[k], axis), pb = glm::dot(b[k], axis);
+      a_lo = std::min(a_lo, pa), a_hi = std::max(a_hi, pa);
+      b_lo = std::min(b_lo, pb), b_hi = std::max(b_hi, pb);
+    }
+    const float tol = eps * glm::length(axis);
+    return a_hi <= b_lo + tol || b_hi <= a_lo + tol;
+  };
+  for (int e = 0; e < 3; ++e)
+    if (separated_along(a, e) || separated_along(b, e)) return false;
+  return true;
+}
+
+/// Grows the charts of one mesh.
+void grow_charts(const rc::TriangleMesh& mesh, uint32_t mesh_index, std::vector<Chart>& charts) {
+  const size_t faces = mesh.triangle_count();
+  if (faces == 0) return;
+  const std::vector<uint32_t> id = weld(mesh.positions);
+  // Faces around each welded edge.
+  std::unordered_map<uint64_t, std::vector<uint32_t>> edge_faces;
+  edge_faces.reserve(faces * 2);
+  const auto edge_key = [&](uint32_t f, int e) {
+    const uint32_t a = id[mesh.indices[3 * f + uint32_t(e)]], b = id[mesh.indices[3 * f + uint32_t((e + 1) % 3)]];
+    return (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+  };
+  std::vector<Vec3> normal(faces);
+  std::vector<float> area(faces), longest(faces);
+  for (uint32_t f = 0; f < faces; ++f) {
+    const Vec3 &p0 = mesh.positions[mesh.indices[3 * f]], &p1 = mesh.positions[mesh.indices[3 * f + 1]],
+               &p2 = mesh.positions[mesh.indices[3 * f + 2]];
+    const Vec3 c = glm::cross(p1 - p0, p2 - p0);
+    area[f] = 0.5f * glm::length(c);
+    normal[f] = area[f] > 0.0f ? c / (2.0f * area[f]) : Vec3(0.0f);
+    longest[f] = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
+    for (int e = 0; e < 3; ++e) edge_faces[edge_key(f, e)].push_back(f);
+  }
+  std::vector<float> sorted_longest = longest;
+  std::nth_element(sorted_longest.begin(), sorted_longest.begin() + long(faces / 2), sorted_longest.end());
+  const float cell = std::max(2.0f * sorted_longest[faces / 2], 1e-12f);
+
+  std::vector<uint32_t> order(faces);
+  for (uint32_t f = 0; f < faces; ++f) order[f] = f;
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return area[a] > area[b]; });
+  std::vector<char> taken(faces, 0);
+  const float min_cos = std::cos(kChartAngle * rc::kPi / 180.0f);
+
+  for (const uint32_t seed : order) {
+    if (taken[seed]) continue;
+    Chart chart;
+    chart.mesh = mesh_index;
+    // The plane of projection: the seed's (any plane for a degenerate seed, whose area is zero).
+    const Vec3 axis = area[seed] > 0.0f ? normal[seed] : Vec3(0.0f, 0.0f, 1.0f);
+    const Vec3 helper = std::abs(axis.x) > 0.9f ? Vec3(0.0f, 1.0f, 0.0f) : Vec3(1.0f, 0.0f, 0.0f);
+    const Vec3 tangent = glm::normalize(glm::cross(helper, axis)), bitangent = glm::cross(axis, tangent);
+    const auto project = [&](uint32_t f, Vec2* out) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& p = mesh.positions[mesh.indices[3 * f + uint32_t(k)]];
+        out[k] = Vec2(glm::dot(p, tangent), glm::dot(p, bitangent));
+      }
+    };
+    // The chart's faces by grid cell, for the overlap test.
+    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+    const auto cells = [&](const Vec2* t, auto&& visit) {
+      const Vec2 lo = glm::min(t[0], glm::min(t[1], t[2])), hi = glm::max(t[0], glm::max(t[1], t[2]));
+      const int64_t x0 = int64_t(std::floor(lo.x / cell)), x1 = int64_t(std::floor(hi.x / cell));
+      const int64_t y0 = int64_t(std::floor(lo.y / cell)), y1 = int64_t(std::floor(hi.y / cell));
+      for (int64_t x = x0; x <= x1; ++x)
+        for (int64_t y = y0; y <= y1; ++y) visit((uint64_t(uint32_t(x)) << 32) | uint32_t(y));
+    };
+    const auto fits = [&](uint32_t f, const Vec2* t) {
+      if (!(area[f] > 0.0f)) return true;  // covers nothing
+      const float eps = 1e-4f * longest[f];
+      bool clear = true;
+      cells(t, [&](uint64_t key) {
+        if (!clear) return;
+        const auto it = grid.find(key);
+        if (it == grid.end()) return;
+        for (uint32_t local : it->second)
+          if (triangles_overlap(t, &chart.corner[3 * size_t(local)], eps)) {
+            clear = false;
+            return;
+          }
+      });
+      return clear;
+    };
+    const auto add = [&](uint32_t f, const Vec2* t) {
+      taken[f] = 1;
+      const uint32_t local = uint32_t(chart.faces.size());
+      chart.faces.push_back(f);
+      chart.corner.insert(chart.corner.end(), {t[0], t[1], t[2]});
+      if (area[f] > 0.0f) cells(t, [&](uint64_t key) { grid[key].push_back(local); });
+    };
+    Vec2 t[3];
+    project(seed, t);
+    add(seed, t);
+    std::deque<uint32_t> frontier{seed};
+    while (!frontier.empty()) {
+      const uint32_t f = frontier.front();
+      frontier.pop_front();
+      for (int e = 0; e < 3; ++e)
+        for (const uint32_t g : edge_faces[edge_key(f, e)]) {
+          if (taken[g]) continue;
+          // Degenerate faces ride along with any neighbour; others must face the plane.
+          if (area[g] > 0.0f && glm::dot(normal[g], axis) < min_cos) continue;
+          project(g, t);
+          if (!fits(g, t)) continue;
+          add(g, t);
+          frontier.push_back(g);
+        }
+    }
+    charts.push_back(std::move(chart));
+  }
+}
+
+/// Turns a chart to its smallest bounding rectangle (over its convex hull's edge directions),
+/// wider than tall, with its corner at the origin.
+void fit_rectangle(Chart& chart) {
+  std::vector<Vec2> pts = chart.corner;
+  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  std::vector<Vec2> hull;
+  if (pts.size() < 3) {
+    hull = pts;
+  } else {  // Andrew's monotone chain
+    const auto cross = [](const Vec2& o, const Vec2& a, const Vec2& b) {
+      return double(a.x - o.x) * double(b.y - o.y) - double(a.y - o.y) * double(b.x - o.x);
+    };
+    std::vector<Vec2> h(2 * pts.size());
+    size_t k = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
+      h[k++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
+      while (k >= lower && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
+      h[k++] = pts[i];
+    }
+    h.resize(k - 1);
+    hull = std::move(h);
+  }
+  Vec2 best_dir(1.0f, 0.0f);
+  double best_area = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < std::max<size_t>(hull.size(), 1); ++i) {
+    Vec2 d = hull.size() >= 2 ? hull[(i + 1) % hull.size()] - hull[i] : Vec2(1.0f, 0.0f);
+    const float len = glm::length(d);
+    if (!(len > 0.0f)) continue;
+    d /= len;
+    float x0 = rc::kInfinity, x1 = -rc::kInfinity, y0 = rc::kInfinity, y1 = -rc::kInfinity;
+    for (const Vec2& p : hull) {
+      const float x = glm::dot(p, d), y = d.x * p.y - d.y * p.x;
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+    const double a = double(x1 - x0) * double(y1 - y0);
+    if (a < best_area) best_area = a, best_dir = d;
+  }
+  // Rotate into the frame (d, d⊥); swap axes if taller than wide. Both keep the chart's winding
+  // or mirror it, which does not matter for a lightmap: each texel maps to one surface point.
+  Vec2 lo(rc::kInfinity), hi(-rc::kInfinity);
+  for (Vec2& p : chart.corner) {
+    p = Vec2(glm::dot(p, best_dir), best_dir.x * p.y - best_dir.y * p.x);
+    lo = glm::min(lo, p), hi = glm::max(hi, p);
+  }
+  for (Vec2& p : chart.corner) p -= lo;
+  chart.extent = hi - lo;
+  if (chart.extent.y > chart.extent.x) {
+    for (Vec2& p : chart.corner) p = Vec2(p.y, p.x);
+    chart.extent = Vec2(chart.extent.y, chart.extent.x);
+  }
+}
+
+/// A chart's cell in the atlas at `density` texels per unit: its rectangle, one texel more so
+/// that a chart of no width still holds one, and the pad on each side.
+int cell_size(float extent, double density) { return int(std::ceil(double(extent) * density)) + 1 + 2 * kLightmapPad; }
+
+/// Shelf packing of charts (sorted by height, tallest first) into size × size; false when they do
+/// not fit. Stores each chart's texel corner.
+bool pack(std::vector<Chart>& charts, int size, double density) {
+  int x = 0, y = 0, shelf = 0;
+  for (Chart& c : charts) {
+    const int w = cell_size(c.extent.x, density), h = cell_size(c.extent.y, density);
+    if (w > size) return false;
+    if (x + w > size) {
+      y += shelf;
+      x = 0;
+      shelf = 0;
+    }
+    if (y + h > size) return false;
+    c.x = x + kLightmapPad;
+    c.y = y + kLightmapPad;
+    x += w;
+    shelf = std::max(shelf, h);
+  }
+  return true;
+}
+
+/// Closest point of triangle t to p, as barycentrics of t[1] and t[2] (Ericson, Real-Time
+/// Collision Detection, §5.1.5, in 2D).
+Vec2 closest_barycentric(const Vec2* t, const Vec2& p) {
+  const Vec2 ab = t[1] - t[0], ac = t[2] - t[0], ap = p - t[0];
+  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0f && d2 <= 0.0f) return Vec2(0.0f, 0.0f);
+  const Vec2 bp = p - t[1];
+  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0f && d4 <= d3) return Vec2(1.0f, 0.0f);
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return Vec2(d1 / (d1 - d3), 0.0f);
+  const Vec2 cp = p - t[2];
+  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0f && d5 <= d6) return Vec2(0.0f, 1.0f);
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return Vec2(0.0f, d2 / (d2 - d6));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+    const float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return Vec2(1.0f - w, w);
+  }
+  const float denom = 1.0f / (va + vb + vc);
+  return Vec2(vb * denom, vc * denom);
+}
+
+}  // namespace
+
+Rgb Lightmap::at(size_t mesh, size_t face, float u, float v) const {
+  const Vec2* c = &corner_uv[mesh][3 * face];
+  const Vec2 uv = c[0] * (1.0f - u - v) + c[1] * u + c[2] * v;
+  const float x = uv.x * float(size) - 0.5f, y = uv.y * float(size) - 0.5f;
+  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+  const float fx = x - float(x0), fy = y - float(y0);
+  const auto texel = [&](int tx, int ty) {
+    tx = std::clamp(tx, 0, size - 1), ty = std::clamp(ty, 0, size - 1);
+    return image.pixels[size_t(ty) * size_t(size) + size_t(tx)];
+  };
+  return (texel(x0, y0) * (1.0f - fx) + texel(x0 + 1, y0) * fx) * (1.0f - fy) +
+         (texel(x0, y0 + 1) * (1.0f - fx) + texel(x0 + 1, y0 + 1) * fx) * fy;
+}
+
+Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size) {
+  if (size < 16 || size > 16384)
+    throw InputError("--lightmap " + std::to_string(size) + ": the atlas's size must be 16 to 16384 texels");
+  auto start = std::chrono::steady_clock::now();
+  Lightmap out;
+  out.size = size;
+  out.file = onto_input_file(scene);
+  out.corner_uv.resize(scene.meshes.size());
+
+  // Layout.
+  std::vector<Chart> charts;
+  std::vector<std::vector<char>> buried(scene.meshes.size());
+  double chart_area = 0.0;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const rc::TriangleMesh& mesh = scene.meshes[m];
+    if (mesh.origin.file != out.file || scene.materials[mesh.material].is_specular()) continue;
+    grow_charts(mesh, m, charts);
+    out.stats.faces += mesh.triangle_count();
+    buried[m] = input_faces_buried(scene, mesh.positions, mesh.indices);
+    for (char b : buried[m]) out.stats.buried_faces += size_t(b);
+  }
+  rc::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
+  std::stable_sort(charts.begin(), charts.end(), [](const Chart& a, const Chart& b) { return a.extent.y > b.extent.y; });
+  for (const Chart& c : charts) chart_area += double(c.extent.x) * double(c.extent.y);
+  out.stats.charts = charts.size();
+  if (charts.empty()) throw InputError("--lightmap: " + scene.name + " has no faces to bake (all are mirrors or glass)");
+  // The densest layout that packs: bisection between one that fits and one that does not.
+  double lo = 0.0, hi = double(size) / std::sqrt(std::max(chart_area, 1e-30));
+  if (!pack(charts, size, 0.0))
+    throw InputError("--lightmap " + std::to_string(size) + ": " + std::to_string(charts.size()) +
+                     " charts do not fit in the atlas even at one texel each: give a larger size");
+  for (int i = 0; i < 40 && hi > lo * (1.0 + 1e-4); ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (pack(charts, size, mid) ? lo : hi) = mid;
+  }
+  pack(charts, size, lo);
+  out.stats.texels_per_metre = lo;
+  for (const Chart& c : charts) {
+    std::vector<Vec2>& uv = out.corner_uv[c.mesh];
+    uv.resize(3 * scene.meshes[c.mesh].triangle_count(), Vec2(0.0f));
+    for (size_t i = 0; i < c.faces.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const Vec2 texel = Vec2(float(c.x + double(c.corner[3 * i + size_t(k)].x) * lo + 0.5),
+                                float(c.y + double(c.corner[3 * i + size_t(k)].y) * lo + 0.5));
+        uv[3 * size_t(c.faces[i]) + size_t(k)] = texel / float(size);
+      }
+  }
+  out.stats.layout_seconds = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+
+  // Which face each texel shows: the nearest to its centre, within 1.5 texels. Charts own
+  // disjoint cells of the atlas, so they are rasterised in parallel.
+  constexpr float kReach = 1.5f;
+  const size_t texels = size_t(size) * size_t(size);
+  struct Owner {
+    uint32_t mesh = UINT32_MAX, face = 0;
+    float distance = rc::kInfinity;
+  };
+  std::vector<Owner> owner(texels);
+  rc::parallel_for(charts.size(), [&](size_t ci) {
+    const Chart& c = charts[ci];
+    const std::vector<Vec2>& uv = out.corner_uv[c.mesh];
+    for (const uint32_t f : c.faces) {
+      if (buried[c.mesh][f]) continue;
+      const Vec2 t[3] = {uv[3 * f] * float(size), uv[3 * f + 1] * float(size), uv[3 * f + 2] * float(size)};
+      if (!(std::abs((t[1].x - t[0].x) * (t[2].y - t[0].y) - (t[1].y - t[0].y) * (t[2].x - t[0].x)) > 0.0f)) continue;
+      const Vec2 lo_t = glm::min(t[0], glm::min(t[1], t[2])) - kReach, hi_t = glm::max(t[0], glm::max(t[1], t[2])) + kReach;
+      const int x0 = std::max(0, int(std::floor(lo_t.x))), x1 = std::min(size - 1, int(std::floor(hi_t.x)));
+      const int y0 = std::max(0, int(std::floor(lo_t.y))), y1 = std::min(size - 1, int(std::floor(hi_t.y)));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const Vec2 centre(float(x) + 0.5f, float(y) + 0.5f);
+          const Vec2 b = closest_barycentric(t, centre);
+          const float d = glm::length(t[0] * (1.0f - b.x - b.y) + t[1] * b.x + t[2] * b.y - centre);
+          Owner& o = owner[size_t(y) * size_t(size) + size_t(x)];
+          if (d <= kReach && d < o.distance) o = {c.mesh, f, d};
+        }
+    }
+  });
+
+  // Each owned texel: the mean of the solution at four points of its footprint, clamped onto
+  // its face.
+  const SolutionAtInput at_input(scene, solution, quantity);
+  out.image.width = out.image.height = size;
+  out.image.pixels.assign(texels, Rgb(0.0f));
+  std::vector<char> filled(texels, 0);
+  rc::parallel_for(size_t(size), [&](size_t y) {
+    for (size_t x = 0; x < size_t(size); ++x) {
+      const Owner& o = owner[y * size_t(size) + x];
+      if (o.mesh == UINT32_MAX) continue;
+      const rc::TriangleMesh& mesh = scene.meshes[o.mesh];
+      const std::vector<Vec2>& uv = out.corner_uv[o.mesh];
+      const Vec2 t[3] = {uv[3 * o.face] * float(size), uv[3 * o.face + 1] * float(size), uv[3 * o.face + 2] * float(size)};
+      const Vec3 &p0 = mesh.positions[mesh.indices[3 * o.face]], &p1 = mesh.positions[mesh.indices[3 * o.face + 1]],
+                 &p2 = mesh.positions[mesh.indices[3 * o.face + 2]];
+      const Vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+      const rc::Material& material = scene.materials[mesh.material];
+      Rgb sum(0.0f);
+      int count = 0;
+      for (int s = 0; s < 4; ++s) {
+        const Vec2 point(float(x) + 0.25f + 0.5f * float(s & 1), float(y) + 0.25f + 0.5f * float(s >> 1));
+        const Vec2 b = closest_barycentric(t, point);
+        const std::optional<Rgb> v = at_input(material, p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y, n);
+        if (v) sum += *v, ++count;
+      }
+      if (count == 0) continue;
+      out.image.pixels[y * size_t(size) + x] = sum / float(count);
+      filled[y * size_t(size) + x] = 1;
+    }
+  });
+  for (char f : filled) out.stats.texels += size_t(f);
+  // The border: kLightmapPad rounds of filling empty texels with their filled neighbours' mean.
+  for (int round = 0; round < kLightmapPad; ++round) {
+    std::vector<char> next = filled;
+    std::vector<Rgb> pixels = out.image.pixels;
+    rc::parallel_for(size_t(size), [&](size_t y) {
+      for (size_t x = 0; x < size_t(size); ++x) {
+        if (filled[y * size_t(size) + x]) continue;
+        Rgb sum(0.0f);
+        int count = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const long nx = long(x) + dx, ny = long(y) + dy;
+            if (nx < 0 || ny < 0 || nx >= size || ny >= size || !filled[size_t(ny) * size_t(size) + size_t(nx)]) continue;
+            sum += out.image.pixels[size_t(ny) * size_t(size) + size_t(nx)];
+            ++count;
+          }
+        if (count == 0) continue;
+        pixels[y * size_t(size) + x] = sum / float(count);
+        next[y * size_t(size) + x] = 1;
+      }
+    });
+    filled = std::move(next);
+    out.image.pixels = std::move(pixels);
+  }
+  out.stats.bake_seconds = seconds_since(start);
+  return out;
+}
+
+std::string lightmap_image_path(const std::string& model_output) {
+  const std::filesystem::path p(model_output);
+  return (p.parent_path() / (p.stem().string() + "_lightmap.exr")).string();
+}
+
+}  // namespace gilt::radiosity
