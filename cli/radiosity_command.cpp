@@ -151,6 +151,8 @@ void run_radiosity(RadiosityOptions& o) {
                         {"vertices_moved_onto_input_far", snap.moved_far},
                         {"vertices_left_off_input", snap.not_moved},
                         {"largest_move_onto_input", snap.largest},
+                        {"coincident_faces_merged", snap.coincident_merged},
+                        {"coincident_back_to_back_pairs", snap.back_to_back},
                         {"output", o.output}};
     if (onto)
       j["fit"] = {{"method", o.fit},

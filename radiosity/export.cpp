@@ -23,6 +23,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <unordered_map>
 #include <array>
 #include <atomic>
 #include <bit>
@@ -527,6 +528,56 @@ Quantity parse_quantity(const std::string& name) {
   throw InputError("unknown quantity '" + name + "' (expected radiance, irradiance or radiosity)");
 }
 
+RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats) {
+  // Each element's corners by bits, turned so the smallest comes first: equal keys are the same
+  // face with the same orientation; the key of the reversed order finds the opposite face.
+  using Key = std::array<uint32_t, 9>;
+  struct Hash {
+    size_t operator()(const Key& k) const {
+      size_t h = 0xcbf29ce484222325ull;
+      for (uint32_t x : k) h = (h ^ x) * 0x100000001b3ull;
+      return h;
+    }
+  };
+  const auto key = [&](const std::array<uint32_t, 3>& e, bool reversed) {
+    std::array<std::array<uint32_t, 3>, 3> corner;
+    for (int k = 0; k < 3; ++k) std::memcpy(corner[size_t(k)].data(), &mesh.positions[e[size_t(reversed ? 2 - k : k)]], 12);
+    const size_t first = size_t(std::min_element(corner.begin(), corner.end()) - corner.begin());
+    Key out;
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t c = 0; c < 3; ++c) out[3 * k + c] = corner[(first + k) % 3][c];
+    return out;
+  };
+  std::unordered_map<Key, uint32_t, Hash> seen;
+  seen.reserve(mesh.element_count());
+  std::vector<char> keep(mesh.element_count(), 1);
+  size_t merged = 0, back_to_back = 0;
+  for (uint32_t e = 0; e < mesh.element_count(); ++e) {
+    if (!seen.emplace(key(mesh.elements[e], false), e).second) {
+      keep[e] = 0;
+      ++merged;
+    } else if (seen.count(key(mesh.elements[e], true))) {
+      ++back_to_back;
+    }
+  }
+  if (stats) stats->coincident_merged = merged, stats->back_to_back = back_to_back;
+  if (merged == 0) return mesh;
+  RadiosityMesh out = mesh;
+  const auto compact = [&](auto& per_element) {
+    if (per_element.size() != mesh.element_count()) return;
+    size_t n = 0;
+    for (size_t e = 0; e < keep.size(); ++e)
+      if (keep[e]) per_element[n++] = per_element[e];
+    per_element.resize(n);
+  };
+  compact(out.elements);
+  compact(out.element_material);
+  compact(out.element_surface);
+  compact(out.element_normal);
+  compact(out.element_area);
+  return out;
+}
+
 void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,
                     const ExportSettings& settings, SnapStats* snap) {
   const fs::path destination(path);
@@ -538,7 +589,8 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
   require_folder(destination);
   // Vertices on the input's own surface: remeshing, contact imprints and repairs leave some a
   // little off it, and a viewer shows the model, not gilt's approximation of it.
-  const RadiosityMesh mesh = snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap);
+  const RadiosityMesh mesh =
+      without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap), snap);
   check_mesh(mesh, scene.materials.size());
   const std::vector<Rgb> colours = vertex_colours(solution, settings.quantity);
   const auto groups = elements_by_material(mesh, scene.materials.size());

@@ -38,6 +38,8 @@ struct SnapStats {
   size_t kept_to_avoid_folds = 0;  ///< of which moves taken back because an element would turn over
   size_t moved_far = 0;            ///< vertices moved by more than 10⁻³ of the scene's bounding-box diagonal
   double largest = 0.0;            ///< the longest move, scene units
+  size_t coincident_merged = 0;    ///< elements dropped by without_coincident
+  size_t back_to_back = 0;         ///< pairs of coincident elements facing opposite ways, both kept
 };
 
 /// The mesh with every vertex moved to the nearest point of the input meshes its elements were
@@ -48,11 +50,20 @@ struct SnapStats {
 RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach,
                                SnapStats* stats = nullptr);
 
+/// The mesh without elements that repeat an earlier element: the same three corner positions (to
+/// the bit, after snapping) in the same turning order, so the same face facing the same way, which
+/// every viewer would show z-fighting. The first is kept (its duplicates carry the same light, to
+/// the solution's noise). Pairs facing opposite ways are the two sides of a thin sheet and keep
+/// their own light: both stay, counted in `back_to_back` (viewers that cull back faces, as glTF
+/// asks for single-sided materials, show each from its side). Vertices are not renumbered.
+RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats = nullptr);
+
 /// Writes the mesh with per-vertex colours by extension: .ply (binary little-endian, float
 /// `red green blue` by default, uchar with srgb8), .obj (`v x y z r g b` with linear colours,
 /// materials in a .mtl beside it), .gltf / .glb (COLOR_0 as linear float RGB, materials as
 /// baseColorFactor / emissive). The vertices are snapped_to_input first (within half the
-/// solution's target edge); `snap` receives what that did. Throws InputError for an unsupported
+/// solution's target edge), then coincident elements dropped (without_coincident); `snap`
+/// receives what both did. Throws InputError for an unsupported
 /// extension or an unwritable destination.
 void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,
                     const ExportSettings& settings, SnapStats* snap = nullptr);

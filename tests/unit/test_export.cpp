@@ -662,6 +662,32 @@ TEST_F(ExportTest, MaterialsLoadBackIntoGiltAsTheSameKind) {
 namespace gilt::radiosity {
 namespace {
 
+TEST(ExportSnap, CoincidentElementsFacingTheSameWayAreMerged) {
+  // Four elements over five vertex slots: element 1 is element 0 again (other vertices at the
+  // same positions, listed from another corner: the same face, the same way up), element 2 is
+  // element 0 turned over (the other side of a sheet), element 3 another face.
+  RadiosityMesh mesh;
+  mesh.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 0),
+                    Vec3(1, 1, 0)};
+  mesh.normals.assign(mesh.positions.size(), Vec3(0, 0, 1));
+  mesh.vertex_material.assign(mesh.positions.size(), 0);
+  mesh.elements = {{0, 1, 2}, {3, 4, 5}, {0, 2, 1}, {1, 6, 2}};
+  mesh.element_material = {0, 0, 0, 0};
+  mesh.element_surface = {0, 1, 2, 3};
+  mesh.element_normal = {Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(0, 0, 1)};
+  mesh.element_area = {0.5f, 0.5f, 0.5f, 0.5f};
+  SnapStats stats;
+  const RadiosityMesh out = without_coincident(mesh, &stats);
+  EXPECT_EQ(stats.coincident_merged, 1u);
+  EXPECT_EQ(stats.back_to_back, 1u);
+  ASSERT_EQ(out.element_count(), 3u);
+  EXPECT_EQ(out.element_surface, (std::vector<uint32_t>{0, 2, 3}));  // the first of the pair stays
+  EXPECT_EQ(out.elements[1], (std::array<uint32_t, 3>{0, 2, 1}));
+  EXPECT_EQ(out.element_normal.size(), 3u);
+  EXPECT_EQ(out.element_area.size(), 3u);
+  EXPECT_EQ(out.positions.size(), mesh.positions.size());
+}
+
 TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
   // A sphere of 1,280 flat facets, remeshed into fewer, larger elements whose vertices lie on
   // it; bisecting elements (as adaptive subdivision does at shadow edges) puts new vertices at
