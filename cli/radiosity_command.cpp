@@ -313,7 +313,7 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
       ->check(CLI::IsMember({"least-squares", "point"}));
   cmd->add_flag("--srgb8", o->srgb8, "PLY: 8-bit sRGB colours instead of linear float");
   cmd->add_option("--exposure", o->exposure,
-                  "Scale by 2^exposure: with --srgb8, and for glTF COLOR_0 with --onto input")
+                  "Scale by 2^exposure: with --srgb8, for glTF COLOR_0, and OBJ/PLY colours with --onto input")
       ->check(CLI::Range(-64.0f, 64.0f))
       ->check(finite_number());
   cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));

@@ -350,8 +350,9 @@ tinygltf::Material gltf_material(const Material& m, const std::string& name, tin
 
 /// One mesh with one primitive per material; each primitive holds the vertices its elements use.
 std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const std::vector<Rgb>& colours,
-                        const std::vector<std::string>& names,
-                        const std::vector<std::vector<uint32_t>>& groups, bool binary) {
+                        const std::vector<std::string>& names, const std::vector<std::vector<uint32_t>>& groups,
+                        const ExportSettings& settings, bool binary) {
+  const float scale = std::exp2(settings.exposure);
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "gilt radiosity export";
@@ -367,10 +368,11 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
     std::sort(vertices.begin(), vertices.end());
     vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
 
-    std::vector<float> positions, normals, rgb;
+    std::vector<float> positions, normals, rgb, hdr;
     positions.reserve(3 * vertices.size());
     normals.reserve(3 * vertices.size());
     rgb.reserve(3 * vertices.size());
+    hdr.reserve(3 * vertices.size());
     Vec3 lo(rc::kInfinity), hi(-rc::kInfinity);
     for (const uint32_t v : vertices) {
       const Vec3& p = mesh.positions[v];
@@ -379,7 +381,8 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
       for (int i = 0; i < 3; ++i) {
         positions.push_back(p[i]);
         normals.push_back(mesh.normals[v][i]);
-        rgb.push_back(colours[v][i]);
+        rgb.push_back(std::clamp(colours[v][i] * scale, 0.0f, 1.0f));
+        hdr.push_back(colours[v][i]);
       }
     }
     std::vector<uint32_t> indices;
@@ -404,6 +407,9 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
                      TINYGLTF_TARGET_ARRAY_BUFFER);
     primitive.attributes["COLOR_0"] =
         add_accessor(model, buffer, rgb.data(), n, 12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                     TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.attributes[gltf_attribute(settings.quantity)] =
+        add_accessor(model, buffer, hdr.data(), n, 12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
                      TINYGLTF_TARGET_ARRAY_BUFFER);
     primitive.indices =
         add_accessor(model, buffer, indices.data(), indices.size(), 4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
@@ -509,6 +515,10 @@ uint8_t to_srgb8(float linear, float scale) {
   return static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255.0f));
 }
 
+const char* gltf_attribute(Quantity q) {
+  return q == Quantity::irradiance ? "_IRRADIANCE" : q == Quantity::radiosity ? "_RADIOSITY" : "_RADIANCE";
+}
+
 const char* to_string(Quantity quantity) {
   switch (quantity) {
     case Quantity::radiance:
@@ -596,7 +606,7 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
   const auto groups = elements_by_material(mesh, scene.materials.size());
   const auto names = material_names(scene.materials);
 
-  // settings.srgb8 and settings.exposure apply to PLY only: OBJ and glTF keep linear floats.
+  // settings.srgb8 applies to PLY only; settings.exposure to PLY with srgb8 and to glTF COLOR_0.
   switch (format) {
     case Format::ply:
       StagedFile(destination, encode_ply(mesh, colours, settings)).commit();
@@ -616,7 +626,7 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
     }
     case Format::gltf:
     case Format::glb:
-      StagedFile(destination, encode_gltf(scene, mesh, colours, names, groups, format == Format::glb))
+      StagedFile(destination, encode_gltf(scene, mesh, colours, names, groups, settings, format == Format::glb))
           .commit();
       break;
     case Format::unsupported:

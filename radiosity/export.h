@@ -29,6 +29,10 @@ uint8_t to_srgb8(float linear, float scale);
 /// "radiance", "irradiance" or "radiosity".
 const char* to_string(Quantity quantity);
 
+/// The glTF attribute that holds the quantity itself (HDR, float VEC3) beside the clamped COLOR_0:
+/// "_RADIANCE", "_IRRADIANCE" or "_RADIOSITY" (an application-specific name, as glTF asks).
+const char* gltf_attribute(Quantity quantity);
+
 /// Quantity from its name ("radiance", "irradiance", "radiosity"); throws InputError otherwise.
 Quantity parse_quantity(const std::string& name);
 
@@ -60,8 +64,9 @@ RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats = n
 
 /// Writes the mesh with per-vertex colours by extension: .ply (binary little-endian, float
 /// `red green blue` by default, uchar with srgb8), .obj (`v x y z r g b` with linear colours,
-/// materials in a .mtl beside it), .gltf / .glb (COLOR_0 as linear float RGB, materials as
-/// baseColorFactor / emissive). The vertices are snapped_to_input first (within half the
+/// materials in a .mtl beside it), .gltf / .glb (COLOR_0 as linear float RGB, the quantity ×
+/// 2^exposure clamped to [0, 1] as glTF requires, and the quantity itself in gltf_attribute;
+/// materials as baseColorFactor / emissive). The vertices are snapped_to_input first (within half the
 /// solution's target edge), then coincident elements dropped (without_coincident); `snap`
 /// receives what both did. Throws InputError for an unsupported
 /// extension or an unwritable destination.

@@ -222,10 +222,6 @@ void pack_into_binary_chunk(GltfFile& file, const fs::path& in_folder, const std
   buffers[0]["byteLength"] = file.bin.size();
 }
 
-const char* attribute_name(Quantity q) {
-  return q == Quantity::irradiance ? "_IRRADIANCE" : q == Quantity::radiosity ? "_RADIOSITY" : "_RADIANCE";
-}
-
 
 /// An output being made: the edited (or new) JSON, and the bytes of the new buffer.
 struct GltfOutput {
@@ -414,7 +410,7 @@ void write_onto_gltf(const std::string& input, const std::string& output, const 
       if (position.value("count", size_t(0)) != values.size())
         throw std::logic_error("write_onto_gltf: vertex count of a primitive changed while loading");
       attributes["COLOR_0"] = add_colours(values, true);
-      attributes[attribute_name(settings.quantity)] = add_colours(values, false);
+      attributes[gltf_attribute(settings.quantity)] = add_colours(values, false);
     }
   }
   if (o.data.empty())

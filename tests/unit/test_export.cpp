@@ -440,15 +440,19 @@ void ExportTest::check_gltf(const std::string& file, bool binary) {
     const auto positions = accessor_items<float>(model, primitive.attributes.at("POSITION"), 3);
     const auto normals = accessor_items<float>(model, primitive.attributes.at("NORMAL"), 3);
     const auto rgb = accessor_items<float>(model, primitive.attributes.at("COLOR_0"), 3);
+    const auto hdr = accessor_items<float>(model, primitive.attributes.at("_RADIANCE"), 3);
     const auto indices = accessor_items<uint32_t>(model, primitive.indices, 1);
     std::vector<size_t> original;
     for (size_t i = 0; i < positions.size() / 3; ++i) {
       const size_t v = vertex_at(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
       original.push_back(v);
       EXPECT_EQ(Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]), mesh.normals[v]);
-      EXPECT_EQ(rgb[3 * i], colours[v].r) << "vertex " << v;  // bit-exact
-      EXPECT_EQ(rgb[3 * i + 1], colours[v].g) << "vertex " << v;
-      EXPECT_EQ(rgb[3 * i + 2], colours[v].b) << "vertex " << v;
+      for (int c = 0; c < 3; ++c) {
+        // COLOR_0 is display-referred, clamped to [0, 1] as glTF requires; _RADIANCE holds the
+        // value itself, bit-exact.
+        EXPECT_EQ(rgb[3 * i + size_t(c)], std::clamp(colours[v][c], 0.0f, 1.0f)) << "vertex " << v;
+        EXPECT_EQ(hdr[3 * i + size_t(c)], colours[v][c]) << "vertex " << v;
+      }
     }
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
       triangles.push_back({original.at(indices[i]), original.at(indices[i + 1]), original.at(indices[i + 2]),
