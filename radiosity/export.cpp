@@ -211,15 +211,6 @@ std::string encode_ply(const RadiosityMesh& mesh, const std::vector<Rgb>& colour
 
 // --- OBJ + MTL ------------------------------------------------------------------------------
 
-/// Appends " x" with nine significant digits, which bring every float back exactly even through
-/// a parser that rounds slightly off; std::to_chars ignores the locale, unlike printf.
-void append_float(std::string& out, float x) {
-  char buffer[40];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x, std::chars_format::general, 9);
-  out += ' ';
-  out.append(buffer, result.ptr);
-}
-
 void append_line(std::string& out, const char* key, const Rgb& c) {
   out += key;
   for (int i = 0; i < 3; ++i) append_float(out, c[i]);
@@ -508,11 +499,22 @@ RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh
   return out;
 }
 
-uint8_t to_srgb8(float linear, float scale) {
+void append_float(std::string& out, float x) {
+  char buffer[40];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x, std::chars_format::general, 9);
+  out += ' ';
+  out.append(buffer, result.ptr);
+}
+
+float to_srgb(float linear, float scale) {
   // The sRGB transfer function (IEC 61966-2-1) of the clamped value.
   const float x = std::clamp(linear * scale, 0.0f, 1.0f);
   const float encoded = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255.0f));
+  return std::clamp(encoded, 0.0f, 1.0f);
+}
+
+uint8_t to_srgb8(float linear, float scale) {
+  return static_cast<uint8_t>(std::lround(to_srgb(linear, scale) * 255.0f));
 }
 
 const char* gltf_attribute(Quantity q) {

@@ -23,8 +23,15 @@ struct ExportSettings {
   float exposure = 0.0f;   ///< with srgb8
 };
 
-/// Linear value to an 8-bit sRGB code: scaled, clamped to [0, 1], encoded (IEC 61966-2-1), rounded.
+/// Linear value to a display value: scaled, clamped to [0, 1], sRGB-encoded (IEC 61966-2-1).
+float to_srgb(float linear, float scale);
+
+/// to_srgb as an 8-bit code, rounded.
 uint8_t to_srgb8(float linear, float scale);
+
+/// Appends " x" with nine significant digits, which bring every float back exactly even through
+/// a parser that rounds slightly off; std::to_chars ignores the locale, unlike printf.
+void append_float(std::string& out, float x);
 
 /// "radiance", "irradiance" or "radiosity".
 const char* to_string(Quantity quantity);

@@ -94,7 +94,9 @@ void write_onto_input(const std::string& path, const rc::Scene& scene, const Inp
                       const ExportSettings& settings);
 
 /// OBJ writer behind write_onto_input (radiosity/onto_obj.cpp): `v x y z r g b`, the quantity
-/// × 2^exposure clamped to [0, 1] as linear floats (OBJ has no place for the HDR values).
+/// × 2^exposure clamped to [0, 1] and sRGB-encoded (to_srgb): display values, which Blender's
+/// OBJ importer decodes to linear and MeshLab shows as they are (OBJ has no place for the HDR
+/// values).
 void write_onto_obj(const std::string& input, const std::string& output, const InputColours& colours,
                     const ExportSettings& settings);
 

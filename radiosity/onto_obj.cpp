@@ -22,13 +22,6 @@ using rc::InputError;
 
 namespace {
 
-void append_float(std::string& out, float x) {
-  char buffer[40];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x, std::chars_format::general, 9);
-  out += ' ';
-  out.append(buffer, result.ptr);
-}
-
 /// The first `n` whitespace-separated tokens of `s` with the spaces between them, as written.
 std::string_view first_tokens(std::string_view s, int n) {
   size_t at = 0;
@@ -52,7 +45,7 @@ void write_onto_obj(const std::string& input, const std::string& output, const I
   const float scale = std::exp2(settings.exposure);
   std::string out = "# vertex colours by gilt radiosity --onto input: ";
   out += to_string(settings.quantity);
-  out += " times 2^exposure, linear, clamped to 0..1; exposure";
+  out += " times 2^exposure, clamped to 0..1, sRGB-encoded (display values, as Blender and MeshLab read them); exposure";
   append_float(out, settings.exposure);
   out += '\n';
   size_t vertex = 0, line_number = 0;
@@ -68,7 +61,7 @@ void write_onto_obj(const std::string& input, const std::string& output, const I
       out.append(line, 0, first);
       out += first_tokens(body, 4);  // "v x y z": any w or colour after it is replaced
       const Rgb c = vertex < colours.per_file_vertex.size() ? colours.per_file_vertex[vertex] : Rgb(0.0f);
-      for (int k = 0; k < 3; ++k) append_float(out, std::clamp(c[k] * scale, 0.0f, 1.0f));
+      for (int k = 0; k < 3; ++k) append_float(out, to_srgb(c[k], scale));
       ++vertex;
     } else if (body.rfind("mtllib", 0) == 0 && body.size() > 6 && (body[6] == ' ' || body[6] == '\t')) {
       out.append(line, 0, first);

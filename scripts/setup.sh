@@ -2,7 +2,8 @@
 # gilt set-up on Debian 12: installs what is missing, builds, then runs one job.
 #   bash scripts/setup.sh demo   install, build, compare every method on the built-in cornell-caustics
 #                                scene: the report is out/compare/index.html (about 4 minutes)
-#   bash scripts/setup.sh test   install, build with warnings as errors, run the whole test suite,
+#   bash scripts/setup.sh test   install, build with warnings as errors, run the whole test suite
+#                                (the clients label opens exports in headless Blender),
 #                                then build the unit tests with AddressSanitizer + UBSan and run them
 #                                (what CI runs; SANITIZE=0 skips the sanitizer stage), then
 #                                fuzzes every scene loader for 10 s with clang's libFuzzer
@@ -23,8 +24,9 @@ packages=(
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev
   libgtest-dev libbenchmark-dev
 )
-# The report test looks at index.html in a real browser.
-[ "$job" = test ] && packages+=(chromium)
+# The report test looks at index.html in a real browser; the clients tests open gilt's exports in
+# headless Blender (scripts/blender_check.py, which needs Blender's numpy).
+[ "$job" = test ] && packages+=(chromium blender python3-numpy)
 # The glTF tests run the Khronos glTF-Validator, an npm package (scripts/gltf_validate.js).
 if [ "$job" = test ] && ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
 

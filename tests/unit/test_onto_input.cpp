@@ -374,7 +374,7 @@ TEST(OntoInput, AnObjComesBackLineForLine) {
   fs::create_directories(dir / "out");
   run(quoted(dir / "scene.json") + " --onto input --elements 400 -o " + quoted(dir / "out" / "baked.obj"), dir);
   const double red = expect_same_obj(obj, slurp(dir / "out" / "baked.obj"), "../model.mtl");
-  EXPECT_GT(red, 0.05);  // lit: L = ρ E / π with E ≈ 2.8 is about 0.45 on the grey floor
+  EXPECT_GT(red, 0.05);  // lit: L = ρ E / π with E ≈ 2.8 is about 0.45 on the grey floor (0.70 as sRGB)
   EXPECT_FALSE(fs::exists(dir / "out" / "baked.mtl"));
   fs::remove_all(dir);
 }
