@@ -164,6 +164,8 @@ void run_radiosity(RadiosityOptions& o) {
     if (atlas)
       j["lightmap"] = {{"size", atlas->size},
                        {"image", radiosity::lightmap_image_path(o.output)},
+                       {"uvs", atlas->stats.uv_source},
+                       {"uv_set", atlas->stats.uv_set},
                        {"charts", atlas->stats.charts},
                        {"faces", atlas->stats.faces},
                        {"buried_faces_left_out", atlas->stats.buried_faces},
@@ -230,12 +232,14 @@ void run_radiosity(RadiosityOptions& o) {
                 o.fit.c_str(), static_cast<unsigned long long>(onto->stats.samples),
                 static_cast<unsigned long long>(onto->stats.missing), onto->buried_faces, onto->seconds);
   if (atlas)
-    std::printf("  lightmap: %d x %d, %zu charts over %zu faces (%zu buried left out), %zu texels (%.3g %%) at %.4g "
-                "per unit; layout %.3g s, bake %.3g s\n             wrote %s\n",
-                atlas->size, atlas->size, atlas->stats.charts, atlas->stats.faces, atlas->stats.buried_faces,
-                atlas->stats.texels, 100.0 * double(atlas->stats.texels) / (double(atlas->size) * atlas->size),
-                atlas->stats.texels_per_metre, atlas->stats.layout_seconds, atlas->stats.bake_seconds,
-                radiosity::lightmap_image_path(o.output).c_str());
+    std::printf("  lightmap: %d x %d over %zu faces (%zu buried left out), %zu texels (%.3g %%); layout %.3g s, "
+                "bake %.3g s\n            UVs: %s",
+                atlas->size, atlas->size, atlas->stats.faces, atlas->stats.buried_faces, atlas->stats.texels,
+                100.0 * double(atlas->stats.texels) / (double(atlas->size) * atlas->size),
+                atlas->stats.layout_seconds, atlas->stats.bake_seconds, atlas->stats.uv_source.c_str());
+  if (atlas && atlas->stats.uv_set < 0)
+    std::printf(", %zu charts at %.4g texels per unit", atlas->stats.charts, atlas->stats.texels_per_metre);
+  if (atlas) std::printf("\n            wrote %s\n", radiosity::lightmap_image_path(o.output).c_str());
   if (surface_check)
     std::printf("  check:   irradiance at %zu random points inside the input's faces against the path tracer (%d "
                 "samples each; %zu points no light reaches left out): relMSE %.4g (of which the reference's own "

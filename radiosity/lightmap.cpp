@@ -9,10 +9,16 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
+#include <functional>
+#include <map>
+#include <set>
 #include <unordered_map>
+
+#include <tiny_gltf.h>
 
 #include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
+#include "raytrace_core/loaders.h"
 #include "raytrace_core/parallel.h"
 
 namespace gilt::radiosity {
@@ -286,6 +292,169 @@ Vec2 closest_barycentric(const Vec2* t, const Vec2& p) {
   return Vec2(vb * denom, vc * denom);
 }
 
+/// The input's own UV set chosen for the lightmap, or why none was.
+struct InputUvs {
+  int set = -1;  ///< glTF TEXCOORD_<set>; OBJ and PLY: 0, their one set
+  std::string why;
+  std::vector<std::vector<Vec2>> corner_uv;  ///< per scene mesh, three per face
+};
+
+/// Vertex UVs of a glTF primitive's TEXCOORD_<set> (float, or normalized unsigned byte or
+/// short); empty when it has none or they do not match the mesh's vertices.
+std::vector<Vec2> gltf_uvs(const tinygltf::Model& model, const rc::TriangleMesh& mesh, int set) {
+  const rc::MeshOrigin& o = mesh.origin;
+  if (o.mesh < 0 || size_t(o.mesh) >= model.meshes.size() ||
+      size_t(o.primitive) >= model.meshes[size_t(o.mesh)].primitives.size())
+    return {};
+  const auto& attributes = model.meshes[size_t(o.mesh)].primitives[size_t(o.primitive)].attributes;
+  const auto it = attributes.find("TEXCOORD_" + std::to_string(set));
+  if (it == attributes.end() || it->second < 0 || size_t(it->second) >= model.accessors.size()) return {};
+  const tinygltf::Accessor& a = model.accessors[size_t(it->second)];
+  if (a.type != TINYGLTF_TYPE_VEC2 || a.count != mesh.positions.size() || a.sparse.isSparse || a.bufferView < 0 ||
+      size_t(a.bufferView) >= model.bufferViews.size())
+    return {};
+  const tinygltf::BufferView& view = model.bufferViews[size_t(a.bufferView)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size()) return {};
+  const std::vector<unsigned char>& buffer = model.buffers[size_t(view.buffer)].data;
+  const int component = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+  if (component <= 0) return {};
+  const size_t stride = view.byteStride != 0 ? view.byteStride : size_t(2 * component);
+  std::vector<Vec2> uv(a.count);
+  for (size_t i = 0; i < a.count; ++i) {
+    const size_t at = view.byteOffset + a.byteOffset + i * stride;
+    if (at + size_t(2 * component) > buffer.size()) return {};
+    for (int k = 0; k < 2; ++k) {
+      const unsigned char* p = buffer.data() + at + size_t(k * component);
+      float x = 0.0f;
+      if (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+        std::memcpy(&x, p, 4);
+      } else if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && a.normalized) {
+        x = float(*p) / 255.0f;
+      } else if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && a.normalized) {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        x = float(v) / 65535.0f;
+      } else {
+        return {};
+      }
+      uv[i][k] = x;
+    }
+  }
+  return uv;
+}
+
+/// Whether one UV set of every baked mesh can hold the lightmap: inside [0, 1]², no face with
+/// area flattened to none, and no two faces on the same texels (texel centres inside two faces,
+/// at the atlas's size, beyond 0.1 % of those covered: touching charts share a few by rounding).
+/// Returns an empty string when it can, else why not.
+std::string check_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked,
+                         const std::vector<std::vector<Vec2>>& corner_uv, int size) {
+  std::vector<uint32_t> claimed(size_t(size) * size_t(size), 0);
+  size_t covered = 0, shared = 0;
+  for (uint32_t m : baked) {
+    const rc::TriangleMesh& mesh = scene.meshes[m];
+    for (size_t f = 0; f < mesh.triangle_count(); ++f) {
+      const Vec2* c = &corner_uv[m][3 * f];
+      Vec2 t[3];
+      for (int k = 0; k < 3; ++k) {
+        if (!(c[k].x >= 0.0f && c[k].x <= 1.0f && c[k].y >= 0.0f && c[k].y <= 1.0f))
+          return "UVs outside [0, 1] (a tiling texture's)";
+        t[k] = c[k] * float(size);
+      }
+      const Vec3 &p0 = mesh.positions[mesh.indices[3 * f]], &p1 = mesh.positions[mesh.indices[3 * f + 1]],
+                 &p2 = mesh.positions[mesh.indices[3 * f + 2]];
+      const double twice = double(t[1].x - t[0].x) * (t[2].y - t[0].y) - double(t[1].y - t[0].y) * (t[2].x - t[0].x);
+      if (twice == 0.0) {
+        if (glm::length(glm::cross(p1 - p0, p2 - p0)) > 0.0f) return "a face whose UVs have no area";
+        continue;
+      }
+      const Vec2 lo = glm::min(t[0], glm::min(t[1], t[2])), hi = glm::max(t[0], glm::max(t[1], t[2]));
+      for (int y = std::max(0, int(std::floor(lo.y))); y <= std::min(size - 1, int(std::floor(hi.y))); ++y)
+        for (int x = std::max(0, int(std::floor(lo.x))); x <= std::min(size - 1, int(std::floor(hi.x))); ++x) {
+          const Vec2 q(float(x) + 0.5f, float(y) + 0.5f);
+          const double b1 = (double(q.x - t[0].x) * (t[2].y - t[0].y) - double(q.y - t[0].y) * (t[2].x - t[0].x)) / twice;
+          const double b2 = (double(t[1].x - t[0].x) * (q.y - t[0].y) - double(t[1].y - t[0].y) * (q.x - t[0].x)) / twice;
+          if (!(b1 > 0.0 && b2 > 0.0 && b1 + b2 < 1.0)) continue;
+          uint32_t& owner = claimed[size_t(y) * size_t(size) + size_t(x)];
+          ++covered;
+          if (owner != 0) ++shared;
+          owner = 1;
+        }
+    }
+  }
+  if (covered == 0) return "no texel inside any face";
+  if (double(shared) > 1e-3 * double(covered)) return "faces overlap in UV space";
+  return {};
+}
+
+InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked, int size) {
+  InputUvs out;
+  const std::string& file = scene.model_files.at(size_t(scene.meshes[baked[0]].origin.file));
+  const std::string ext = rc::lower_extension(file);
+  std::vector<std::string> reasons;
+  const auto try_set = [&](int set, const std::function<std::vector<Vec2>(const rc::TriangleMesh&)>& vertex_uvs) {
+    std::vector<std::vector<Vec2>> corner(scene.meshes.size());
+    for (uint32_t m : baked) {
+      const rc::TriangleMesh& mesh = scene.meshes[m];
+      const std::vector<Vec2> uv = vertex_uvs(mesh);
+      if (uv.size() != mesh.positions.size()) {
+        reasons.push_back("set " + std::to_string(set) + ": not on every mesh");
+        return false;
+      }
+      for (uint32_t v : mesh.indices) corner[m].push_back(uv[v]);
+    }
+    const std::string why = check_uv_set(scene, baked, corner, size);
+    if (!why.empty()) {
+      reasons.push_back("set " + std::to_string(set) + ": " + why);
+      return false;
+    }
+    out.set = set;
+    out.corner_uv = std::move(corner);
+    return true;
+  };
+  if (ext == ".gltf" || ext == ".glb") {
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(
+        [](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+          return true;
+        },
+        nullptr);
+    std::string error, warning;
+    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, file)
+                                  : loader.LoadASCIIFromFile(&model, &error, &warning, file);
+    if (!ok) throw InputError(file + ": " + error);
+    // A mesh placed by several nodes shares its UVs between its instances, which are lit
+    // differently: the input's sets cannot hold them all.
+    std::map<int32_t, std::set<int32_t>> nodes_of_mesh;
+    for (uint32_t m : baked) nodes_of_mesh[scene.meshes[m].origin.mesh].insert(scene.meshes[m].origin.node);
+    bool instanced = false;
+    for (const auto& [mesh, nodes] : nodes_of_mesh) instanced = instanced || nodes.size() > 1;
+    if (instanced) {
+      reasons.push_back("a mesh is placed by several nodes, and each instance needs its own texels");
+    } else {
+      for (int set : {1, 0})
+        if (try_set(set, [&](const rc::TriangleMesh& mesh) { return gltf_uvs(model, mesh, set); })) break;
+    }
+  } else {  // OBJ and PLY: one set, v counted up from the bottom
+    try_set(0, [](const rc::TriangleMesh& mesh) {
+      std::vector<Vec2> uv;
+      for (const Vec2& t : mesh.uvs) uv.emplace_back(t.x, 1.0f - t.y);
+      return uv;
+    });
+  }
+  if (out.set >= 0) {
+    out.why = ext == ".gltf" || ext == ".glb" ? "the input's TEXCOORD_" + std::to_string(out.set)
+                                              : std::string("the input's UVs");
+  } else {
+    out.why = "laid out by gilt (the input's UVs cannot hold it:";
+    for (const std::string& r : reasons) out.why += " " + r + ";";
+    if (reasons.empty()) out.why += " it has none;";
+    out.why.back() = ')';
+  }
+  return out;
+}
+
 }  // namespace
 
 Rgb Lightmap::at(size_t mesh, size_t face, float u, float v) const {
@@ -311,49 +480,69 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
   out.file = onto_input_file(scene);
   out.corner_uv.resize(scene.meshes.size());
 
-  // Layout.
-  std::vector<Chart> charts;
+  // Layout: the input's own UV set where it can hold a lightmap, else charts of gilt's own.
+  std::vector<uint32_t> baked_meshes;
   std::vector<std::vector<char>> buried(scene.meshes.size());
-  double chart_area = 0.0;
   for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
     const rc::TriangleMesh& mesh = scene.meshes[m];
     if (mesh.origin.file != out.file || scene.materials[mesh.material].is_specular()) continue;
-    grow_charts(mesh, m, charts);
+    baked_meshes.push_back(m);
     out.stats.faces += mesh.triangle_count();
     buried[m] = input_faces_buried(scene, mesh.positions, mesh.indices);
     for (char b : buried[m]) out.stats.buried_faces += size_t(b);
   }
-  rc::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
-  std::stable_sort(charts.begin(), charts.end(), [](const Chart& a, const Chart& b) { return a.extent.y > b.extent.y; });
-  for (const Chart& c : charts) chart_area += double(c.extent.x) * double(c.extent.y);
-  out.stats.charts = charts.size();
-  if (charts.empty()) throw InputError("--lightmap: " + scene.name + " has no faces to bake (all are mirrors or glass)");
-  // The densest layout that packs: bisection between one that fits and one that does not.
-  double lo = 0.0, hi = double(size) / std::sqrt(std::max(chart_area, 1e-30));
-  if (!pack(charts, size, 0.0))
-    throw InputError("--lightmap " + std::to_string(size) + ": " + std::to_string(charts.size()) +
-                     " charts do not fit in the atlas even at one texel each: give a larger size");
-  for (int i = 0; i < 40 && hi > lo * (1.0 + 1e-4); ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (pack(charts, size, mid) ? lo : hi) = mid;
-  }
-  pack(charts, size, lo);
-  out.stats.texels_per_metre = lo;
-  for (const Chart& c : charts) {
-    std::vector<Vec2>& uv = out.corner_uv[c.mesh];
-    uv.resize(3 * scene.meshes[c.mesh].triangle_count(), Vec2(0.0f));
-    for (size_t i = 0; i < c.faces.size(); ++i)
-      for (int k = 0; k < 3; ++k) {
-        const Vec2 texel = Vec2(float(c.x + double(c.corner[3 * i + size_t(k)].x) * lo + 0.5),
-                                float(c.y + double(c.corner[3 * i + size_t(k)].y) * lo + 0.5));
-        uv[3 * size_t(c.faces[i]) + size_t(k)] = texel / float(size);
-      }
+  if (baked_meshes.empty())
+    throw InputError("--lightmap: " + scene.name + " has no faces to bake (all are mirrors or glass)");
+  // Groups of faces that own disjoint texels, rasterised in parallel: charts; or, with the
+  // input's UVs, whose charts gilt did not place, all faces in one group.
+  std::vector<std::pair<uint32_t, std::vector<uint32_t>>> groups;
+  const InputUvs input = input_uv_set(scene, baked_meshes, size);
+  out.stats.uv_set = input.set;
+  out.stats.uv_source = input.why;
+  if (input.set >= 0) {
+    for (uint32_t m : baked_meshes) {
+      out.corner_uv[m] = input.corner_uv[m];
+      std::vector<uint32_t> faces(scene.meshes[m].triangle_count());
+      for (uint32_t f = 0; f < faces.size(); ++f) faces[f] = f;
+      groups.emplace_back(m, std::move(faces));
+    }
+  } else {
+    std::vector<Chart> charts;
+    for (uint32_t m : baked_meshes) grow_charts(scene.meshes[m], m, charts);
+    rc::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
+    std::stable_sort(charts.begin(), charts.end(),
+                     [](const Chart& a, const Chart& b) { return a.extent.y > b.extent.y; });
+    double chart_area = 0.0;
+    for (const Chart& c : charts) chart_area += double(c.extent.x) * double(c.extent.y);
+    out.stats.charts = charts.size();
+    // The densest layout that packs: bisection between one that fits and one that does not.
+    double lo = 0.0, hi = double(size) / std::sqrt(std::max(chart_area, 1e-30));
+    if (!pack(charts, size, 0.0))
+      throw InputError("--lightmap " + std::to_string(size) + ": " + std::to_string(charts.size()) +
+                       " charts do not fit in the atlas even at one texel each: give a larger size");
+    for (int i = 0; i < 40 && hi > lo * (1.0 + 1e-4); ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (pack(charts, size, mid) ? lo : hi) = mid;
+    }
+    pack(charts, size, lo);
+    out.stats.texels_per_metre = lo;
+    for (const Chart& c : charts) {
+      std::vector<Vec2>& uv = out.corner_uv[c.mesh];
+      uv.resize(3 * scene.meshes[c.mesh].triangle_count(), Vec2(0.0f));
+      for (size_t i = 0; i < c.faces.size(); ++i)
+        for (int k = 0; k < 3; ++k) {
+          const Vec2 texel = Vec2(float(c.x + double(c.corner[3 * i + size_t(k)].x) * lo + 0.5),
+                                  float(c.y + double(c.corner[3 * i + size_t(k)].y) * lo + 0.5));
+          uv[3 * size_t(c.faces[i]) + size_t(k)] = texel / float(size);
+        }
+      groups.emplace_back(c.mesh, c.faces);
+    }
   }
   out.stats.layout_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
 
-  // Which face each texel shows: the nearest to its centre, within 1.5 texels. Charts own
-  // disjoint cells of the atlas, so they are rasterised in parallel.
+  // Which face each texel shows: the nearest to its centre, within 1.5 texels. gilt's charts own
+  // disjoint cells of the atlas, so they are rasterised in parallel; the input's UVs in one go.
   constexpr float kReach = 1.5f;
   const size_t texels = size_t(size) * size_t(size);
   struct Owner {
@@ -361,11 +550,11 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
     float distance = rc::kInfinity;
   };
   std::vector<Owner> owner(texels);
-  rc::parallel_for(charts.size(), [&](size_t ci) {
-    const Chart& c = charts[ci];
-    const std::vector<Vec2>& uv = out.corner_uv[c.mesh];
-    for (const uint32_t f : c.faces) {
-      if (buried[c.mesh][f]) continue;
+  const auto rasterise = [&](size_t gi) {
+    const uint32_t mesh_index = groups[gi].first;
+    const std::vector<Vec2>& uv = out.corner_uv[mesh_index];
+    for (const uint32_t f : groups[gi].second) {
+      if (buried[mesh_index][f]) continue;
       const Vec2 t[3] = {uv[3 * f] * float(size), uv[3 * f + 1] * float(size), uv[3 * f + 2] * float(size)};
       if (!(std::abs((t[1].x - t[0].x) * (t[2].y - t[0].y) - (t[1].y - t[0].y) * (t[2].x - t[0].x)) > 0.0f)) continue;
       const Vec2 lo_t = glm::min(t[0], glm::min(t[1], t[2])) - kReach, hi_t = glm::max(t[0], glm::max(t[1], t[2])) + kReach;
@@ -377,10 +566,15 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
           const Vec2 b = closest_barycentric(t, centre);
           const float d = glm::length(t[0] * (1.0f - b.x - b.y) + t[1] * b.x + t[2] * b.y - centre);
           Owner& o = owner[size_t(y) * size_t(size) + size_t(x)];
-          if (d <= kReach && d < o.distance) o = {c.mesh, f, d};
+          if (d <= kReach && d < o.distance) o = {mesh_index, f, d};
         }
     }
-  });
+  };
+  if (input.set >= 0) {
+    for (size_t g = 0; g < groups.size(); ++g) rasterise(g);
+  } else {
+    rc::parallel_for(groups.size(), rasterise);
+  }
 
   // Each owned texel: the mean of the solution at four points of its footprint, clamped onto
   // its face.

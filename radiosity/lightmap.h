@@ -2,6 +2,10 @@
 // Lightmaps (`gilt radiosity --lightmap SIZE`): the solution baked into one square texture atlas,
 // addressed by a UV set laid out for it over the input model's faces.
 //
+// UVs: the input's own TEXCOORD_1, else TEXCOORD_0 (OBJ and PLY: their one set), when every
+// baked mesh has it inside [0, 1]², without faces flattened to no area and without two faces on
+// the same texels, and no mesh is instanced; else a layout of gilt's own.
+//
 // Layout (after Blender's "Smart UV Project", which most lightmap workflows in Blender start
 // from): the faces of each mesh are grown into charts of neighbours (across edges of welded
 // positions) whose normals lie within kChartAngle of the chart's first, largest face, and each
@@ -20,6 +24,7 @@
 // The atlas is a half-float EXR beside the model; glTF outputs get the UV set as a new
 // TEXCOORD_n and name the file in each baked material's extras (see write_lightmap).
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -39,7 +44,9 @@ struct LightmapStats {
   size_t faces = 0;             ///< faces laid out
   size_t buried_faces = 0;      ///< laid out but not baked (input_faces_buried)
   size_t texels = 0;            ///< texels holding a face's value
-  double texels_per_metre = 0;  ///< the atlas's texel density (per unit of the scene's length)
+  double texels_per_metre = 0;  ///< the atlas's texel density (per unit of the scene's length); 0 with the input's UVs
+  int uv_set = -1;              ///< the input's UV set used (glTF TEXCOORD_n; OBJ/PLY 0), or −1: gilt's own
+  std::string uv_source;        ///< which UVs, and why the input's were not used
   double layout_seconds = 0, bake_seconds = 0;
 };
 
@@ -69,7 +76,8 @@ std::string lightmap_image_path(const std::string& model_output);
 void check_lightmap_output(const std::string& path, const rc::Scene& scene);
 
 /// Writes the atlas (lightmap_image_path, half float) and the model:
-/// - glTF in, glTF out: the input as write_onto_gltf keeps it, each baked primitive with its
+/// - glTF in, glTF out, in the input's own UV set: the input unchanged but for the extras;
+/// - glTF in, glTF out, in gilt's layout: the input as write_onto_gltf keeps it, each baked primitive with its
 ///   vertices split where the atlas's charts meet (each vertex attribute gathered over the new
 ///   vertices, positions bit for bit) and the UV set in a new TEXCOORD_n; each baked material
 ///   (one is added for primitives without one) gets extras.gilt_lightmap = {uri, texCoord,

@@ -319,6 +319,10 @@ void finish_output(GltfOutput& o, const std::string& output) {
   std::string& data = o.data;
   GltfFile& file = o.file;
   const std::vector<fs::path>& input_files = o.input_files;
+  if (data.empty() && !extend_bin && !glb_out) {  // nothing new to store (a lightmap in the input's UVs)
+    rc::StagedFile(out_path, j.dump(2) + "\n").commit();
+    return;
+  }
   size_t buffer_index = 0;
   std::string bin;
   if (extend_bin) {
@@ -540,6 +544,7 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
   const auto scene_meshes_of_node = split_instances(
       j, scene, lightmap.file, [&](size_t m) { return !lightmap.corner_uv[m].empty(); }, mesh_of_node);
   Json& meshes = array(j, "meshes");
+  bool baked_any = false;
   for (const auto& [node, list] : scene_meshes_of_node) {
     Json& primitives = meshes[size_t(mesh_of_node.at(node))]["primitives"];
     for (size_t m : list) {
@@ -547,6 +552,15 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
       Json& primitive = primitives[size_t(mesh.origin.primitive)];
       const std::string what = input + ": mesh " + std::to_string(mesh.origin.mesh) + " primitive " +
                                std::to_string(mesh.origin.primitive);
+      baked_any = true;
+      if (lightmap.stats.uv_set >= 0) {  // the input's own UV set: the primitive stays as it was
+        const Json extras = lightmap_extras(image_uri, lightmap.stats.uv_set, settings);
+        primitive["extras"]["gilt_lightmap"] = extras;
+        Json& material = material_for(j, primitive);
+        if (!material.contains("extras") || !material["extras"].is_object()) material["extras"] = Json::object();
+        if (!material["extras"].contains("gilt_lightmap")) material["extras"]["gilt_lightmap"] = extras;
+        continue;
+      }
       const UvSplit split = split_by_uv(mesh.indices, lightmap.corner_uv[m]);
       const auto regather = [&](Json& attributes, bool target) {
         for (auto& [name, index] : attributes.items()) {
@@ -582,7 +596,7 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
       if (!material["extras"].contains("gilt_lightmap")) material["extras"]["gilt_lightmap"] = extras;
     }
   }
-  if (o.data.empty())
+  if (!baked_any)
     throw InputError(input + ": no surface of the model holds a solution (mirrors and glass are not baked)");
   finish_output(o, output);
 }

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -343,6 +344,111 @@ TEST(Lightmap, SharedScenesKeepTheirNodesAndTriangles) {
     }
     EXPECT_GT(lightmapped, 0u) << c.model;
   }
+  fs::remove_all(dir);
+}
+
+/// A floor and, 1 above it, a panel (each placed once), with UV sets: `uv1` true gives both
+/// TEXCOORD_1 in separate parts of [0, 1]² (floor left half, panel top right corner); TEXCOORD_0
+/// maps each to the whole square (overlapping) unless `uv0_apart`, which puts them apart too.
+fs::path write_uv_model(const fs::path& dir, bool uv1, bool uv0_apart) {
+  std::string bin;
+  const auto put = [&bin](std::initializer_list<float> xs) {
+    for (float x : xs) bin.append(reinterpret_cast<const char*>(&x), 4);
+  };
+  put({-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2});                       // 0: floor positions, 48 bytes
+  put({-0.5f, 1, 0.5f, 0.5f, 1, 0.5f, 0.5f, 1, -0.5f, -0.5f, 1, -0.5f});  // 48: panel positions
+  for (uint16_t i : {0, 1, 2, 0, 2, 3}) bin.append(reinterpret_cast<const char*>(&i), 2);  // 96: indices
+  bin.append(4, '\0');                                                  // 108: pad to 112
+  if (uv0_apart) {
+    put({0, 1, 0.5f, 1, 0.5f, 0.5f, 0, 0.5f});                          // 112: floor TEXCOORD_0
+    put({0.6f, 0.4f, 1, 0.4f, 1, 0, 0.6f, 0});                          // 144: panel TEXCOORD_0
+  } else {
+    put({0, 1, 1, 1, 1, 0, 0, 0});
+    put({0, 1, 1, 1, 1, 0, 0, 0});
+  }
+  put({0, 1, 0.5f, 1, 0.5f, 0, 0, 0});                                  // 176: floor TEXCOORD_1
+  put({0.6f, 0.4f, 1, 0.4f, 1, 0, 0.6f, 0});                            // 208: panel TEXCOORD_1
+  write_file(dir / "uv.bin", bin);
+  Json model = Json::parse(R"({
+    "asset": {"version": "2.0"},
+    "scene": 0,
+    "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"name": "floor", "mesh": 0}, {"name": "panel", "mesh": 1}],
+    "meshes": [
+      {"name": "floor", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 3}, "indices": 2, "material": 0}]},
+      {"name": "panel", "primitives": [{"attributes": {"POSITION": 1, "TEXCOORD_0": 4}, "indices": 2, "material": 0}]}],
+    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}}],
+    "accessors": [
+      {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
+      {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, 1, -0.5], "max": [0.5, 1, 0.5]},
+      {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"},
+      {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC2"},
+      {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC2"},
+      {"bufferView": 5, "componentType": 5126, "count": 4, "type": "VEC2"},
+      {"bufferView": 6, "componentType": 5126, "count": 4, "type": "VEC2"}],
+    "bufferViews": [
+      {"buffer": 0, "byteOffset": 0, "byteLength": 48, "target": 34962},
+      {"buffer": 0, "byteOffset": 48, "byteLength": 48, "target": 34962},
+      {"buffer": 0, "byteOffset": 96, "byteLength": 12, "target": 34963},
+      {"buffer": 0, "byteOffset": 112, "byteLength": 32, "target": 34962},
+      {"buffer": 0, "byteOffset": 144, "byteLength": 32, "target": 34962},
+      {"buffer": 0, "byteOffset": 176, "byteLength": 32, "target": 34962},
+      {"buffer": 0, "byteOffset": 208, "byteLength": 32, "target": 34962}],
+    "buffers": [{"uri": "uv.bin"}]})");
+  model["buffers"][0]["byteLength"] = bin.size();
+  if (uv1) {
+    model["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = 5;
+    model["meshes"][1]["primitives"][0]["attributes"]["TEXCOORD_1"] = 6;
+  }
+  write_file(dir / "uv.gltf", model.dump(2));
+  write_file(dir / "uv-scene.json", R"({
+    "meshes": [{"file": "uv.gltf"}],
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2},
+               {"type": "environment", "radiance": 0.3}]})");
+  return dir / "uv-scene.json";
+}
+
+TEST(Lightmap, TheInputsOwnUvSetIsUsedWhenItCanHoldTheLightmap) {
+  const fs::path dir = fresh_dir("input-uvs");
+  struct Case {
+    bool uv1, uv0_apart;
+    int expected_set;
+  };
+  // TEXCOORD_1 first; else TEXCOORD_0 when its charts lie apart; else gilt's own (overlapping
+  // TEXCOORD_0, as a tiling or mirrored texture's).
+  for (const Case c : {Case{true, false, 1}, Case{false, true, 0}, Case{false, false, -1}}) {
+    const Solved s = solve(write_uv_model(dir, c.uv1, c.uv0_apart), 400);
+    const rad::Lightmap lm = rad::bake_lightmap(s.scene, s.solution, rad::Quantity::irradiance, 128);
+    EXPECT_EQ(lm.stats.uv_set, c.expected_set) << lm.stats.uv_source;
+    if (c.expected_set < 0) {
+      EXPECT_NE(lm.stats.uv_source.find("overlap"), std::string::npos) << lm.stats.uv_source;
+      continue;
+    }
+    // The floor's corners in the set used, by vertex.
+    size_t floor = 0;
+    while (s.scene.meshes[floor].origin.mesh != 0) ++floor;
+    const rc::TriangleMesh& mesh = s.scene.meshes[floor];
+    const float low = c.expected_set == 1 ? 0.0f : 0.5f;
+    const Vec2 corner[4] = {Vec2(0, 1), Vec2(0.5f, 1), Vec2(0.5f, low), Vec2(0, low)};
+    for (size_t k = 0; k < mesh.indices.size(); ++k) EXPECT_EQ(lm.corner_uv[floor][k], corner[mesh.indices[k]]);
+    // The open floor (beside the panel's shadow) holds E = 2 + 0.3π.
+    const double open = 2.0 + 0.3 * M_PI;
+    EXPECT_NEAR(lm.at(floor, 0, 0.1f, 0.05f).g, open, 0.06 * open);
+  }
+  // Written out: the input's JSON kept but for the extras, which name TEXCOORD_1; no new buffer.
+  const fs::path scene = write_uv_model(dir, true, false);
+  const CliResult r =
+      run_command(kGilt + " radiosity " + quoted(scene) + " --lightmap 128 --elements 400 -q -o " + quoted(dir / "out.gltf"), dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  Json in = Json::parse(slurp(dir / "uv.gltf")), out = Json::parse(slurp(dir / "out.gltf"));
+  for (Json& p : {std::ref(out["meshes"][0]["primitives"][0]), std::ref(out["meshes"][1]["primitives"][0])}) {
+    EXPECT_EQ(p["extras"]["gilt_lightmap"]["texCoord"], 1);
+    p.erase("extras");
+  }
+  EXPECT_EQ(out["materials"][0]["extras"]["gilt_lightmap"]["uri"], "out_lightmap.exr");
+  out["materials"][0].erase("extras");
+  EXPECT_EQ(out, in);
+  EXPECT_FALSE(fs::exists(dir / "out.bin"));
   fs::remove_all(dir);
 }
 
