@@ -452,6 +452,49 @@ TEST(Lightmap, TheInputsOwnUvSetIsUsedWhenItCanHoldTheLightmap) {
   fs::remove_all(dir);
 }
 
+TEST(Lightmap, CompressedQuantizedAndSparseModelsAreNamedNotMisread) {
+  // gilt reads neither Draco nor meshopt compression nor quantized positions, and no sparse
+  // accessors: each must be refused with its name, and the input left as it was.
+  const fs::path dir = fresh_dir("unsupported");
+  const fs::path scene = write_uv_model(dir, true, false);
+  const Json model = Json::parse(slurp(dir / "uv.gltf"));
+  struct Case {
+    std::string name, message;
+    std::function<void(Json&)> edit;
+  };
+  const Case cases[] = {
+      {"draco", "KHR_draco_mesh_compression",
+       [](Json& j) { j["extensionsUsed"] = j["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }},
+      {"meshopt", "EXT_meshopt_compression",
+       [](Json& j) { j["extensionsUsed"] = j["extensionsRequired"] = {"EXT_meshopt_compression"}; }},
+      {"quantized", "KHR_mesh_quantization",
+       [](Json& j) { j["extensionsUsed"] = j["extensionsRequired"] = {"KHR_mesh_quantization"}; }},
+      {"sparse", "sparse",
+       [](Json& j) {
+         j["accessors"][0]["sparse"] = {{"count", 1},
+                                        {"indices", {{"bufferView", 2}, {"componentType", 5123}}},
+                                        {"values", {{"bufferView", 0}}}};
+       }},
+  };
+  for (const Case& c : cases) {
+    Json edited = model;
+    c.edit(edited);
+    write_file(dir / "uv.gltf", edited.dump(2));
+    const std::string before = slurp(dir / "uv.gltf");
+    for (const char* mode : {"--lightmap 64", "--onto input"}) {
+      const CliResult r = run_command(kGilt + " radiosity " + quoted(scene) + " " + mode + " -q -o " +
+                                          quoted(dir / (c.name + ".glb")),
+                                      dir);
+      EXPECT_NE(r.code, 0) << c.name << " " << mode;
+      EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << " " << mode << ": " << r.err;
+      EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+      EXPECT_FALSE(fs::exists(dir / (c.name + ".glb")));
+    }
+    EXPECT_EQ(slurp(dir / "uv.gltf"), before);
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Lightmap, AnObjComesOutAsGltfWithItsUvsAndTheLightmaps) {
   const fs::path dir = fresh_dir("obj");
   write_file(dir / "room.mtl", "newmtl white\nKd 0.7 0.7 0.7\nnewmtl red\nKd 0.6 0.1 0.1\n");
