@@ -29,7 +29,7 @@ struct RadiosityOptions {
   int check_points = 0;  ///< 0: no check
   int lightmap = 0;      ///< 0: no lightmap
   bool onto_given = false, fit_given = false;
-  bool srgb8 = false, json = false, quiet = false;
+  bool srgb8 = false, linear_float = false, json = false, quiet = false;
   float exposure = 0.0f;
 };
 
@@ -54,8 +54,13 @@ void run_radiosity(RadiosityOptions& o) {
   if (lightmap && o.fit_given) throw rc::InputError("--fit applies to vertex colours, not to --lightmap's texels");
   if (lightmap) o.onto = "input";
   const bool onto_input = o.onto == "input";
+  ex.linear_float = o.linear_float;
   if (o.srgb8 && (onto_input || std::filesystem::path(o.output).extension() != ".ply"))
     throw rc::InputError("--srgb8 applies to .ply output of --onto elements only");
+  const std::string ext = std::filesystem::path(o.output).extension().string();
+  if (o.linear_float && (onto_input || (ext != ".ply" && ext != ".obj")))
+    throw rc::InputError("--linear-float applies to .ply and .obj output of --onto elements only");
+  if (o.linear_float && o.srgb8) throw rc::InputError("--linear-float and --srgb8 ask for opposite colours");
   if (o.fit != "least-squares" && !onto_input) throw rc::InputError("--fit applies to --onto input only");
   const auto start = std::chrono::steady_clock::now();
   const rc::Scene scene = rc::load_scene(o.scene);
@@ -315,9 +320,13 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
                   "With --onto input: least-squares (default) fits the colours to the solution over each face; "
                   "point takes the solution at each vertex")
       ->check(CLI::IsMember({"least-squares", "point"}));
-  cmd->add_flag("--srgb8", o->srgb8, "PLY: 8-bit sRGB colours instead of linear float");
+  cmd->add_flag("--srgb8", o->srgb8,
+                "PLY: only the 8-bit sRGB colours, without the float <quantity>_red/_green/_blue beside them");
+  cmd->add_flag("--linear-float", o->linear_float,
+                "PLY and OBJ: the quantity itself as linear float colours, unclamped, instead of display colours "
+                "(what gilt wrote before; viewers show them wrongly)");
   cmd->add_option("--exposure", o->exposure,
-                  "Scale by 2^exposure: with --srgb8, for glTF COLOR_0, and OBJ/PLY colours with --onto input")
+                  "Display colours (PLY 8-bit, OBJ, glTF COLOR_0) show the quantity times 2^exposure")
       ->check(CLI::Range(-64.0f, 64.0f))
       ->check(finite_number());
   cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));

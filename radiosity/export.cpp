@@ -176,31 +176,43 @@ void append_raw(std::string& out, const T& value) {
   out.append(bytes, sizeof(T));
 }
 
-/// Binary little-endian PLY: per vertex x y z, nx ny nz and the colour (float linear, or 8-bit
-/// sRGB after exposure with `settings.srgb8`), per element a three-index list. PLY is a face
-/// list, so it is written directly: a half-edge writer such as OpenMesh's must refuse or
-/// duplicate the vertices of non-manifold elements, and Debian's OpenMesh 9.0 aborts on an
-/// assertion for some of them (Khronos' 24_animation_pointer.gltf round-trip test scene).
+/// Binary little-endian PLY: per vertex x y z, nx ny nz and the colours (write_solution says
+/// which), per element a three-index list. PLY is a face list, so it is written directly: a
+/// half-edge writer such as OpenMesh's must refuse or duplicate the vertices of non-manifold
+/// elements, and Debian's OpenMesh 9.0 aborts on an assertion for some of them (Khronos'
+/// 24_animation_pointer.gltf round-trip test scene).
 std::string encode_ply(const RadiosityMesh& mesh, const std::vector<Rgb>& colours, const ExportSettings& settings) {
-  const char* colour_type = settings.srgb8 ? "uchar" : "float";
-  std::string out = "ply\nformat binary_little_endian 1.0\ncomment gilt radiosity export\n";
-  out += "element vertex " + std::to_string(mesh.vertex_count()) + "\n";
+  const bool bytes = !settings.linear_float, floats = settings.linear_float || !settings.srgb8;
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment gilt radiosity export: ";
+  out += bytes ? "red green blue are the " : "red green blue are the linear ";
+  out += to_string(settings.quantity);
+  out += bytes ? " times 2^exposure as 8-bit sRGB" : "";
+  if (bytes && floats) {
+    out += ", ";
+    out += to_string(settings.quantity);
+    out += "_* the value itself";
+  }
+  out += "\nelement vertex " + std::to_string(mesh.vertex_count()) + "\n";
   for (const char* name : {"x", "y", "z", "nx", "ny", "nz"}) out += std::string("property float ") + name + "\n";
-  for (const char* name : {"red", "green", "blue"}) out += std::string("property ") + colour_type + " " + name + "\n";
+  for (const char* name : {"red", "green", "blue"}) out += std::string("property ") + (bytes ? "uchar " : "float ") + name + "\n";
+  if (bytes && floats)
+    for (const char* name : {"_red", "_green", "_blue"}) {
+      out += "property float ";
+      out += to_string(settings.quantity);
+      out += name;
+      out += '\n';
+    }
   out += "element face " + std::to_string(mesh.element_count()) + "\n";
   out += "property list uchar int vertex_indices\nend_header\n";
-  const size_t colour_bytes = settings.srgb8 ? 3 : 12;
-  out.reserve(out.size() + mesh.vertex_count() * (24 + colour_bytes) + mesh.element_count() * 13);
+  out.reserve(out.size() + mesh.vertex_count() * (24 + 3 + 12) + mesh.element_count() * 13);
   const float scale = std::exp2(settings.exposure);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     for (int k = 0; k < 3; ++k) append_raw(out, mesh.positions[v][k]);
     for (int k = 0; k < 3; ++k) append_raw(out, mesh.normals[v][k]);
-    for (int k = 0; k < 3; ++k) {
-      if (settings.srgb8)
-        append_raw(out, to_srgb8(colours[v][k], scale));
-      else
-        append_raw(out, colours[v][k]);
-    }
+    if (bytes)
+      for (int k = 0; k < 3; ++k) append_raw(out, to_srgb8(colours[v][k], scale));
+    if (floats)
+      for (int k = 0; k < 3; ++k) append_raw(out, colours[v][k]);
   }
   for (const auto& element : mesh.elements) {
     append_raw(out, uint8_t{3});
@@ -255,20 +267,26 @@ std::string encode_mtl(const std::vector<Material>& materials, const std::vector
   return out;
 }
 
-std::string encode_obj(const RadiosityMesh& mesh, const std::vector<Rgb>& colours, Quantity quantity,
+std::string encode_obj(const RadiosityMesh& mesh, const std::vector<Rgb>& colours, const ExportSettings& settings,
                        const std::string& mtl_name, const std::vector<std::string>& names,
                        const std::vector<std::vector<uint32_t>>& groups) {
   std::string out;
   out.reserve(96 * mesh.vertex_count() + 40 * mesh.element_count());
-  out += "# gilt radiosity export: vertex colours are linear ";
-  out += to_string(quantity);
+  out += settings.linear_float ? "# gilt radiosity export: vertex colours are linear "
+                               : "# gilt radiosity export: vertex colours are display values, the ";
+  out += to_string(settings.quantity);
   out += " in ";
-  out += quantity_units(quantity);
+  out += quantity_units(settings.quantity);
+  if (!settings.linear_float) {
+    out += " times 2^exposure, clamped to 0..1 and sRGB-encoded; exposure";
+    append_float(out, settings.exposure);
+  }
   out += "\nmtllib " + mtl_name + "\n";
+  const float scale = std::exp2(settings.exposure);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     out += 'v';
     for (int i = 0; i < 3; ++i) append_float(out, mesh.positions[v][i]);
-    for (int i = 0; i < 3; ++i) append_float(out, colours[v][i]);
+    for (int i = 0; i < 3; ++i) append_float(out, settings.linear_float ? colours[v][i] : to_srgb(colours[v][i], scale));
     out += '\n';
   }
   for (const Vec3& n : mesh.normals) {
@@ -608,7 +626,7 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
   const auto groups = elements_by_material(mesh, scene.materials.size());
   const auto names = material_names(scene.materials);
 
-  // settings.srgb8 applies to PLY only; settings.exposure to PLY with srgb8 and to glTF COLOR_0.
+  // Display colours in every format (PLY bytes, OBJ, glTF COLOR_0) show the quantity × 2^exposure.
   switch (format) {
     case Format::ply:
       StagedFile(destination, encode_ply(mesh, colours, settings)).commit();
@@ -620,7 +638,7 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
       fs::path mtl_path = destination;
       mtl_path.replace_extension(".mtl");
       StagedFile mtl(mtl_path, encode_mtl(scene.materials, names, groups));
-      StagedFile obj(destination, encode_obj(mesh, colours, settings.quantity, mtl_path.filename().string(),
+      StagedFile obj(destination, encode_obj(mesh, colours, settings, mtl_path.filename().string(),
                                              names, groups));
       mtl.commit();
       obj.commit();

@@ -19,8 +19,13 @@ enum class Quantity : uint8_t {
 /// Export options.
 struct ExportSettings {
   Quantity quantity = Quantity::radiance;
-  bool srgb8 = false;      ///< PLY only: 8-bit sRGB colours (after 2^exposure) instead of float
-  float exposure = 0.0f;   ///< with srgb8
+  /// PLY: only the 8-bit sRGB colours, without the float quantity beside them.
+  bool srgb8 = false;
+  /// PLY and OBJ: the quantity itself as linear float colours, unclamped (gilt's convention
+  /// before display colours became the default; no viewer shows these as meant).
+  bool linear_float = false;
+  /// Display colours (PLY and OBJ by default, glTF COLOR_0) show the quantity × 2^exposure.
+  float exposure = 0.0f;
 };
 
 /// Linear value to a display value: scaled, clamped to [0, 1], sRGB-encoded (IEC 61966-2-1).
@@ -69,8 +74,11 @@ RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh
 /// asks for single-sided materials, show each from its side). Vertices are not renumbered.
 RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats = nullptr);
 
-/// Writes the mesh with per-vertex colours by extension: .ply (binary little-endian, float
-/// `red green blue` by default, uchar with srgb8), .obj (`v x y z r g b` with linear colours,
+/// Writes the mesh with per-vertex colours by extension (docs/exports.md): .ply (binary
+/// little-endian; uchar `red green blue`, the quantity × 2^exposure as 8-bit sRGB, and float
+/// `<quantity>_red _green _blue`, the quantity itself; uchar only with srgb8; float `red green
+/// blue` = the quantity with linear_float), .obj (`v x y z r g b` with display colours, the
+/// quantity × 2^exposure clamped and sRGB-encoded, or the quantity itself with linear_float;
 /// materials in a .mtl beside it), .gltf / .glb (COLOR_0 as linear float RGB, the quantity ×
 /// 2^exposure clamped to [0, 1] as glTF requires, and the quantity itself in gltf_attribute;
 /// materials as baseColorFactor / emissive). The vertices are snapped_to_input first (within half the

@@ -132,17 +132,18 @@ fs::path write_room(const fs::path& dir) {
 TEST(Blender, ShowsTheColoursOfElementExports) {
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh test installs it)";
   const fs::path dir = fresh_dir("gilt-clients", "elements");
-  const fs::path glb = dir / "cornell.glb", ply = dir / "cornell.ply";
-  for (const fs::path& out : {glb, ply}) {
-    const std::string extra = out.extension() == ".ply" ? " --srgb8" : "";
-    const CliResult r = run_command(kGilt + " radiosity cornell --elements 800 -q" + extra + " -o " + quoted(out), dir);
+  const fs::path glb = dir / "cornell.glb", ply = dir / "cornell.ply", obj = dir / "cornell.obj";
+  for (const fs::path& out : {glb, ply, obj}) {
+    const CliResult r = run_command(kGilt + " radiosity cornell --elements 800 -q -o " + quoted(out), dir);
     ASSERT_EQ(r.code, 0) << r.err;
   }
-  // The same solve (deterministic) in both: COLOR_0 is the radiance clamped to [0, 1]; the PLY's
-  // 8-bit sRGB bytes are the same values quantised.
+  // The same solve (deterministic) in all three, with gilt's default display colours: COLOR_0 is
+  // the radiance clamped to [0, 1]; the PLY's 8-bit sRGB bytes and the OBJ's sRGB-encoded floats
+  // are the same values encoded, which Blender decodes back to linear.
   const double expected = gltf_colour_mean(glb);
   ASSERT_GT(expected, 0.0);
-  for (const fs::path& out : {glb, ply}) {
+  EXPECT_NEAR(obj_colour_mean(obj), expected, 1e-4 * expected + 1e-6);
+  for (const fs::path& out : {glb, ply, obj}) {
     const BlenderReport b = open_in_blender(out, pictures() / ("cornell-elements" + out.extension().string() + ".png"),
                                             1.0, dir);
     ASSERT_FALSE(b.colours.empty()) << out;

@@ -258,7 +258,9 @@ TEST(ParseQuantity, KnowsTheThreeNames) {
 }
 
 TEST_F(ExportTest, PlyFloatColoursRoundTripExactly) {
-  write_solution(path("out.ply"), scene_, solution_, {});
+  ExportSettings linear;
+  linear.linear_float = true;
+  write_solution(path("out.ply"), scene_, solution_, linear);
   const PlyData ply = read_ply(path("out.ply"));
   EXPECT_EQ(ply.vertex_names,
             (std::vector<std::string>{"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue"}));
@@ -329,17 +331,26 @@ TEST_F(ExportTest, PlySrgb8IsWithinHalfAStep) {
 }
 
 TEST_F(ExportTest, QuantityChoosesTheColour) {
+  // By default the PLY holds display colours (8-bit sRGB after exposure) and the quantity itself
+  // in <quantity>_red/_green/_blue, bit-exact.
   for (const Quantity quantity : {Quantity::radiance, Quantity::irradiance, Quantity::radiosity}) {
     ExportSettings settings;
     settings.quantity = quantity;
-    settings.exposure = 3.0f;  // ignored without srgb8
+    settings.exposure = 3.0f;
     write_solution(path("out.ply"), scene_, solution_, settings);
     const PlyData ply = read_ply(path("out.ply"));
+    const std::string name = to_string(quantity);
+    EXPECT_EQ(ply.vertex_names, (std::vector<std::string>{"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue",
+                                                          name + "_red", name + "_green", name + "_blue"}));
+    EXPECT_EQ(std::vector<std::string>(ply.vertex_types.begin() + 6, ply.vertex_types.begin() + 9),
+              std::vector<std::string>(3, "uchar"));
     const auto colours = expected(quantity);
     for (size_t v = 0; v < colours.size(); ++v) {
-      EXPECT_EQ(ply.value(v, "red"), colours[v].r);
-      EXPECT_EQ(ply.value(v, "green"), colours[v].g);
-      EXPECT_EQ(ply.value(v, "blue"), colours[v].b);
+      EXPECT_EQ(ply.value(v, name + "_red"), colours[v].r);
+      EXPECT_EQ(ply.value(v, name + "_green"), colours[v].g);
+      EXPECT_EQ(ply.value(v, name + "_blue"), colours[v].b);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(ply.value(v, ply.vertex_names[6 + size_t(c)]), to_srgb8(colours[v][c], 8.0f)) << v;
     }
   }
 }
@@ -347,6 +358,7 @@ TEST_F(ExportTest, QuantityChoosesTheColour) {
 TEST_F(ExportTest, ObjRoundTripsThroughTinyobjloader) {
   ExportSettings settings;
   settings.quantity = Quantity::radiosity;
+  settings.linear_float = true;  // the values themselves, bit-exact; display colours below
   write_solution(path("out.obj"), scene_, solution_, settings);
   EXPECT_EQ(files(), (std::vector<std::string>{"out.mtl", "out.obj"}));
 
@@ -488,6 +500,26 @@ void ExportTest::check_gltf(const std::string& file, bool binary) {
       model.extensionsUsed.end());
 }
 
+TEST_F(ExportTest, ObjColoursAreDisplayValuesByDefault) {
+  // Blender's and MeshLab's OBJ importers read `v x y z r g b` as display colours: the default is
+  // the quantity × 2^exposure, clamped and sRGB-encoded (to_srgb), to nine digits.
+  ExportSettings settings;
+  settings.exposure = -1.0f;
+  write_solution(path("out.obj"), scene_, solution_, settings);
+  tinyobj::ObjReader reader;
+  ASSERT_TRUE(reader.ParseFromFile(path("out.obj"), tinyobj::ObjReaderConfig())) << reader.Error();
+  const auto colours = expected(Quantity::radiance);
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  ASSERT_EQ(attrib.colors.size(), 3 * colours.size());
+  for (size_t v = 0; v < colours.size(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      const float display = attrib.colors[3 * v + size_t(c)];
+      EXPECT_GE(display, 0.0f);
+      EXPECT_LE(display, 1.0f);
+      EXPECT_NEAR(display, to_srgb(colours[v][c], 0.5f), 1e-6f) << "vertex " << v << " channel " << c;
+    }
+}
+
 TEST_F(ExportTest, GltfRoundTripsThroughTinygltf) { check_gltf("out.gltf", false); }
 
 TEST_F(ExportTest, GlbRoundTripsThroughTinygltf) { check_gltf("out.glb", true); }
@@ -602,8 +634,8 @@ TEST_F(ExportTest, PlyWritesNonManifoldElementsAsTheyAre) {
                                                int(mesh.elements[el][2])}));
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     EXPECT_EQ(ply.value(v, "x"), mesh.positions[v].x);
-    EXPECT_EQ(ply.value(v, "red"), colours[v].r);
-    EXPECT_EQ(ply.value(v, "blue"), colours[v].b);
+    EXPECT_EQ(ply.value(v, "radiance_red"), colours[v].r);
+    EXPECT_EQ(ply.value(v, "radiance_blue"), colours[v].b);
   }
 }
 

@@ -396,13 +396,17 @@ TEST(OntoInput, ASunShadowSmallerThanAFaceIsFittedByItsArea) {
     "meshes": [{"file": "model.obj"}],
     "lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2}]})");
   const auto floor_integral = [&](const std::string& fit) {
-    // --exposure -2 keeps E (about 1.9) inside the OBJ's clamped 0..1 colours.
+    // --exposure -2 keeps E (about 1.9) inside the OBJ's clamped 0..1 colours, which are
+    // sRGB-encoded (display values, as Blender reads them): decoded here.
     run(quoted(dir / "scene.json") + " --onto input --fit " + fit +
             " --elements 2000 --quantity irradiance --exposure -2 -o " + quoted(dir / ("baked-" + fit + ".obj")),
         dir);
     std::vector<double> e;
     for (const std::string& line : lines_of(slurp(dir / ("baked-" + fit + ".obj"))))
-      if (line.rfind("v ", 0) == 0) e.push_back(4.0 * std::stod(rc::tokens_of(line).at(4)));
+      if (line.rfind("v ", 0) == 0) {
+        const double encoded = std::stod(rc::tokens_of(line).at(4));
+        e.push_back(4.0 * (encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4)));
+      }
     EXPECT_EQ(e.size(), 8u);
     if (e.size() < 4) return std::make_pair(0.0, 0.0);
     return std::make_pair(8.0 / 3.0 * (e[0] + e[1] + e[2]) + 8.0 / 3.0 * (e[0] + e[2] + e[3]), e[0]);
