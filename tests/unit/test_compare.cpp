@@ -40,10 +40,10 @@ class Compare : public ::testing::Test {
   }
   Result gilt(const std::string& args) { return run(std::string("'") + GILT_BINARY_PATH + "' " + args); }
 
-  /// A small report: two methods, two budgets, 32 × 32.
+  /// A small report: two methods, two budgets (0.3 and 1.5 s), 32 × 32.
   fs::path small_report(const std::string& name) {
     const fs::path report = dir_ / name;
-    const Result r = gilt("compare cornell --methods path,radiosity --budgets 0.3,0.6 --reference-time 1 --width 32 "
+    const Result r = gilt("compare cornell --methods path,radiosity --budgets 0.3,1.5 --reference-time 1 --width 32 "
                           "--height 32 -q -o '" + report.string() + "'");
     EXPECT_EQ(r.code, 0) << r.err;
     return report;
@@ -67,7 +67,13 @@ TEST_F(Compare, WritesReportMetricsAndImages) {
     EXPECT_GE(e["rmse"].get<double>(), 0.0);
     if (e["method"] == "radiosity") {
       EXPECT_TRUE(e["object_space_error"].is_number());
-      EXPECT_GT(e["shots"].get<int>(), 0);
+      // No shot starts that would end past the budget, and under AddressSanitizer with another
+      // test beside it meshing and direct light can take all of 0.3 s (0 shots seen; 8 alone):
+      // shots are required at the larger budget only.
+      EXPECT_GE(e["shots"].get<int>(), 0);
+      if (e["budget_seconds"].get<double>() > 1.0) {
+        EXPECT_GT(e["shots"].get<int>(), 0);
+      }
     } else {
       EXPECT_TRUE(e["object_space_error"].is_null());
       EXPECT_GT(e["spp_or_iterations"].get<int>(), 0);
