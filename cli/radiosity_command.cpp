@@ -134,6 +134,9 @@ void run_radiosity(RadiosityOptions& o) {
                         {"links", sol.links},
                         {"iterations", sol.iterations},
                         {"final_gather", sol.final_gather},
+                        {"final_gather_note", sol.final_gather_note},
+                        {"link_tolerance", sol.link_tolerance},
+                        {"linking_stopped_by_time", sol.linking_stopped},
                         {"shots", sol.shots},
                         {"residual", sol.residual},
                         {"tolerance", o.solver.tolerance},
@@ -207,10 +210,12 @@ void run_radiosity(RadiosityOptions& o) {
                 100.0 * sol.mesh_report.buried_area / std::max(sol.mesh_report.meshed_area, 1e-300),
                 sol.mesh_report.buried_faces, sol.mesh_report.buried_elements);
   if (sol.solver == radiosity::SolverKind::hierarchical)
-    std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links, %d iterations, residual %.3g (tolerance %.3g), "
-                "final gather %s (%.3g nodes per vertex)\n",
-                sol.solver_reason.c_str(), sol.nodes, sol.links, sol.iterations, sol.residual, o.solver.tolerance,
-                sol.final_gather ? "at every vertex" : "stopped by --time",
+    std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links at tolerance %.3g%s, %d iterations, residual %.3g "
+                "(tolerance %.3g), final gather %s (%.3g nodes per vertex)\n",
+                sol.solver_reason.c_str(), sol.nodes, sol.links, sol.link_tolerance,
+                sol.linking_stopped ? (sol.links > 0 ? " (finer linking stopped by --time)" : " (linking stopped by --time)") : "",
+                sol.iterations, sol.residual,
+                o.solver.tolerance, sol.final_gather_note.c_str(),
                 double(sol.gather_nodes) / double(std::max<size_t>(1, sol.mesh.vertex_count())));
   else
     std::printf("  solve:   progressive (%s): %llu shots, residual %.3g (tolerance %.3g)\n", sol.solver_reason.c_str(),
@@ -290,6 +295,17 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
                  "of the reflected power (default 2e-6; 2e-5 for gilt render's two-pass radiosity view)")
       ->check(CLI::Range(1e-12, 1.0))
       ->check(finite_number());
+  cmd.add_option_function<std::string>(
+         "--final-gather",
+         [&s](const std::string& name) {
+           s.hierarchical.final_gather = name == "on"    ? radiosity::FinalGather::always
+                                         : name == "off" ? radiosity::FinalGather::never
+                                                         : radiosity::FinalGather::automatic;
+         },
+         "Hierarchical radiosity: gather at every vertex from the hierarchy at the end: on, off, or auto (default: "
+         "when a probe at every 61st vertex or more predicts at most 4x the links' shadow rays, and under --time when "
+         "it fits)")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd.add_option("--gather-tolerance", s.hierarchical.gather_tolerance,
                  "Hierarchical radiosity: a cluster stands in for its elements in the vertex final gather when the "
                  "irradiance it may carry wrongly is below this fraction of the vertex's own (default 0.02)")

@@ -29,7 +29,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
+#include <optional>
 
 #include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
@@ -55,6 +57,10 @@ constexpr int kMixedDepth = 3;
 constexpr float kMaxReflectedGain = 0.99f;
 /// A partly visible cluster link is accepted when this many times its error is acceptable.
 constexpr double kPartialVisibility = 10.0;
+/// The final gather's probe takes every this-many-th vertex.
+constexpr uint32_t kGatherProbeStride = 61;
+/// `auto` skips the final gather when it would trace more than this many times the links' rays.
+constexpr double kGatherRayShare = 4.0;
 
 /// One vector per colour channel: Σ B A n and the irradiance vector W.
 struct RgbVec {
@@ -288,6 +294,8 @@ struct Counters {
 
 class Linker {
  public:
+  bool out_of_time() const { return in_.out_of_time && in_.out_of_time(); }
+
   Linker(const HierarchicalInput& in, const Tree& tree, std::span<const float> power_estimate,
          std::span<const Vec3> moment_estimate, double epsilon, const HierarchicalSettings& settings,
          Counters& counters)
@@ -299,8 +307,9 @@ class Linker {
         settings_(settings),
         counters_(counters) {}
 
-  std::vector<Link> link() {
-    if (tree_.nodes.empty()) return {};
+  /// The accepted links, or nothing when `in.out_of_time` said stop before linking finished.
+  std::optional<std::vector<Link>> link() {
+    if (tree_.nodes.empty()) return std::vector<Link>{};
     // Breadth-first from the root pair until there are enough pairs to share out, then each
     // pair's refinement runs on its own, its links appended in pair order (deterministic).
     std::vector<std::pair<uint32_t, uint32_t>> frontier{{0, 0}}, next;
@@ -311,14 +320,21 @@ class Linker {
       frontier.swap(next);
     }
     std::vector<std::vector<Link>> parts(frontier.size());
+    std::atomic<bool> stopped{false};
     rc::parallel_for(frontier.size(), [&](size_t i) {
       std::vector<std::pair<uint32_t, uint32_t>> stack{frontier[i]};
-      while (!stack.empty()) {
+      for (uint32_t steps = 1; !stack.empty(); ++steps) {
+        // The clock is read every 4,096 pairs: often enough to stop within milliseconds.
+        if (steps % 4096 == 0 && (stopped.load(std::memory_order_relaxed) || out_of_time())) {
+          stopped = true;
+          return;
+        }
         const auto [r, s] = stack.back();
         stack.pop_back();
         refine(r, s, parts[i], stack);
       }
     });
+    if (stopped) return std::nullopt;
     for (auto& part : parts) links.insert(links.end(), part.begin(), part.end());
     return links;
   }
@@ -668,21 +684,19 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     }
   }
 
-  // Links, grouped by receiver for gathering.
+  // Links, grouped by receiver for gathering. Without a time limit they are made once, at the
+  // requested tolerance. With one, a ladder of tolerances from 1,000 times coarser runs down to
+  // it, each level linked afresh and its iteration started from the last level's solution,
+  // while the next level's predicted cost (the last one's times its observed growth) still fits:
+  // a coarse solution in time beats a fine one cut off before it iterates.
   const double link_tolerance = settings.link_tolerance > 0.0 ? settings.link_tolerance : kDefaultLinkTolerance;
-  std::vector<Link> links = Linker(in, tree, power_estimate, moment_estimate,
-                                   link_tolerance * total_estimate, settings, counters)
-                                .link();
-  std::stable_sort(links.begin(), links.end(),
-                   [](const Link& a, const Link& b) { return a.receiver < b.receiver; });
-  result.links = links.size();
-  result.link_seconds = lap();
+  const bool timed = bool(in.seconds_left);
+  std::vector<double> ladder;
+  if (timed)
+    for (double t = link_tolerance * 1000.0; t > link_tolerance * 1.5; t /= 10.0) ladder.push_back(t);
+  ladder.push_back(link_tolerance);
+  std::vector<Link> links;
   std::vector<uint32_t> receivers, first_link;
-  for (uint32_t i = 0; i < links.size(); ++i)
-    if (i == 0 || links[i].receiver != links[i - 1].receiver)
-      receivers.push_back(links[i].receiver), first_link.push_back(i);
-  first_link.push_back(uint32_t(links.size()));
-
   // One gathering step: pull B up the tree, gather over the links, push the gathered irradiance
   // down to the elements.
   std::vector<Rgb> power, indirect(ne, Rgb(0.0f));
@@ -733,35 +747,78 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // reached 10³³. Such an element's gathering is scaled so that ρ·c = 0.99, which bounds every
   // row of the iteration below 1 and makes it a contraction; elsewhere nothing changes.
   std::vector<float> gain(ne, 1.0f);
-  {
+  auto bound_gains = [&] {
+    std::fill(gain.begin(), gain.end(), 1.0f);
+    result.clamped_elements = 0;
     std::vector<Rgb> unit(ne, Rgb(1.0f)), capacity(ne);
     gather(unit, capacity);
     for (size_t e = 0; e < ne; ++e) {
       const float reflected = in.albedo[e].max_component() * capacity[e].max_component();
       if (reflected > kMaxReflectedGain) gain[e] = kMaxReflectedGain / reflected, ++result.clamped_elements;
     }
-  }
+  };
 
   // Jacobi iteration: gather, then reflect.
   std::vector<Rgb> next(ne);
-  for (int it = 0; it < settings.max_iterations; ++it) {
-    if (out_of_time()) break;
-    gather(radiosity, indirect);
-    double change = 0.0, total = 0.0;
-    for (size_t e = 0; e < ne; ++e) {
-      indirect[e] *= gain[e];
-      next[e] = in.albedo[e] * (direct[e] + indirect[e]);
-      const Rgb delta = next[e] - radiosity[e];
-      change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e];
-      total += double(next[e].average()) * mesh.element_area[e];
+  auto iterate = [&] {
+    result.iterations = 0;
+    result.residual = 0.0;
+    for (int it = 0; it < settings.max_iterations; ++it) {
+      if (out_of_time()) break;
+      gather(radiosity, indirect);
+      double change = 0.0, total = 0.0;
+      for (size_t e = 0; e < ne; ++e) {
+        indirect[e] *= gain[e];
+        next[e] = in.albedo[e] * (direct[e] + indirect[e]);
+        const Rgb delta = next[e] - radiosity[e];
+        change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e];
+        total += double(next[e].average()) * mesh.element_area[e];
+      }
+      radiosity.swap(next);
+      ++result.iterations;
+      result.residual = total > 0.0 ? change / total : 0.0;
+      if (result.residual < settings.tolerance) break;
     }
-    radiosity.swap(next);
-    ++result.iterations;
-    result.residual = total > 0.0 ? change / total : 0.0;
-    if (result.residual < settings.tolerance) break;
+  };
+
+  const auto seconds_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  double last_link = 0.0, last_iterate = 0.0, growth = 3.0;
+  for (size_t level = 0; level < ladder.size(); ++level) {
+    if (level > 0 && last_link * growth + last_iterate > in.seconds_left()) break;
+    const auto link_start = std::chrono::steady_clock::now();
+    std::optional<std::vector<Link>> made = Linker(in, tree, power_estimate, moment_estimate,
+                                                   ladder[level] * total_estimate, settings, counters)
+                                                .link();
+    const double link_seconds = seconds_since(link_start);
+    result.link_seconds += link_seconds;
+    if (!made) {
+      result.linking_stopped = true;
+      break;
+    }
+    if (level > 0 && last_link > 0.0) growth = std::max(1.5, link_seconds / last_link);
+    last_link = link_seconds;
+    links = std::move(*made);
+    std::stable_sort(links.begin(), links.end(),
+                     [](const Link& a, const Link& b) { return a.receiver < b.receiver; });
+    receivers.clear();
+    first_link.clear();
+    for (uint32_t i = 0; i < links.size(); ++i)
+      if (i == 0 || links[i].receiver != links[i - 1].receiver)
+        receivers.push_back(links[i].receiver), first_link.push_back(i);
+    first_link.push_back(uint32_t(links.size()));
+    result.links = links.size();
+    result.link_tolerance = ladder[level];
+    result.link_rays = counters.rays;
+    const auto iterate_start = std::chrono::steady_clock::now();
+    bound_gains();
+    iterate();
+    last_iterate = seconds_since(iterate_start);
+    result.iterate_seconds += last_iterate;
   }
   pull(tree, mesh, radiosity, power, moment);
-  result.iterate_seconds = lap();
+  lap();
 
   // Vertices first take the area-weighted mean of their elements' gathered irradiance; the
   // final gather then replaces it while time allows.
@@ -782,37 +839,83 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // irradiance it may carry wrongly is below gather_tolerance of the vertex's own indirect
   // irradiance (at least 5 % of the scene's mean), and elements by Lambert's formula.
   result.final_gather = false;
-  if (!settings.vertex_final_gather) {
+  const auto finish = [&] {
+    result.gather_seconds = lap();
     result.shadow_rays = counters.rays;
     result.form_factors = counters.form_factors;
+    result.gather_nodes = counters.gather_nodes;
     return result;
+  };
+  if (settings.final_gather == FinalGather::never) {
+    result.final_gather_note = "not asked for";
+    return finish();
   }
   const TreeWalk walker{in, tree, radiosity, power, moment};
-  std::atomic<bool> stopped{false};
-  rc::parallel_for((nv + 63) / 64, [&](size_t chunk) {
-    if (stopped.load(std::memory_order_relaxed) || out_of_time()) {
-      stopped = true;
-      return;
-    }
-    WalkCounts walk;
-    std::vector<uint32_t> stack;
-    for (size_t v = chunk * 64; v < std::min(nv, chunk * 64 + 64); ++v) {
-      const double epsilon = settings.gather_tolerance *
-                             std::max(double(result.vertex_irradiance[v].average()), 0.05 * mean_indirect);
-      rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5200000000ull);
-      const Rgb e_sum = walker.irradiance(v, epsilon, 1, rng, stack, walk);
-      result.vertex_irradiance[v] = e_sum;
-    }
-    counters.rays += walk.rays;
-    counters.gather_nodes += walk.nodes;
-    counters.form_factors += walk.form_factors;
-  });
-  result.final_gather = !stopped;
-  result.gather_seconds = lap();
-  result.shadow_rays = counters.rays;
-  result.form_factors = counters.form_factors;
-  result.gather_nodes = counters.gather_nodes;
-  return result;
+  std::vector<Rgb> gathered_at(nv);
+  std::vector<char> done(nv, 0);
+  // Gathers at the listed vertices in parallel; false when time ran out first.
+  auto gather_at = [&](const std::vector<uint32_t>& list) {
+    std::atomic<bool> stopped{false};
+    rc::parallel_for((list.size() + 63) / 64, [&](size_t chunk) {
+      if (stopped.load(std::memory_order_relaxed) || out_of_time()) {
+        stopped = true;
+        return;
+      }
+      WalkCounts walk;
+      std::vector<uint32_t> stack;
+      for (size_t i = chunk * 64; i < std::min(list.size(), chunk * 64 + 64); ++i) {
+        const uint32_t v = list[i];
+        const double epsilon = settings.gather_tolerance *
+                               std::max(double(result.vertex_irradiance[v].average()), 0.05 * mean_indirect);
+        rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5200000000ull);
+        gathered_at[v] = walker.irradiance(v, epsilon, 1, rng, stack, walk);
+        done[v] = 1;
+      }
+      counters.rays += walk.rays;
+      counters.gather_nodes += walk.nodes;
+      counters.form_factors += walk.form_factors;
+    });
+    return !stopped;
+  };
+  // A probe of every kGatherProbeStride-th vertex (at most about 1,024 of them) predicts what the whole gather costs. `auto`
+  // skips it when it would trace more than kGatherRayShare times the links' shadow rays: on a
+  // large interior (Šibenik: 3,000–9,000 nodes per vertex, four to ten times the linking's
+  // time) it costs minutes and moves the result by less than the links' own error, while on a
+  // compact scene it is a fraction of the solve and sharpens the vertices. Under a time limit
+  // it is skipped when the prediction does not fit in the time left.
+  std::vector<uint32_t> probe, rest;
+  const size_t stride = std::max<size_t>(kGatherProbeStride, nv / 1024);
+  for (uint32_t v = 0; v < nv; ++v) (v % stride == 0 ? probe : rest).push_back(v);
+  const uint64_t rays_before = counters.rays;
+  const auto probe_start = std::chrono::steady_clock::now();
+  bool complete = gather_at(probe);
+  const double scale = double(nv) / double(std::max<size_t>(1, probe.size()));
+  result.final_gather_predicted_rays = uint64_t(double(counters.rays - rays_before) * scale);
+  const double predicted_seconds = seconds_since(probe_start) * (scale - 1.0);
+  if (complete && settings.final_gather == FinalGather::automatic &&
+      double(result.final_gather_predicted_rays) > kGatherRayShare * double(std::max<uint64_t>(1, result.link_rays))) {
+    result.final_gather_note = "skipped: it would trace about " + std::to_string(result.final_gather_predicted_rays) +
+                               " shadow rays, more than " + std::to_string(int(kGatherRayShare)) +
+                               " times the links' " + std::to_string(result.link_rays);
+    complete = false;
+  } else if (complete && timed && predicted_seconds > in.seconds_left()) {
+    char note[160];
+    std::snprintf(note, sizeof note, "skipped: it would take about %.3g s, %.3g s were left", predicted_seconds,
+                  std::max(0.0, in.seconds_left()));
+    result.final_gather_note = note;
+    complete = false;
+  } else if (complete) {
+    complete = gather_at(rest);
+    result.final_gather = complete;
+    result.final_gather_note = complete ? "at every vertex" : "stopped by --time";
+  } else {
+    result.final_gather_note = "stopped by --time";
+  }
+  // A partial gather would leave its boundary visible between vertices that had it and their
+  // neighbours that did not: only a complete one is used.
+  if (result.final_gather)
+    for (size_t v = 0; v < nv; ++v) result.vertex_irradiance[v] = gathered_at[v];
+  return finish();
 }
 
 }  // namespace gilt::radiosity

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "radiosity/mesh.h"
@@ -21,6 +22,13 @@ using rc::Rgb;
 
 /// The link tolerance for solutions whose vertices are the answer (exports, the mesh view).
 inline constexpr double kDefaultLinkTolerance = 2e-6;
+
+/// Whether the vertex final gather runs.
+enum class FinalGather {
+  automatic,  ///< when a probe of its cost predicts at most kGatherRayShare times the links' rays
+  always,
+  never,      ///< for a view that gathers per pixel, or when asked
+};
 
 /// Parameters of the hierarchical pass; the defaults are the documented defaults.
 struct HierarchicalSettings {
@@ -35,9 +43,9 @@ struct HierarchicalSettings {
   int link_rays = 4;        ///< shadow rays per link (between random points of the two ends)
   double tolerance = 1e-3;  ///< stop iterating when the solution changes by less than this (relative)
   int max_iterations = 200;
-  /// Gather at every vertex from the hierarchy at the end; without it, a vertex takes the
-  /// area-weighted mean of its elements' gathered irradiance (for a view that gathers per pixel).
-  bool vertex_final_gather = true;
+  /// Gather at every vertex from the hierarchy at the end (see FinalGather); without it, a
+  /// vertex takes the area-weighted mean of its elements' gathered irradiance.
+  FinalGather final_gather = FinalGather::automatic;
   uint64_t seed = 0;
 };
 
@@ -58,6 +66,9 @@ struct HierarchicalInput {
   std::function<bool(const rc::Bounds3&)> may_be_blocked;
   /// Called between steps; returning true stops the pass early (the result is then partial).
   std::function<bool()> out_of_time;
+  /// Seconds left of a time limit; empty when there is none. With it the links are made coarse
+  /// first and refined while the time allows (see solve_hierarchical).
+  std::function<double()> seconds_left;
 };
 
 /// The reflected (indirect) irradiance at every vertex, and what it took.
@@ -69,8 +80,12 @@ struct HierarchicalResult {
   size_t clamped_elements = 0;  ///< elements whose links promised more light than they can reflect (scaled down)
   uint64_t shadow_rays = 0, form_factors = 0;
   uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated
-  bool final_gather = true;   ///< false when it was not asked for or time ran out before it (vertices then take
-                              ///< their elements' mean)
+  bool final_gather = true;   ///< false when it did not run to the end (vertices then take their elements' mean)
+  std::string final_gather_note;  ///< how it ran, or why not ("at every vertex", "skipped: ...")
+  uint64_t final_gather_predicted_rays = 0;  ///< what its probe predicted for every vertex
+  double link_tolerance = 0.0;  ///< the tolerance of the links used (coarser than asked when time ran short)
+  bool linking_stopped = false; ///< time ran out while linking at link_tolerance / 10 (or at all)
+  uint64_t link_rays = 0;       ///< shadow rays traced while linking
   double link_seconds = 0.0, iterate_seconds = 0.0, gather_seconds = 0.0;  ///< tree and links; iterations; final gather
 };
 

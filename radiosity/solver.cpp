@@ -640,7 +640,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       std::vector<Rgb> emission(mesh.element_count());
       for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
       const std::vector<Rgb> rho = element_albedo();
-      const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, {}, may_be_blocked, {}};
+      const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, {}, may_be_blocked, {}, {}};
       uint64_t tree_rays = 0;
       const std::vector<Rgb> e = emitted_irradiance(input, emission, first_vertex, hs, settings.visibility_samples, &tree_rays);
       for (size_t v = first_vertex; v < nv; ++v) direct_emitted[v] = e[v];
@@ -773,7 +773,9 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     // Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex.
     const std::vector<Rgb> rho = element_albedo();
     const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, sol.vertex_irradiance, may_be_blocked,
-                                  [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; }};
+                                  [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; },
+                                  settings.time_limit > 0.0 ? std::function<double()>([&] { return settings.time_limit - elapsed(); })
+                                                            : std::function<double()>()};
     if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
                     [](const Rgb& e) { return e.is_black(); }))
       sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
@@ -790,6 +792,9 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.residual = h.residual;
     sol.gather_nodes = h.gather_nodes;
     sol.final_gather = h.final_gather;
+    sol.final_gather_note = h.final_gather_note;
+    sol.link_tolerance = h.link_tolerance;
+    sol.linking_stopped = h.linking_stopped;
     sol.link_seconds = h.link_seconds;
     sol.iterate_seconds = h.iterate_seconds;
     sol.gather_seconds = h.gather_seconds;

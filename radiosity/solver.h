@@ -76,6 +76,9 @@ struct Solution {
   int iterations = 0;            ///< hierarchical: gathering iterations
   uint64_t gather_nodes = 0;     ///< hierarchical: nodes the vertex final gather evaluated
   bool final_gather = false;     ///< hierarchical: the vertex final gather ran to the end
+  std::string final_gather_note; ///< hierarchical: how the final gather ran, or why it did not
+  double link_tolerance = 0.0;   ///< hierarchical: the tolerance of the links used
+  bool linking_stopped = false;  ///< hierarchical: time ran out while linking finer
   double residual = 0.0;         ///< progressive: unshot power / emitted power at the end;
                                  ///< hierarchical: relative change of the last iteration
   /// Ambient radiosity (W·m⁻²) standing in for the light not yet shot, for displaying a partial

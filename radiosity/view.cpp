@@ -20,7 +20,7 @@ namespace gilt::radiosity {
 SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
   if (mode == ViewMode::two_pass) {
     settings.subdivision_levels = 0;
-    settings.hierarchical.vertex_final_gather = false;
+    settings.hierarchical.final_gather = FinalGather::never;
     if (!(settings.hierarchical.link_tolerance > 0.0)) settings.hierarchical.link_tolerance = kTwoPassLinkTolerance;
   }
   return settings;

@@ -159,6 +159,7 @@ std::vector<NumericFlag> radiosity_flags() {
       {"--solver", {"bogus", "nan"}, {"--solver"}, "--elements 50"},
       {"--link-tolerance", {"nan", "0", "2"}, {"--link-tolerance"}, "--elements 50 --solver hierarchical"},
       {"--gather-tolerance", {"inf", "-1"}, {"--gather-tolerance"}, "--elements 50 --solver hierarchical"},
+      {"--final-gather", {"maybe", "1"}, {"--final-gather"}, "--elements 50 --solver hierarchical"},
   };
 }
 
