@@ -23,7 +23,7 @@ namespace rc = gilt::raytrace_core;
 namespace {
 
 struct RadiosityOptions {
-  std::string scene, output, quantity = "radiance", onto = "elements", fit = "least-squares";
+  std::string scene, output, quantity = "radiance", onto = "elements", fit = "least-squares", check_points_file;
   radiosity::SolverSettings solver;
   radiosity::CheckSettings check;
   int check_points = 0;  ///< 0: no check
@@ -62,6 +62,15 @@ void run_radiosity(RadiosityOptions& o) {
     throw rc::InputError("--linear-float applies to .ply and .obj output of --onto elements only");
   if (o.linear_float && o.srgb8) throw rc::InputError("--linear-float and --srgb8 ask for opposite colours");
   if (o.fit != "least-squares" && !onto_input) throw rc::InputError("--fit applies to --onto input only");
+  if (!o.check_points_file.empty()) {
+    if (o.check_points == 0) throw rc::InputError("--check-points writes the points of --check N: give --check too");
+    if (!onto_input)
+      throw rc::InputError("--check-points applies to --onto input and --lightmap, whose check draws points on the "
+                           "input's faces");
+    const std::filesystem::path parent = std::filesystem::absolute(o.check_points_file).parent_path();
+    if (!std::filesystem::is_directory(parent))
+      throw rc::InputError("--check-points " + o.check_points_file + ": folder " + parent.string() + " does not exist");
+  }
   const auto start = std::chrono::steady_clock::now();
   const rc::Scene scene = rc::load_scene(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
@@ -111,6 +120,8 @@ void run_radiosity(RadiosityOptions& o) {
     } else {
       check = radiosity::check_against_path_tracer(scene, sol, o.check);
     }
+    if (surface_check && !o.check_points_file.empty())
+      radiosity::write_check_points(o.check_points_file, scene, *surface_check);
   }
 
   const double secs = std::max(sol.seconds, 1e-9);
@@ -354,6 +365,10 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--check-samples", o->check.samples, "Path-traced samples per checked vertex (default 4096)")
       ->check(CLI::Range(2, 100000000));
+  cmd->add_option("--check-points", o->check_points_file,
+                  "With --check and --onto input or --lightmap: write every compared point (its face's file "
+                  "vertices, barycentrics, albedo, path-traced irradiance with its standard error, the baked "
+                  "value) as CSV, to score other bakes against the same reference");
   cmd->add_flag("--json", o->json, "Print the statistics as one JSON object");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
   return [o, onto, fit] {

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -27,6 +28,7 @@
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/sampling.h"
+#include "raytrace_core/staged_file.h"
 
 namespace gilt::radiosity {
 
@@ -152,6 +154,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
   const float step = 1e-4f * glm::length(scene.bounds().diagonal());
   const size_t count = size_t(settings.points);
   std::vector<Rgb> baked(count), mean(count), variance(count);
+  std::vector<SurfaceCheckPoint> where(count);
   std::vector<char> usable(count, 0);
   const rc::PathSettings path;
   rc::parallel_for(count, [&](size_t i) {
@@ -193,6 +196,15 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     for (int c = 0; c < 3; ++c)
       variance[i][c] = std::max(0.0f, (sum_squares[c] - sum[c] * sum[c] / ns) / (ns - 1.0f)) / ns;
     baked[i] = value;
+    SurfaceCheckPoint& at = where[i];
+    at.mesh = f.mesh;
+    at.triangle = f.triangle;
+    for (int k = 0; k < 3; ++k) {
+      at.file_vertex[k] = mesh.origin.vertex.empty() ? corner[k] : mesh.origin.vertex[corner[k]];
+      at.weight[k] = w[k];
+    }
+    at.position = p;
+    at.albedo = m.albedo;
     usable[i] = 1;
   });
   double reference_mean = 0.0;
@@ -212,6 +224,11 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
       share += double(variance[i][c]) / (r * r + floor * floor);
       relative += std::abs(d) / (r + floor);
     }
+    SurfaceCheckPoint& at = where[i];
+    at.reference = mean[i];
+    at.baked = baked[i];
+    for (int c = 0; c < 3; ++c) at.standard_error[c] = std::sqrt(variance[i][c]);
+    result.compared.push_back(at);
   }
   result.points = used;
   result.relative_mse = squared / (3.0 * double(used));
@@ -222,6 +239,30 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
 }
 
 }  // namespace
+
+void write_check_points(const std::string& path, const rc::Scene& scene, const SurfaceCheckResult& result) {
+  std::string out =
+      "gltf_mesh,gltf_primitive,v0,v1,v2,w0,w1,w2,x,y,z,albedo_r,albedo_g,albedo_b,reference_r,reference_g,"
+      "reference_b,standard_error_r,standard_error_g,standard_error_b,baked_r,baked_g,baked_b\n";
+  char line[512];
+  const auto rgb = [&](const Rgb& c) {
+    std::snprintf(line, sizeof line, ",%.9g,%.9g,%.9g", double(c.r), double(c.g), double(c.b));
+    out += line;
+  };
+  for (const SurfaceCheckPoint& p : result.compared) {
+    const rc::MeshOrigin& origin = scene.meshes[p.mesh].origin;
+    std::snprintf(line, sizeof line, "%d,%d,%u,%u,%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", origin.mesh, origin.primitive,
+                  p.file_vertex[0], p.file_vertex[1], p.file_vertex[2], double(p.weight[0]), double(p.weight[1]),
+                  double(p.weight[2]), double(p.position.x), double(p.position.y), double(p.position.z));
+    out += line;
+    rgb(p.albedo);
+    rgb(p.reference);
+    rgb(p.standard_error);
+    rgb(p.baked);
+    out += '\n';
+  }
+  rc::StagedFile(path, out).commit();
+}
 
 SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings) {

@@ -4,6 +4,8 @@
 // reader knows which differences the check can resolve.
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "radiosity/solver.h"
 
@@ -44,6 +46,21 @@ struct InputColours;  // radiosity/onto_input.h
 
 /// How colours baked onto the input model (`--onto input`) compare with the path tracer at random
 /// points inside the input's faces, where the baked colour is its face's corners interpolated.
+/// One point of a surface check, as `gilt radiosity --check-points` writes it: enough to score
+/// another bake (Blender's, an older gilt's) against the same path-traced reference.
+struct SurfaceCheckPoint {
+  uint32_t mesh = 0;              ///< scene mesh
+  uint32_t triangle = 0;          ///< its triangle
+  uint32_t file_vertex[3] = {};   ///< the corners as the input file numbers them (OBJ `v` line from 0, PLY
+                                  ///< vertex, glTF primitive vertex)
+  float weight[3] = {};           ///< barycentric weights of the corners
+  Vec3 position{0.0f};
+  Rgb albedo{0.0f};
+  Rgb reference{0.0f};            ///< path-traced irradiance
+  Rgb standard_error{0.0f};       ///< of `reference`
+  Rgb baked{0.0f};                ///< the bake's irradiance
+};
+
 struct SurfaceCheckResult {
   size_t points = 0;           ///< points compared
   size_t unlit = 0;            ///< points left out: on buried faces, or no path-traced sample found light
@@ -51,7 +68,12 @@ struct SurfaceCheckResult {
   double reference_share = 0.0;  ///< what the estimates' own variance adds to it (same mean of se²)
   double mean_relative_error = 0.0;  ///< mean |E_baked − E_path| / (E_path + 0.01 Ē_path)
   double seconds = 0.0;
+  std::vector<SurfaceCheckPoint> compared;  ///< the points compared, in drawing order
 };
+
+/// Writes `result.compared` as CSV with a header line (atomically); throws rc::InputError when
+/// the file cannot be written.
+void write_check_points(const std::string& path, const rc::Scene& scene, const SurfaceCheckResult& result);
 
 /// Draws `settings.points` points uniformly by area over the faces that `irradiance` (an
 /// InputColours fitted with Quantity::irradiance) covers, from `settings.seed`, and compares

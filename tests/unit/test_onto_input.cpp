@@ -257,6 +257,11 @@ TEST(OntoInput, BadRequestsAreRefusedBeforeSolving) {
       {"cornell --onto input -o " + quoted(dir / "x.glb"), "use --onto elements"},
       {q + "--srgb8 -o " + quoted(dir / "x.glb"), "--srgb8 applies"},
       {"cornell --fit point -o " + quoted(dir / "x.ply"), "--fit applies to --onto input only"},
+      {q + "--check-points " + quoted(dir / "p.csv") + " -o " + quoted(dir / "x.glb"), "give --check too"},
+      {"cornell --check 5 --check-points " + quoted(dir / "p.csv") + " -o " + quoted(dir / "x.ply"),
+       "--check-points applies to --onto input"},
+      {q + "--check 5 --check-points " + quoted(dir / "nowhere" / "p.csv") + " -o " + quoted(dir / "x.glb"),
+       "does not exist"},
   };
   const std::string before = slurp(dir / "model.gltf"), bin = slurp(dir / "data.bin");
   for (const auto& c : cases) {
@@ -267,6 +272,51 @@ TEST(OntoInput, BadRequestsAreRefusedBeforeSolving) {
   EXPECT_EQ(slurp(dir / "model.gltf"), before);
   EXPECT_EQ(slurp(dir / "data.bin"), bin);
   EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  EXPECT_FALSE(fs::exists(dir / "p.csv"));
+  fs::remove_all(dir);
+}
+
+// `--check-points` writes every compared point, so another bake can be scored against the same
+// reference: the figures recomputed from the file are the ones the run printed, the weights are
+// barycentric, and the corners are the input file's vertices.
+TEST(OntoInput, CheckPointsHoldWhatTheCheckCompared) {
+  const fs::path dir = fresh_dir("checkpoints");
+  const fs::path scene = write_model(dir);
+  const fs::path csv = dir / "points.csv";
+  const Json j = Json::parse(run(quoted(scene) + " --onto input --elements 400 --check 60 --check-samples 32 --json "
+                                 "--check-points " + quoted(csv) + " -o " + quoted(dir / "x.glb"), dir));
+  std::istringstream in(slurp(csv));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line.rfind("gltf_mesh,gltf_primitive,v0,v1,v2,w0,w1,w2,x,y,z,albedo_r", 0), 0u) << line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) row.push_back(std::stod(f));
+    ASSERT_EQ(row.size(), 23u) << line;
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), j["check"]["points"].get<size_t>());
+  ASSERT_GT(rows.size(), 30u);
+  double mean = 0.0;
+  for (const auto& r : rows) {
+    EXPECT_NEAR(r[5] + r[6] + r[7], 1.0, 1e-6);
+    for (int k = 2; k < 5; ++k) EXPECT_LT(r[k], 4.0) << "each primitive of the model has 4 vertices";
+    mean += (r[14] + r[15] + r[16]) / 3.0;
+  }
+  const double floor = 0.01 * mean / double(rows.size());
+  double squared = 0.0, relative = 0.0;
+  for (const auto& r : rows)
+    for (int c = 0; c < 3; ++c) {
+      const double ref = r[14 + c], d = r[20 + c] - ref;
+      squared += d * d / (ref * ref + floor * floor);
+      relative += std::abs(d) / (ref + floor);
+    }
+  // The file rounds to 9 digits; the run sums in double from floats.
+  EXPECT_NEAR(squared / (3.0 * rows.size()), j["check"]["relative_mse"].get<double>(),
+              1e-5 * j["check"]["relative_mse"].get<double>() + 1e-12);
+  EXPECT_NEAR(relative / (3.0 * rows.size()), j["check"]["mean_relative_error"].get<double>(), 1e-6);
   fs::remove_all(dir);
 }
 
