@@ -42,7 +42,7 @@ echo "== reference: 2000 points, $reference path-traced samples each"
   --check 2000 --check-samples "$reference" --check-points ref.csv -o ref.obj -q --threads 2 | grep check:
 echo "== gilt radiosity --onto input --time $seconds"
 /usr/bin/time -f "gilt wall %e s" "$gilt" radiosity open.json --onto input --time "$seconds" --quantity irradiance \
-  --check 2000 --check-samples 2 --check-points gilt.csv -o gilt.obj -q --threads 2 | grep -E "solve:|time:"
+  --check 2000 --check-samples 256 --check-points gilt.csv -o gilt.obj -q --threads 2 | grep -E "solve:|time:"
 echo "== Blender Cycles vertex bake, $samples samples"
 SUN="0.35,-1,0.45,8" ENV=1.0 blender -b --factory-startup -P "$shared/tools/cycles_bake.py" -- open.obj "$samples" \
   blender.npy 2 2>&1 | grep BAKE_SECONDS

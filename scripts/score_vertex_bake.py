@@ -10,7 +10,8 @@ radiance is its face's corners interpolated with the point's barycentric weights
 shows a per-corner colour, and turned into irradiance, E = pi L / albedo. The figures use gilt's
 own definitions (radiosity/check.cpp), so the two bakes are scored by one reference:
   relMSE = mean (E - E_ref)^2 / (E_ref^2 + f^2),  mean relative error = mean |E - E_ref| / (E_ref + f),
-with f = 1 % of the mean reference, over points and channels. gilt's own bake (the CSV's `baked`
+with f = 1 % of the mean reference, over points and channels, and the median over points of
+the relative error (less ruled by the few worst points). gilt's own bake (the CSV's `baked`
 columns) is scored beside it the same way. --reference takes the path-traced columns from another
 check of the same scene and seed (the same points, drawn again; say with many more samples), so
 several bakes can be scored by one low-noise reference without paying for it each time.
@@ -111,13 +112,15 @@ def main():
     def score(x):
         d = x[keep] - ref[keep]
         r = ref[keep]
-        return ((d * d) / (r * r + floor * floor)).mean(), (np.abs(d) / (r + floor)).mean()
+        rel = np.abs(d) / (r + floor)
+        return ((d * d) / (r * r + floor * floor)).mean(), rel.mean(), np.median(rel.mean(axis=1))
 
     share = (se[keep] ** 2 / (ref[keep] ** 2 + floor * floor)).mean()
     print(f"points {int(keep.sum())} (faces not found: {missing}); reference's own share of relMSE {share:.4g}")
     for name, x in (("gilt", gilt), (a.label, other)):
-        m, e = score(x)
-        print(f"{name:>10}: relMSE {m:.4g}  mean relative error {100 * e:.1f} %  mean {x[keep].mean() / ref[keep].mean():.3f} of the reference")
+        m, e, med = score(x)
+        print(f"{name:>10}: relMSE {m:.4g}  mean relative error {100 * e:.1f} %  median {100 * med:.1f} %  "
+              f"mean {x[keep].mean() / ref[keep].mean():.3f} of the reference")
 
 
 if __name__ == "__main__":
