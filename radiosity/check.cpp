@@ -170,8 +170,9 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     const Rgb value = baked_at(f.mesh, f.triangle, w);
     const Vec3 n = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
                                              mesh.positions[corner[2]] - mesh.positions[corner[0]]));
-    if (input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]], mesh.positions[corner[2]])) {
-      usable[i] = 2;  // inside a solid or under an object: the fit leaves it out too
+    if (input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]], mesh.positions[corner[2]]) ||
+        input_point_buried(scene, p, n)) {
+      usable[i] = 2;  // inside a solid or under an object: no one sees it (the fit leaves buried faces out too)
       return;
     }
     Rgb sum(0.0f), sum_squares(0.0f);

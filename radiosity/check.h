@@ -81,9 +81,9 @@ void write_check_points(const std::string& path, const rc::Scene& scene, const S
 /// down the face normal at the point, E = π (L − Le) / ρ, `settings.samples` samples per point.
 /// Surfaces that are not diffuse or have an albedo with a zero channel are not drawn from, and
 /// a point with something lying on it (the path tracer's ray hits another surface) is left out,
-/// and so is a point on a buried face (input_triangle_buried: inside a closed solid or under an
-/// object; the fit leaves those out) or one no path-traced sample brings any light to: no one
-/// sees their colour.
+/// and so is a buried point (input_triangle_buried for its face, which the fit leaves out, or
+/// input_point_buried for the point: inside a closed solid or under an object) or one no
+/// path-traced sample brings any light to: no one sees their colour.
 SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings);
 

@@ -455,6 +455,14 @@ bool input_triangle_buried(const rc::Scene& scene, const Vec3& a, const Vec3& b,
   return detail::triangle_buried(scene, rc::DVec3(a), rc::DVec3(b), rc::DVec3(c));
 }
 
+bool input_point_buried(const rc::Scene& scene, const Vec3& p, const Vec3& n) {
+  rc::SurfacePoint at;
+  at.p = p;
+  at.p_error = rc::error_gamma(16) * rc::abs(p);
+  at.ng = n;
+  return detail::enclosed(scene, at);
+}
+
 float target_edge_length(const rc::Scene& scene, const MeshSettings& settings) {
   if (!std::isfinite(settings.max_edge) || settings.max_edge < 0.0f)
     throw rc::InputError("mesh: max_edge must be a finite length ≥ 0, not " +

@@ -78,6 +78,10 @@ size_t split_longest_edges(RadiosityMesh& mesh, const std::vector<uint32_t>& ele
 /// lies inside a closed solid or under an object standing on it), and the camera does not see it.
 bool input_triangle_buried(const rc::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c);
 
+/// The same test at one point p of a surface whose front faces n: for a face that is only partly
+/// inside a solid (a wall running down under a roof), the part no one can see.
+bool input_point_buried(const rc::Scene& scene, const Vec3& p, const Vec3& n);
+
 /// The edge length `settings` asks for on this scene (resolving `elements` and the default).
 float target_edge_length(const rc::Scene& scene, const MeshSettings& settings);
 

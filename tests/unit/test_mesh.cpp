@@ -590,6 +590,30 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   EXPECT_EQ(straddling, 0u);
 }
 
+// input_point_buried tests one point of a face that is only partly buried: the floor's two
+// triangles run under the standing and the sunk box, so neither is buried as a whole, but the
+// points under the boxes are, and those beside them and under the floating box are not.
+TEST(Mesh, PointsUnderABoxAreBuriedOnAFaceThatIsNot) {
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+  TriangleMesh floor;
+  floor.positions = {Vec3(-2, -2, 0), Vec3(2, -2, 0), Vec3(2, 2, 0), Vec3(-2, 2, 0)};
+  floor.indices = {0, 1, 2, 0, 2, 3};
+  scene.meshes.push_back(floor);
+  scene.meshes.push_back(closed_box("standing", -0.9, -0.8, 0.45, 0.3, 0.0, 0.0f, 0.8f));
+  scene.meshes.push_back(closed_box("sunk", 0.9, 0.7, 0.35, 0.35, 0.0, -0.25f, 0.6f));
+  scene.meshes.push_back(closed_box("floating", 0.9, -1.1, 0.3, 0.3, 0.0, 0.05f, 0.5f));
+  scene.commit();
+  const Vec3 up(0, 0, 1);
+  EXPECT_FALSE(input_triangle_buried(scene, floor.positions[0], floor.positions[1], floor.positions[2]));
+  EXPECT_FALSE(input_triangle_buried(scene, floor.positions[0], floor.positions[2], floor.positions[3]));
+  EXPECT_TRUE(input_point_buried(scene, Vec3(-0.9f, -0.8f, 0.0f), up)) << "under the standing box";
+  EXPECT_TRUE(input_point_buried(scene, Vec3(0.9f, 0.7f, 0.0f), up)) << "inside the sunk box";
+  EXPECT_FALSE(input_point_buried(scene, Vec3(-1.6f, 1.5f, 0.0f), up)) << "open floor";
+  EXPECT_FALSE(input_point_buried(scene, Vec3(0.9f, -1.1f, 0.0f), up)) << "under the floating box: in view";
+  EXPECT_FALSE(input_point_buried(scene, Vec3(-0.9f, -0.8f, 0.8f), up)) << "the standing box's top";
+}
+
 // A room modelled inside out (a closed box facing outwards, as a scaled cube primitive comes)
 // encloses what stands in it just as a block encloses the floor under it. What the camera inside
 // sees is kept; and when "buried" would take a large share of the scene, nothing is removed.
