@@ -27,12 +27,12 @@
 
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
-#include "raytrace_core/image_error.h"
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

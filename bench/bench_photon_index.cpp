@@ -23,7 +23,7 @@
 #include "photonmap/photon_index.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/scene.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

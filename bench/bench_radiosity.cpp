@@ -45,13 +45,13 @@
 #include "radiosity/mesh.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
-#include "raytrace_core/image_error.h"
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
 #include "raytrace_core/rng.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

@@ -18,11 +18,11 @@
 #include "cli/methods.h"
 #include "cli/report.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/image_error.h"
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/path_tracer.h"
-#include "raytrace_core/scene_io.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/scene_io.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;

@@ -12,7 +12,7 @@
 #include "cli/commands.h"
 #include "photonmap/photon_map.h"
 #include "radiosity/solver.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;

@@ -15,11 +15,11 @@
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/whitted.h"
 
 namespace gilt::cli {

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::cli {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "radiosity/export.h"
 #include "radiosity/solver.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {
   namespace rc = gilt::raytrace_core;

@@ -5,10 +5,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {
   namespace rc = gilt::raytrace_core;

@@ -28,7 +28,7 @@
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/sampling.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::radiosity {
 

@@ -43,7 +43,7 @@
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::radiosity {
 

@@ -16,9 +16,11 @@
 
 #include <tiny_gltf.h>
 
+#include "raytrace_core/io/gltf_file.h"
+
 #include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
+#include "raytrace_core/io/loaders.h"
 #include "raytrace_core/parallel.h"
 
 namespace gilt::radiosity {
@@ -413,17 +415,7 @@ InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked
     return true;
   };
   if (ext == ".gltf" || ext == ".glb") {
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(
-        [](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
-          return true;
-        },
-        nullptr);
-    std::string error, warning;
-    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, file)
-                                  : loader.LoadASCIIFromFile(&model, &error, &warning, file);
-    if (!ok) throw InputError(file + ": " + error);
+    const tinygltf::Model model = rc::read_gltf_file(file);
     // A mesh placed by several nodes shares its UVs between its instances, which are lit
     // differently: the input's sets cannot hold them all.
     std::map<int32_t, std::set<int32_t>> nodes_of_mesh;

@@ -30,7 +30,7 @@
 
 #include "radiosity/export.h"
 #include "radiosity/solver.h"
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 
 namespace gilt::radiosity {
 

@@ -21,11 +21,13 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
+#include "raytrace_core/io/gltf_file.h"
+
 #include "radiosity/lightmap.h"
 #include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/loaders.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::radiosity {
 
@@ -525,19 +527,7 @@ Json& material_for(Json& j, Json& primitive) {
 
 void write_lightmap_gltf(const std::string& input, const std::string& output, const rc::Scene& scene,
                          const Lightmap& lightmap, const ExportSettings& settings, const std::string& image_uri) {
-  tinygltf::Model model;
-  {
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(
-        [](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
-          return true;
-        },
-        nullptr);
-    std::string error, warning;
-    const bool ok = rc::lower_extension(input) == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, input)
-                                                         : loader.LoadASCIIFromFile(&model, &error, &warning, input);
-    if (!ok) throw InputError(input + ": " + (error.empty() ? std::string("cannot read glTF file") : error));
-  }
+  const tinygltf::Model model = rc::read_gltf_file(input);
   GltfOutput o = begin_output(input, output);
   Json& j = o.json();
   std::map<int32_t, int32_t> mesh_of_node;

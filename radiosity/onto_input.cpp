@@ -11,7 +11,7 @@
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
+#include "raytrace_core/io/loaders.h"
 
 namespace gilt::radiosity {
 

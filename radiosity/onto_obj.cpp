@@ -13,7 +13,7 @@
 
 #include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::radiosity {
 

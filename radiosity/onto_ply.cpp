@@ -17,8 +17,8 @@
 
 #include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
-#include "raytrace_core/ply_header.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/ply_header.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::radiosity {
 

@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace gilt::raytrace_core {
 

@@ -17,7 +17,7 @@
 #include <string_view>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace gilt::fuzz {
 

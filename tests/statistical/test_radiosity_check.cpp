@@ -16,7 +16,7 @@
 #include "radiosity/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

@@ -15,12 +15,12 @@
 #include <cmath>
 #include <cstdio>
 
-#include "raytrace_core/image_error.h"
+#include "raytrace_core/io/image_error.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

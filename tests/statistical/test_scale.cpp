@@ -15,7 +15,7 @@
 
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;

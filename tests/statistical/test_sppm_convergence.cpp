@@ -14,11 +14,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "raytrace_core/image_error.h"
+#include "raytrace_core/io/image_error.h"
 #include "photonmap/sppm.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/stress/bad_files.h"
 #include "tests/stress/stress_support.h"
 

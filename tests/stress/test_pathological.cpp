@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/stress/stress_support.h"
 
 namespace rc = gilt::raytrace_core;

@@ -39,7 +39,7 @@
 #include <tuple>
 #include <vector>
 
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/stress/stress_support.h"
 
 namespace rc = gilt::raytrace_core;

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 
 #include "tests/support/cli_run.h"
 

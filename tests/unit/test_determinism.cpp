@@ -6,10 +6,10 @@
 #include <fstream>
 #include <iterator>
 
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 

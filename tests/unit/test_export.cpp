@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
 namespace gilt::radiosity {

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "raytrace_core/image_error.h"
+#include "raytrace_core/io/image_error.h"
 
 namespace rc = gilt::raytrace_core;
 

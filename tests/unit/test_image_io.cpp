@@ -1,6 +1,6 @@
 // Image files: round trips within each format's precision, and atomic, tidy writes.
 
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>

@@ -20,8 +20,8 @@
 #include "radiosity/check.h"
 #include "radiosity/lightmap.h"
 #include "radiosity/solver.h"
-#include "raytrace_core/image_io.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/model_files.h"
 

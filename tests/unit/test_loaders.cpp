@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace gilt::raytrace_core {
 namespace {

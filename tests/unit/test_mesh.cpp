@@ -19,7 +19,7 @@
 #include "radiosity/mesh.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
 namespace gilt::radiosity {

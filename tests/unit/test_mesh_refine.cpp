@@ -9,7 +9,7 @@
 #include <numeric>
 
 #include "radiosity/solver.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

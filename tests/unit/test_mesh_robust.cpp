@@ -25,7 +25,7 @@
 #include "radiosity/mesh_detail.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/parallel.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/ply_header.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/ply_header.h"
+#include "raytrace_core/io/scene_io.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/model_files.h"
 

@@ -11,7 +11,7 @@
 #include "photonmap/photon_map.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

@@ -25,10 +25,12 @@
 #include <vector>
 
 #include <tiny_gltf.h>
+
+#include "raytrace_core/io/gltf_file.h"
 #include <glm/gtc/quaternion.hpp>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
+#include "raytrace_core/io/loaders.h"
 
 namespace gilt::raytrace_core {
 
@@ -387,36 +389,12 @@ class GltfLoader {
   bool camera_done_ = false;
 };
 
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                void*) {
-  return true;  // textures are not used: do not decode them
-}
-
-std::string trim(std::string s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
-  return s;
-}
 
 }  // namespace
 
 void load_gltf(const fs::path& path, Scene& scene) {
   const std::string file = path.string();
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skip_image, nullptr);
-  std::string error, warning;
-  bool ok = false;
-  try {
-    ok = lower_extension(path) == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, file)
-                                         : loader.LoadASCIIFromFile(&model, &error, &warning, file);
-  } catch (const std::exception& e) {
-    throw InputError(file + ": " + e.what());
-  }
-  std::istringstream lines(warning);
-  for (std::string w; std::getline(lines, w);)
-    if (!trim(w).empty()) scene.warnings.push_back(file + ": " + trim(w));
-  if (!ok)
-    throw InputError(file + ": " + (error.empty() ? std::string("cannot read glTF file") : trim(error)));
+  const tinygltf::Model model = read_gltf_file(file, &scene.warnings);
   GltfLoader(model, file, scene).load();
 }
 

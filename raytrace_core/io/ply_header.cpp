@@ -1,6 +1,6 @@
 // PLY header parsing (see ply_header.h).
 
-#include "raytrace_core/ply_header.h"
+#include "raytrace_core/io/ply_header.h"
 
 #include <algorithm>
 #include <cctype>

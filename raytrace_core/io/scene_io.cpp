@@ -1,7 +1,7 @@
 // Scene loading entry points: a built-in name or a file dispatched by its extension, then commit.
 // The format loaders live in load_*.cpp, the built-in scenes in builtin_scenes.cpp.
 
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/scene_io.h"
 
 #include <algorithm>
 #include <cctype>
@@ -13,7 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
+#include "raytrace_core/io/loaders.h"
 
 namespace gilt::raytrace_core {
 

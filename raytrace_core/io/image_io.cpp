@@ -8,7 +8,7 @@
 // Non-finite pixel values (NaN, ±inf) are written as 0: no file ever holds them. Callers that want
 // to warn about them check Film::non_finite_count() before writing.
 
-#include "raytrace_core/image_io.h"
+#include "raytrace_core/io/image_io.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -29,7 +29,7 @@
 #include <system_error>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::raytrace_core {
 

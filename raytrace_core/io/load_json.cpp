@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
-#include "raytrace_core/scene_io.h"
+#include "raytrace_core/io/loaders.h"
+#include "raytrace_core/io/scene_io.h"
 
 namespace gilt::raytrace_core {
 

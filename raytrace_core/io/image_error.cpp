@@ -1,4 +1,4 @@
-#include "raytrace_core/image_error.h"
+#include "raytrace_core/io/image_error.h"
 
 #include <cmath>
 #include <stdexcept>

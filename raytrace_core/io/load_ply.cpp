@@ -25,8 +25,8 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
 #include "raytrace_core/error.h"
-#include "raytrace_core/loaders.h"
-#include "raytrace_core/ply_header.h"
+#include "raytrace_core/io/loaders.h"
+#include "raytrace_core/io/ply_header.h"
 
 namespace gilt::raytrace_core {
 

@@ -1,7 +1,7 @@
 // Atomic file output through a temporary file and rename (POSIX: open O_EXCL, write, fsync,
 // rename(2) within one folder).
 
-#include "raytrace_core/staged_file.h"
+#include "raytrace_core/io/staged_file.h"
 
 #include <fcntl.h>
 #include <unistd.h>
