@@ -31,6 +31,7 @@
 #include <CGAL/Surface_mesh.h>
 
 #include "radiosity/mesh_detail.h"
+#include "radiosity/ordered_heap.h"
 
 namespace gilt::radiosity::detail {
 namespace {
@@ -245,6 +246,10 @@ size_t imprint_contacts(Part& part, const std::vector<const Part*>& tools, Const
       ++counts.contacts_failed;
       continue;
     }
+    // Corefinement orders what it cuts by memory addresses (see OrderedHeap): it runs in a heap
+    // of its own, so the cuts depend on the two meshes alone. Nothing made in it may outlive it:
+    // the exception is caught and the result copied out inside.
+    OrderedHeap heap;
     try {
       // corefine() takes the tool by non-const reference even when it leaves it unmodified, and
       // the shared tools are read by other threads: it works on a copy. The piece is cut as a
@@ -253,7 +258,8 @@ size_t imprint_contacts(Part& part, const std::vector<const Part*>& tools, Const
       Constrained cut_constrained = cut.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
       PMP::corefine(cut, tool_copy, CGAL::parameters::edge_is_constrained_map(cut_constrained),
                     CGAL::parameters::do_not_modify(true));
-      part.mesh = std::move(cut);
+      const OrderedHeap::Outside outside(heap);
+      part.mesh = cut;
     } catch (const std::exception&) {
       ++counts.contacts_failed;  // corefinement gave up on this pair; the piece is meshed without it
     }
