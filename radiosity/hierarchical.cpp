@@ -292,6 +292,20 @@ struct Counters {
   std::atomic<uint64_t> rays{0}, form_factors{0}, gather_nodes{0};
 };
 
+/// A pair of nodes to refine, with its visible fraction when already known (else −1).
+struct OpenPair {
+  uint32_t receiver, source;
+  float visible;
+};
+
+/// What linking to one tolerance made: exact element-to-element links (final at any
+/// tolerance), far links, and the far pairs they came from (accepted or wholly hidden), which a
+/// finer tolerance refines further instead of linking again from the root.
+struct LinkLevel {
+  std::vector<Link> exact, far;
+  std::vector<OpenPair> open;
+};
+
 class Linker {
  public:
   bool out_of_time() const { return in_.out_of_time && in_.out_of_time(); }
@@ -307,49 +321,66 @@ class Linker {
         settings_(settings),
         counters_(counters) {}
 
-  /// The accepted links, or nothing when `in.out_of_time` said stop before linking finished.
-  std::optional<std::vector<Link>> link() {
-    if (tree_.nodes.empty()) return std::vector<Link>{};
-    // Breadth-first from the root pair until there are enough pairs to share out, then each
-    // pair's refinement runs on its own, its links appended in pair order (deterministic).
-    std::vector<std::pair<uint32_t, uint32_t>> frontier{{0, 0}}, next;
-    std::vector<Link> links;
+  /// Whether to keep the accepted far pairs (`LinkLevel::open`) for a finer level to refine.
+  Linker& keeping_open_pairs(bool keep) {
+    keep_open_ = keep;
+    return *this;
+  }
+
+  /// The links made by refining every pair of `start` to this linker's tolerance (the root
+  /// pair {0, 0} to link afresh), or nothing when `in.out_of_time` said stop before it finished.
+  std::optional<LinkLevel> link(std::span<const OpenPair> start) {
+    LinkLevel level;
+    if (tree_.nodes.empty()) return level;
+    // Breadth-first until there are enough pairs to share out, then each chunk of pairs is
+    // refined on its own, its output appended in chunk order (deterministic).
+    std::vector<OpenPair> frontier(start.begin(), start.end()), next;
     while (!frontier.empty() && frontier.size() < 4096) {
       next.clear();
-      for (const auto& [r, s] : frontier) refine(r, s, links, next);
+      for (const OpenPair& p : frontier) refine(p, level, next);
       frontier.swap(next);
     }
-    std::vector<std::vector<Link>> parts(frontier.size());
+    const size_t per_chunk = (frontier.size() + 4095) / 4096;
+    std::vector<LinkLevel> parts(per_chunk == 0 ? 0 : (frontier.size() + per_chunk - 1) / per_chunk);
     std::atomic<bool> stopped{false};
-    rc::parallel_for(frontier.size(), [&](size_t i) {
-      std::vector<std::pair<uint32_t, uint32_t>> stack{frontier[i]};
-      for (uint32_t steps = 1; !stack.empty(); ++steps) {
-        // The clock is read every 4,096 pairs: often enough to stop within milliseconds.
-        if (steps % 4096 == 0 && (stopped.load(std::memory_order_relaxed) || out_of_time())) {
-          stopped = true;
-          return;
+    rc::parallel_for(parts.size(), [&](size_t i) {
+      std::vector<OpenPair> stack;
+      uint32_t steps = 0;
+      for (size_t f = i * per_chunk; f < std::min(frontier.size(), (i + 1) * per_chunk); ++f) {
+        stack.push_back(frontier[f]);
+        while (!stack.empty()) {
+          // The clock is read every 4,096 pairs, often enough to stop within milliseconds, and
+          // the flag at every pair, so chunks started after the stop end at once.
+          if (++steps % 4096 == 0 && out_of_time()) stopped = true;
+          if (stopped.load(std::memory_order_relaxed)) return;
+          const OpenPair p = stack.back();
+          stack.pop_back();
+          refine(p, parts[i], stack);
         }
-        const auto [r, s] = stack.back();
-        stack.pop_back();
-        refine(r, s, parts[i], stack);
       }
     });
     if (stopped) return std::nullopt;
-    for (auto& part : parts) links.insert(links.end(), part.begin(), part.end());
-    return links;
+    for (auto& part : parts) {
+      level.exact.insert(level.exact.end(), part.exact.begin(), part.exact.end());
+      level.far.insert(level.far.end(), part.far.begin(), part.far.end());
+      level.open.insert(level.open.end(), part.open.begin(), part.open.end());
+    }
+    return level;
   }
 
  private:
-  /// Accepts, drops or splits the pair (r, s): accepted links go to `links`, halves to `pending`.
-  void refine(uint32_t r, uint32_t s, std::vector<Link>& links,
-              std::vector<std::pair<uint32_t, uint32_t>>& pending) {
+  /// Accepts, drops or splits the pair (r, s): links go to `out` (with the accepted far pairs,
+  /// which a finer tolerance may split), halves to `pending`. A known visible fraction (≥ 0)
+  /// saves the pair's shadow rays.
+  void refine(const OpenPair& pair, LinkLevel& out, std::vector<OpenPair>& pending) {
+    const uint32_t r = pair.receiver, s = pair.source;
     const Node& R = tree_.nodes[r];
     const Node& S = tree_.nodes[s];
     if (r == s) {
       if (R.leaf()) return;
       const uint32_t kids[2] = {r + 1, R.right};
       for (uint32_t a : kids)
-        for (uint32_t b : kids) pending.emplace_back(a, b);
+        for (uint32_t b : kids) pending.push_back({a, b, -1.0f});
       return;
     }
     // Nothing to gather: the receiver reflects nothing, the source sends nothing, or they face away.
@@ -358,7 +389,10 @@ class Linker {
       const uint32_t er = tree_.element(R), es = tree_.element(S);
       ++counters_.form_factors;
       const float f = float(tree_.triangles[es].form_factor(R.center, in_.mesh.element_normal[er]));
-      if (f > 0.0f) add(r, s, in_.mesh.element_normal[er], f, true, links);
+      if (f > 0.0f) {
+        const float visible = visibility(r, s);
+        if (visible > 0.0f) out.exact.push_back({r, s, in_.mesh.element_normal[er], f * visible, true});
+      }
       return;
     }
     const Vec3 d = S.center - R.center;
@@ -379,10 +413,14 @@ class Linker {
         // the source. Where the source is partly hidden, the hidden and the open elements get the
         // same share: light meant for a wall's inner face lands on its outer face and leaves the
         // room. Such a link is kept only where a tenth of its error is still acceptable.
-        const float visible = visibility(r, s);
-        if (!(visible > 0.0f)) return;
+        const float visible = pair.visible >= 0.0f ? pair.visible : visibility(r, s);
+        if (!(visible > 0.0f)) {
+          if (keep_open_) out.open.push_back({r, s, 0.0f});  // hidden here; a finer tolerance splits it
+          return;
+        }
         if (visible >= 1.0f || error * kPartialVisibility <= epsilon_) {
-          split_mixed(r, s, 0, 0, visible, links);
+          if (keep_open_) out.open.push_back({r, s, visible});
+          split_mixed(r, s, 0, 0, visible, out.far);
           return;
         }
       }
@@ -390,23 +428,12 @@ class Linker {
     // Split the larger end (a leaf cannot be split).
     const bool split_receiver = S.leaf() || (!R.leaf() && R.radius >= S.radius);
     if (split_receiver) {
-      pending.emplace_back(r + 1, s);
-      pending.emplace_back(R.right, s);
+      pending.push_back({r + 1, s, -1.0f});
+      pending.push_back({R.right, s, -1.0f});
     } else {
-      pending.emplace_back(r, s + 1);
-      pending.emplace_back(r, S.right);
+      pending.push_back({r, s + 1, -1.0f});
+      pending.push_back({r, S.right, -1.0f});
     }
-  }
-
-  /// Adds the link with its visible fraction (dropped when nothing is visible).
-  void add(uint32_t r, uint32_t s, const Vec3& dir, float factor, bool exact, std::vector<Link>& links) {
-    const float visible = visibility(r, s);
-    if (!(visible > 0.0f)) return;
-    if (exact) {
-      links.push_back({r, s, dir, factor * visible, true});
-      return;
-    }
-    split_mixed(r, s, 0, 0, visible, links);
   }
 
   /// The visible fraction between nodes r and s, by link_rays shadow rays (1 when nothing can
@@ -469,6 +496,7 @@ class Linker {
   double epsilon_;
   const HierarchicalSettings& settings_;
   Counters& counters_;
+  bool keep_open_ = false;
 };
 
 /// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
@@ -686,16 +714,19 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
 
   // Links, grouped by receiver for gathering. Without a time limit they are made once, at the
   // requested tolerance. With one, a ladder of tolerances from 1,000 times coarser runs down to
-  // it, each level linked afresh and its iteration started from the last level's solution,
-  // while the next level's predicted cost (the last one's times its observed growth) still fits:
-  // a coarse solution in time beats a fine one cut off before it iterates.
+  // it, each level's iteration started from the last level's solution (below: while time is
+  // left): a coarse solution in time beats a fine one cut off before it iterates. Each level
+  // refines the pairs the last one accepted rather than linking again from the root: the split
+  // decisions above them would be the same, and their visible fractions are kept, so the whole
+  // ladder costs about what its last level costs alone, and makes the same links.
   const double link_tolerance = settings.link_tolerance > 0.0 ? settings.link_tolerance : kDefaultLinkTolerance;
   const bool timed = bool(in.seconds_left);
   std::vector<double> ladder;
   if (timed)
     for (double t = link_tolerance * 1000.0; t > link_tolerance * 1.5; t /= 10.0) ladder.push_back(t);
   ladder.push_back(link_tolerance);
-  std::vector<Link> links;
+  std::vector<Link> links, exact_links;
+  std::vector<OpenPair> open_pairs{{0, 0, -1.0f}};
   std::vector<uint32_t> receivers, first_link;
   // One gathering step: pull B up the tree, gather over the links, push the gathered irradiance
   // down to the elements.
@@ -784,22 +815,33 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   const auto seconds_since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
-  double last_link = 0.0, last_iterate = 0.0, growth = 3.0;
+  // The next level is tried while the time left exceeds the last level's iteration: since it
+  // only refines what the last one made, its cost is hard to foretell (on Šibenik the levels took
+  // 6.7, 1.6, 5.6 and 4.9 s), and one cut off by the clock leaves the last level's solution as it
+  // was, while one that links in time but iterates only partly still moves it towards its own.
+  double last_iterate = 0.0;
   for (size_t level = 0; level < ladder.size(); ++level) {
-    if (level > 0 && last_link * growth + last_iterate > in.seconds_left()) break;
+    if (level > 0 && last_iterate > in.seconds_left()) break;
     const auto link_start = std::chrono::steady_clock::now();
-    std::optional<std::vector<Link>> made = Linker(in, tree, power_estimate, moment_estimate,
-                                                   ladder[level] * total_estimate, settings, counters)
-                                                .link();
-    const double link_seconds = seconds_since(link_start);
-    result.link_seconds += link_seconds;
-    if (!made) {
+    const bool last = level + 1 == ladder.size();
+    std::optional<LinkLevel> made = Linker(in, tree, power_estimate, moment_estimate,
+                                           ladder[level] * total_estimate, settings, counters)
+                                        .keeping_open_pairs(!last)
+                                        .link(open_pairs);
+    result.link_seconds += seconds_since(link_start);
+    // Sorting the links and bounding their gains cost about what an iteration does: a level that
+    // finished linking without that much time left is dropped too.
+    if (!made || (level > 0 && last_iterate > in.seconds_left())) {
       result.linking_stopped = true;
       break;
     }
-    if (level > 0 && last_link > 0.0) growth = std::max(1.5, link_seconds / last_link);
-    last_link = link_seconds;
-    links = std::move(*made);
+    exact_links.insert(exact_links.end(), made->exact.begin(), made->exact.end());
+    open_pairs = std::move(made->open);
+    if (last)
+      links = std::move(exact_links);
+    else
+      links = exact_links;
+    links.insert(links.end(), made->far.begin(), made->far.end());
     std::stable_sort(links.begin(), links.end(),
                      [](const Link& a, const Link& b) { return a.receiver < b.receiver; });
     receivers.clear();

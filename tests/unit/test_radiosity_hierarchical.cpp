@@ -308,6 +308,10 @@ TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
   const rad::Solution ample = rad::solve(scene, s);
   EXPECT_DOUBLE_EQ(ample.link_tolerance, rad::kDefaultLinkTolerance);
   EXPECT_FALSE(ample.linking_stopped);
+  // Each level of the ladder refines the pairs the last one accepted: the split decisions above
+  // them are those of linking from the root, and a pair's visibility rays are keyed by the pair,
+  // so the last level makes exactly the links the untimed solve makes.
+  EXPECT_EQ(ample.links, untimed.links);
   EXPECT_NEAR(mean_radiance(ample) / mean_radiance(untimed), 1.0, 0.01);
   s.time_limit = 1e-6;
   const rad::Solution none = rad::solve(scene, s);
