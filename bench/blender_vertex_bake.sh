@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # gilt's vertex bake against the one a Blender user would make (Cycles' vertex-colour bake, run by
 # ../shared/tools/cycles_bake.py), on Šibenik under a sun and sky, scored at the same random
-# points against one path-traced reference. Blender's bake script reads only Kd and Ke, so the
-# windows' glass (which it would make black and opaque, and gilt would let light through) is
-# taken out of a copy of the model: both tools then light the same open-windowed interior.
+# points against one path-traced reference. The windows' glass is taken out of a copy of the
+# model (scripts/sibenik_open.py): both tools then light the same open-windowed interior.
 #   bench/blender_vertex_bake.sh [GILT_TIME [BLENDER_SAMPLES [REFERENCE_SAMPLES]]]
 # Needs build/cli/gilt, blender and python3-numpy. Figures in bench/README.md.
 set -euo pipefail
@@ -14,23 +13,7 @@ seconds=${1:-60} samples=${2:-16} reference=${3:-16384}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 py=/usr/bin/python3
-$py - "$shared/scenes/sibenik" "$work" <<'PY'
-import sys, os
-src, dst = sys.argv[1], sys.argv[2]
-out, skip = [], False
-for line in open(os.path.join(src, "sibenik.obj")):
-    t = line.split()
-    if t and t[0] == "usemtl": skip = t[1].startswith("staklo")   # the glass materials
-    if t and t[0] == "f" and skip: continue
-    out.append(line)
-open(os.path.join(dst, "open.obj"), "w").write("".join(out))
-mtl = []
-for line in open(os.path.join(src, "sibenik.mtl")):
-    t = line.split()
-    if t and t[0] in ("Ks", "Tf", "d", "Tr", "illum"): continue  # diffuse only, as the bake script reads it
-    mtl.append(line)
-open(os.path.join(dst, "sibenik.mtl"), "w").write("".join(mtl))
-PY
+$py "$here/scripts/sibenik_open.py" "$shared/scenes/sibenik" "$work"
 cat > "$work/open.json" <<'JSON'
 {"meshes": [{"file": "open.obj"}],
  "lights": [{"type": "directional", "direction": [0.35, -1, 0.45], "irradiance": 8},
