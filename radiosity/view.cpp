@@ -49,6 +49,16 @@ bool scatter_specular(const rc::Material& m, const rc::SurfaceInteraction& si, c
 
 }  // namespace
 
+/// A point of the input closer than this fraction of the view's reach to the element found for
+/// it lies on that element (up to rounding).
+constexpr float kOnElement = 1e-4f;
+/// How far behind an element's plane, as a fraction of the view's reach (twice the target
+/// edge), a point of a concave surface it is a chord of may lie (see indirect_irradiance).
+constexpr float kChordDepth = 0.035f;
+/// Diffuse bounces a gather ray takes past surfaces that have no element on the side it meets
+/// (the backs of one-sided surfaces, which the solution leaves out).
+constexpr int kUnmeshedBounces = 2;
+
 /// cos 60°: an element lit on the same side as the input point faces within 60° of it (the
 /// mesher splits vertices at sharper creases, so a steeper element belongs to another side).
 constexpr float kFacing = 0.5f;
@@ -58,13 +68,17 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   const RadiosityMesh& mesh = solution.mesh;
   const size_t nv = mesh.vertex_count();
   vertex_radiance_.resize(nv);
-  vertex_irradiance_.resize(nv);
+  vertex_indirect_.resize(nv);
   for (size_t v = 0; v < nv; ++v) {
     const Rgb rho = scene.materials[mesh.vertex_material[v]].albedo;
     vertex_radiance_[v] = solution.vertex_radiance(v);
     if (ambient) vertex_radiance_[v] += rho * solution.ambient * (1.0f / rc::kPi);
-    vertex_irradiance_[v] = solution.vertex_irradiance[v] + (ambient ? solution.ambient : Rgb(0.0f));
+    Rgb indirect = solution.vertex_irradiance[v] - solution.vertex_direct[v];
+    for (int k = 0; k < 3; ++k) indirect[k] = std::max(0.0f, indirect[k]);
+    vertex_indirect_[v] = indirect + (ambient ? solution.ambient : Rgb(0.0f));
   }
+  positions_ = mesh.positions;
+  element_normal_ = mesh.element_normal;
   // An input point lies within about an element's size of the element that stands for it
   // (elements are chords of a curved input); twice the target edge leaves room for bisection
   // and for input faces kept as they were.
@@ -86,12 +100,21 @@ std::optional<RadiosityView::Location> RadiosityView::locate(const Vec3& p, cons
   return Location{near->prim_id, near->u, near->v, near->t};
 }
 
-std::optional<Rgb> RadiosityView::irradiance(const Vec3& p, const Vec3& n) const {
-  const std::optional<Location> at = locate(p, n);
+std::optional<Rgb> RadiosityView::indirect_irradiance(const rc::SurfacePoint& p, const Vec3& n) const {
+  const std::optional<Location> at = locate(p.p, n);
   if (!at) return std::nullopt;
   const auto& e = elements_[at->element];
-  return vertex_irradiance_[e[0]] * (1.0f - at->u - at->v) + vertex_irradiance_[e[1]] * at->u +
-         vertex_irradiance_[e[2]] * at->v;
+  const float w0 = 1.0f - at->u - at->v;
+  // Off the element, p may lie on a curved surface that the element is a chord of, or on another
+  // surface entirely: the far side of a wall or slab whose near side has no element. A chord
+  // spans at most the sharp angle (30°) of arc, so a concave surface lies behind it by at most
+  // (1 − cos 15°) / (2 sin 15°) ≈ 0.066 of its length; p farther behind the element's plane is
+  // not on it.
+  if (at->distance > kOnElement * reach_) {
+    const Vec3 q = positions_[e[0]] * w0 + positions_[e[1]] * at->u + positions_[e[2]] * at->v;
+    if (glm::dot(p.p - q, element_normal_[at->element]) < -kChordDepth * reach_) return std::nullopt;
+  }
+  return vertex_indirect_[e[0]] * w0 + vertex_indirect_[e[1]] * at->u + vertex_indirect_[e[2]] * at->v;
 }
 
 Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
@@ -102,29 +125,47 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   Vec3 wi = frame.to_world(rc::sample_cosine_hemisphere(ctx.rng.uniform2()));
   if (!wo_above) wi = -wi;                            // the frame's z is the front's shading normal
   if (glm::dot(wi, side) <= 0.0f) return Rgb(0.0f);  // the shading normal leans the ray through the surface
-  Rgb beta(rc::kPi);
+  Rgb beta(rc::kPi), out(0.0f);
   rc::Ray ray = rc::spawn_ray(si, wi);
+  // Emitters and the sky are next-event estimation's after a diffuse bounce; through glass or a
+  // mirror, shadow rays cannot see them, and the ray is their only way in.
+  bool via_specular = false;
+  int diffuse_left = kUnmeshedBounces;
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    // Straight from x, emitters and the sky are next-event estimation's; through glass or a
-    // mirror, shadow rays cannot see them, and the gather ray is their only way in.
-    if (!hit) return depth > 0 ? beta * environment_ : Rgb(0.0f);
+    if (!hit) return via_specular ? out + beta * environment_ : out;
     const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
     const rc::Material& mj = scene_.materials[sj.material];
     const Vec3 wo_world = -glm::normalize(ray.direction);
     absorb(mj, sj, *hit, ray, beta);
-    Rgb found(0.0f);
-    if (depth > 0 && mj.is_emissive()) found += rc::emitted_radiance(mj, sj.ng, wo_world);
-    if (!mj.is_specular()) {
-      const bool above = glm::dot(wo_world, sj.ng) > 0.0f;
-      return beta * (found + mj.albedo * irradiance(sj.p, above ? sj.ng : -sj.ng).value_or(Rgb(0.0f)) * (1.0f / rc::kPi));
-    }
-    const Rgb seen = beta * found;
+    if (via_specular && mj.is_emissive()) out += beta * rc::emitted_radiance(mj, sj.ng, wo_world);
     const rc::Frame fj = rc::Frame::from_normal(sj.ns);
-    if (!scatter_specular(mj, sj, fj, fj.to_local(wo_world), ctx.rng, beta, ray)) return seen;
+    const Vec3 wo = fj.to_local(wo_world);
+    if (!mj.is_specular()) {
+      // Direct light by a shadow ray, as at the camera's point: the solution holds it only at its
+      // vertices, and across an element that a shadow edge crosses their mean may be anything
+      // from none of it to all of it. On Šibenik's nave (elements as large as the input's
+      // triangles) reading it there made the sunlight's first bounce 1.45 times too bright.
+      const bool above = glm::dot(wo_world, sj.ng) > 0.0f;
+      const Vec3 lit = above ? sj.ng : -sj.ng;
+      out += beta * rc::sample_direct(scene_, sj, mj, fj, wo, above, ctx.rng, ctx.rays).value;
+      if (const std::optional<Rgb> e = indirect_irradiance(sj, lit))
+        return out + beta * mj.albedo * *e * (1.0f / rc::kPi);
+      // No element stands for this side of the surface: one more diffuse bounce from here.
+      if (diffuse_left-- == 0) return out;
+      Vec3 next = fj.to_world(rc::sample_cosine_hemisphere(ctx.rng.uniform2()));
+      if (!above) next = -next;
+      if (glm::dot(next, lit) <= 0.0f) return out;
+      beta *= mj.albedo;  // Lambertian: f cos / pdf
+      ray = rc::spawn_ray(sj, next);
+      via_specular = false;
+      continue;
+    }
+    if (!scatter_specular(mj, sj, fj, wo, ctx.rng, beta, ray)) return out;
+    via_specular = true;
   }
-  return Rgb(0.0f);
+  return out;
 }
 
 Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {

@@ -48,10 +48,11 @@ class RadiosityView {
   Rgb radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
 
   /// Irradiance (W·m⁻²) the solution gives a point of the input at p whose lit side faces along
-  /// the unit normal n: interpolated at the nearest point of an element that faces the same way
-  /// (within 60°) and lies within reach (twice the target edge); nothing where none does (the
-  /// surface was buried, or is a mirror or glass).
-  std::optional<Rgb> irradiance(const Vec3& p, const Vec3& n) const;
+  /// the unit normal n from other surfaces' reflections (the direct light left out): interpolated
+  /// at the nearest point of an element that faces the same way (within 60°) and lies within
+  /// reach (twice the target edge), unless p lies behind the element's plane by more than a
+  /// chord of a concave surface could. Nothing where no element does: the back of a one-sided surface, a face removed as buried, a mirror or glass.
+  std::optional<Rgb> indirect_irradiance(const rc::SurfacePoint& p, const Vec3& n) const;
 
   /// Where irradiance() reads the solution for a point of the input at p with lit side along n:
   /// the element's index and the barycentrics of its second and third vertex.
@@ -64,7 +65,8 @@ class RadiosityView {
 
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
-  /// cosine-distributed gather ray (through mirrors and glass) read against the solution, times π.
+  /// cosine-distributed gather ray (through mirrors and glass), times π: where it lands, direct
+  /// light by a shadow ray and the rest read from the solution.
   Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx) const;
   Rgb mesh_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
   Rgb two_pass_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
@@ -73,7 +75,9 @@ class RadiosityView {
   ViewMode mode_;
   rc::Scene display_;                        ///< the elements (geometry 0) and the specular surfaces
   std::vector<Rgb> vertex_radiance_;         ///< mesh view: W·sr⁻¹·m⁻²
-  std::vector<Rgb> vertex_irradiance_;       ///< two-pass view: W·m⁻², ambient term included
+  std::vector<Rgb> vertex_indirect_;         ///< two-pass view: W·m⁻² from reflections, ambient term included
+  std::vector<Vec3> positions_;              ///< of the elements' vertices
+  std::vector<Vec3> element_normal_;
   std::vector<std::array<uint32_t, 3>> elements_;
   float reach_ = 0.0f;                       ///< how far from an element the two-pass view looks it up
   Rgb environment_{0.0f};
