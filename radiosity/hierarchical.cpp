@@ -228,17 +228,40 @@ bool sends_nothing(const Node& s, const Vec3& p, const Vec3& n) {
   return glm::dot(s.normal, -d) - s.low + s.spread * far <= kPlaneSlack * near;
 }
 
-/// Radiant intensity (W·sr⁻¹) of node s towards unit direction ω, from Σ B A and Σ B A n.
-Rgb intensity(const Node& s, const Rgb& power, const RgbVec& moment, const Vec3& omega) {
-  const Rgb along = moment.dot(omega);
-  const Facing side = facing(s, omega);
-  Rgb out;
-  for (int k = 0; k < 3; ++k) {
-    const float x =
-        side == Facing::front ? along[k] : (side == Facing::back ? 0.0f : 0.25f * power[k] + 0.5f * along[k]);
-    out[k] = std::max(0.0f, x) * (1.0f / kPi);
+/// Six direction bins: ±x, ±y, ±z by w's largest component.
+constexpr int kDirectionBins = 6;
+int direction_bin(const Vec3& w) {
+  const Vec3 a = glm::abs(w);
+  const int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+  return 2 * axis + (w[axis] < 0.0f ? 1 : 0);
+}
+
+/// Σ B A n of a node's elements, per bin of their normals.
+struct Moments {
+  RgbVec bins[kDirectionBins];
+  void add(const Rgb& power, const Vec3& n) { bins[direction_bin(n)].add(power, n); }
+  void add(const Moments& o) {
+    for (int b = 0; b < kDirectionBins; ++b) bins[b].add(o.bins[b]);
   }
-  return out;
+  RgbVec total() const {
+    RgbVec t;
+    for (const RgbVec& b : bins) t.add(b);
+    return t;
+  }
+};
+
+/// Radiant intensity (W·sr⁻¹) of a node towards unit direction ω: Σ B A max(0, n·ω) / π over its
+/// elements, as Σ over normal bins of max(0, ω·Σ B A n). Exact where each bin's elements all
+/// face ω or all face away (always for a flat node); where they split, the parts cancel and the
+/// bin gives less. The bins keep a wall's sunlit outer face from shining through to its inner
+/// face, which a two-band model of the node (¼ Σ B A + ½ ω·Σ B A n) sends a quarter of its power.
+Rgb intensity(const Moments& moment, const Vec3& omega) {
+  Rgb out(0.0f);
+  for (const RgbVec& bin : moment.bins) {
+    const Rgb along = bin.dot(omega);
+    for (int k = 0; k < 3; ++k) out[k] += std::max(0.0f, along[k]);
+  }
+  return out * (1.0f / kPi);
 }
 
 /// What a node sends towards (or receives from) unit direction ω, by the cluster models above:
@@ -501,10 +524,10 @@ class Linker {
 
 /// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
 void pull(const Tree& tree, const RadiosityMesh& mesh, std::span<const Rgb> radiosity,
-          std::vector<Rgb>& power, std::vector<RgbVec>& moment) {
+          std::vector<Rgb>& power, std::vector<Moments>& moment) {
   const size_t n = tree.nodes.size();
   power.assign(n, Rgb(0.0f));
-  moment.assign(n, RgbVec{});
+  moment.assign(n, Moments{});
   for (size_t i = n; i-- > 0;) {
     const Node& node = tree.nodes[i];
     if (node.leaf()) {
@@ -550,7 +573,7 @@ struct TreeWalk {
   const Tree& tree;
   std::span<const Rgb> radiosity;  ///< per element
   const std::vector<Rgb>& power;
-  const std::vector<RgbVec>& moment;
+  const std::vector<Moments>& moment;
 
   Rgb irradiance(size_t v, double epsilon, int rays, rc::Rng& rng, std::vector<uint32_t>& stack,
                  WalkCounts& counts) const {
@@ -589,14 +612,14 @@ struct TreeWalk {
         }
         const float cos_receiver = glm::dot(n, d) / dist;
         if (!(cos_receiver > 0.0f)) continue;
-        value = intensity(S, power[s], moment[s], -d / dist) * (cos_receiver / (dist * dist));
+        value = intensity(moment[s], -d / dist) * (cos_receiver / (dist * dist));
       }
       rc::Bounds3 reach = S.box;
       reach.extend(p);
       if (in.may_be_blocked(reach)) {
         const Vec3 omega = glm::normalize(p - S.center);
         auto sends = [&](uint32_t c) {
-          const RgbVec& m = moment[c];
+          const RgbVec m = moment[c].total();
           return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f),
                          omega);
         };
@@ -639,7 +662,7 @@ std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const
   if (!(total > 0.0) || first_vertex >= nv) return out;
   const Tree tree = TreeBuilder(mesh, in.albedo).build();
   std::vector<Rgb> power;
-  std::vector<RgbVec> moment;
+  std::vector<Moments> moment;
   pull(tree, mesh, emitted, power, moment);
   const TreeWalk walker{in, tree, emitted, power, moment};
   // The emitted power spread over every surface: a scale of the direct irradiance.
@@ -683,8 +706,9 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   double reflected = 0.0, area = 0.0, albedo = 0.0;
   for (size_t e = 0; e < ne; ++e) {
     const auto& el = mesh.elements[e];
-    direct[e] = (in.direct_irradiance[el[0]] + in.direct_irradiance[el[1]] + in.direct_irradiance[el[2]]) *
-                (1.0f / 3.0f);
+    direct[e] = in.element_direct.empty() ? (in.direct_irradiance[el[0]] + in.direct_irradiance[el[1]] +
+                                             in.direct_irradiance[el[2]]) * (1.0f / 3.0f)
+                                          : in.element_direct[e];
     radiosity[e] = in.albedo[e] * direct[e];
     reflected += double(radiosity[e].average()) * mesh.element_area[e];
     area += mesh.element_area[e];
@@ -731,7 +755,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // One gathering step: pull B up the tree, gather over the links, push the gathered irradiance
   // down to the elements.
   std::vector<Rgb> power, indirect(ne, Rgb(0.0f));
-  std::vector<RgbVec> moment;
+  std::vector<Moments> moment;
   std::vector<Gathered> gathered(tree.nodes.size());
   auto gather = [&](std::span<const Rgb> from, std::vector<Rgb>& out) {
     pull(tree, mesh, from, power, moment);
@@ -745,7 +769,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
           const Node& S = tree.nodes[link.source];
           const Rgb j = link.exact
                             ? power[link.source] * (link.factor / S.area)
-                            : intensity(S, power[link.source], moment[link.source], -link.dir) * link.factor;
+                            : intensity(moment[link.source], -link.dir) * link.factor;
           const Facing side = facing(R, link.dir);
           if (side == Facing::front) {
             acc.flat.add(j, link.dir);

@@ -69,6 +69,9 @@ struct HierarchicalInput {
   /// Seconds left of a time limit; empty when there is none. With it the links are made coarse
   /// first and refined while the time allows (see solve_hierarchical).
   std::function<double()> seconds_left;
+  /// Per element: the mean direct irradiance over it, which it reflects into the scene. Empty:
+  /// the mean of its vertices' `direct_irradiance`.
+  std::span<const Rgb> element_direct = {};
 };
 
 /// The reflected (indirect) irradiance at every vertex, and what it took.
