@@ -851,6 +851,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
                     [](const Rgb& e) { return e.is_black(); }))
       sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
     const HierarchicalResult h = solve_hierarchical(input, hs);
+    sol.element_direct = std::move(element_direct);
     for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += h.vertex_irradiance[v];
     sol.nodes = h.nodes;
     sol.links = h.links;

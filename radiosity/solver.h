@@ -62,6 +62,10 @@ struct Solution {
   std::vector<Rgb> vertex_direct;      ///< the part of E straight from the lights and emitting surfaces
   std::vector<Rgb> vertex_punctual;    ///< the part of E straight from point, spot and directional lights
   std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
+  /// Per element: the mean over it of E straight from the lights (stratified points) and the
+  /// emitting surfaces (its vertices' mean); what it reflects into the scene. Hierarchical
+  /// solver only (empty otherwise).
+  std::vector<Rgb> element_direct;
 
   // What the solve did.
   SolverKind solver = SolverKind::progressive;  ///< the one that ran

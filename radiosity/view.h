@@ -3,11 +3,12 @@
 // - the mesh view shows the solution as it is exported: radiance Gouraud-interpolated over the
 //   elements, with mirrors and glass ray traced against it (Wallace, Cohen & Greenberg 1987);
 // - the two-pass view traces the input's own surfaces, takes the direct light per pixel by
-//   shadow rays and the light reflected by other surfaces by one final-gather ray per sample
-//   that reads the solution where it lands (Chen, Rushmeier, Miller & Turner 1991). Sharp
-//   shadows and a sun patch then need no mesh to resolve them, a scanned or curved surface shows
-//   its own shape rather than its elements' chords, and the elements' own errors are blurred
-//   by the gather instead of showing as blotches.
+//   shadow rays and the light reflected by other surfaces from the solution, interpolated over
+//   the element found at the point (Chen, Rushmeier, Miller & Turner 1991); where none stands
+//   for it (the back of a one-sided surface), and for light through mirrors and glass, one
+//   final-gather ray per sample reads the solution where it lands. Sharp shadows and a sun
+//   patch then need no mesh to resolve them, and a scanned or curved surface shows its own
+//   shape rather than its elements' chords.
 
 #include <array>
 #include <optional>
@@ -20,12 +21,13 @@ namespace gilt::radiosity {
 
 /// How the view shows a solution.
 enum class ViewMode {
-  two_pass,  ///< the input's surfaces: direct light per pixel, a final gather into the solution
+  two_pass,  ///< the input's surfaces: direct light per pixel, reflected light from the solution
   mesh,      ///< the elements: the solution's radiance as exported
 };
 
 /// The hierarchical link tolerance of the two-pass view when none is asked for: ten times the
-/// exports' (kDefaultLinkTolerance), since its per-pixel gather blurs what the links get wrong.
+/// exports' (kDefaultLinkTolerance), since the view takes the direct light per pixel and the
+/// links carry only the reflected light.
 /// On Šibenik at a 60-s budget it solves in 23 s instead of running out of time while linking.
 inline constexpr double kTwoPassLinkTolerance = 2e-5;
 
@@ -65,9 +67,15 @@ class RadiosityView {
 
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
-  /// cosine-distributed gather ray (through mirrors and glass), times π: where it lands, direct
-  /// light by a shadow ray and the rest read from the solution.
-  Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx) const;
+  /// cosine-distributed gather ray (through mirrors and glass), times π: where it lands, the
+  /// element's mean direct light (or a shadow ray's) and the reflected light interpolated.
+  /// With via_specular_only, only what the ray brings through a mirror or glass it meets first.
+  Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx,
+             bool via_specular_only = false) const;
+  /// locate(), unless p lies behind the element's plane by more than a chord of a concave
+  /// surface could (see indirect_irradiance).
+  std::optional<Location> locate_on(const rc::SurfacePoint& p, const Vec3& n) const;
+  Rgb indirect_at(const Location& at) const;
   Rgb mesh_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
   Rgb two_pass_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
 
@@ -78,6 +86,8 @@ class RadiosityView {
   std::vector<Rgb> vertex_indirect_;         ///< two-pass view: W·m⁻² from reflections, ambient term included
   std::vector<Vec3> positions_;              ///< of the elements' vertices
   std::vector<Vec3> element_normal_;
+  std::vector<Rgb> element_direct_;          ///< per element (Solution::element_direct; may be empty)
+  bool has_specular_ = false;                ///< the scene has mirrors or glass
   std::vector<std::array<uint32_t, 3>> elements_;
   float reach_ = 0.0f;                       ///< how far from an element the two-pass view looks it up
   Rgb environment_{0.0f};
