@@ -170,7 +170,7 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
       const std::optional<Location> at = locate_on(sj, lit);
       if (at && !element_direct_.empty())
         return out + beta * mj.albedo * (element_direct_[at->element] + indirect_at(*at)) * (1.0f / rc::kPi);
-      out += beta * rc::sample_direct(scene_, sj, mj, fj, wo, above, ctx.rng, ctx.rays).value;
+      out += beta * rc::estimate_direct(scene_, sj, mj, fj, wo, above, ctx.rng, ctx.rays);
       if (at) return out + beta * mj.albedo * indirect_at(*at) * (1.0f / rc::kPi);
       // No element stands for this side of the surface: one more diffuse bounce from here.
       if (diffuse_left-- == 0) return out;
@@ -236,7 +236,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
       // solution where it lands. (Gathering everywhere hides the mesh one bounce away, at the
       // price of its noise: on Šibenik's nave at 60 s its relMSE was 1.5 times the reading's,
       // on the Cornell box at 1,600 elements its error 1.2 times.)
-      radiance += beta * rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays).value;
+      radiance += beta * rc::estimate_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays);
       if (const std::optional<Rgb> e = indirect_irradiance(si, wo_above ? si.ng : -si.ng)) {
         // The solution's light comes from diffuse surfaces in view (mirrors and glass block it);
         // what arrives through them, the gather ray brings.

@@ -6,13 +6,12 @@
 
 namespace gilt::raytrace_core {
 
-DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                           const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+namespace {
+
+/// One sample of light `li`, chosen with probability `pmf`.
+DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const SurfaceInteraction& si, const Material& m,
+                        const Frame& frame, const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
   DirectSample out;
-  const Distribution1D& choice = scene.light_distribution();
-  if (choice.size() == 0) return out;
-  const uint32_t li = choice.sample(rng.uniform());
-  const float pmf = choice.pmf(li);
   const LightSample ls = sample_light(scene, scene.lights()[li], si, rng.uniform2());
   // Reflection only: the light must be on wo's side of the geometric surface (no leaks).
   if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) return out;
@@ -25,6 +24,25 @@ DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, con
   if (scene.occluded(ls.shadow_ray)) return out;
   out.value = f * ls.radiance / out.pdf;
   return out;
+}
+
+}  // namespace
+
+DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
+                           const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+  const Distribution1D& choice = scene.light_distribution();
+  if (choice.size() == 0) return {};
+  const uint32_t li = choice.sample(rng.uniform());
+  return sample_one(scene, li, choice.pmf(li), si, m, frame, wo, wo_above, rng, rays);
+}
+
+Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
+                    const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+  const size_t count = scene.lights().size();
+  if (count > kEachLightLimit) return sample_direct(scene, si, m, frame, wo, wo_above, rng, rays).value;
+  Rgb sum(0.0f);
+  for (uint32_t li = 0; li < count; ++li) sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, rng, rays).value;
+  return sum;
 }
 
 }  // namespace gilt::raytrace_core

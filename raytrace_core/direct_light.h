@@ -4,6 +4,7 @@
 // multiple-importance weight (Veach 1997), as Tungsten's TraceBase::estimateDirect is shared by
 // its path and photon tracers.
 
+#include <cstddef>
 #include <cstdint>
 
 #include "raytrace_core/rng.h"
@@ -28,5 +29,17 @@ struct DirectSample {
 /// Only reflection is estimated: a light on the other side of the geometric surface adds nothing.
 DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
                            const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays);
+
+/// Lights up to which estimate_direct samples every light rather than choosing one.
+inline constexpr size_t kEachLightLimit = 8;
+
+/// Direct light at `si` from all of the scene's lights, for estimators that weigh it against no
+/// other strategy (the radiosity view's two-pass split). With at most kEachLightLimit lights it
+/// samples each once, one shadow ray apiece: a sun and a sky then both count at every point, with
+/// none of the noise of choosing between them (chosen by power with probability p, a sunlit
+/// point's sun reads either 0 or 1/p times its value). With more, one sample of a light chosen by
+/// power, as sample_direct.
+Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
+                    const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays);
 
 }  // namespace gilt::raytrace_core
