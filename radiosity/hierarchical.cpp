@@ -55,6 +55,10 @@ constexpr int kMixedDepth = 3;
 /// The most an element may reflect of what a unit radiosity everywhere sends it (see the
 /// iteration in solve_hierarchical).
 constexpr float kMaxReflectedGain = 0.99f;
+/// The iteration stops when its area-weighted mean relative change per element falls below the
+/// tolerance; an element darker than this fraction of the scene's mean radiosity counts its
+/// change against that mean instead, so that black corners do not set the pace.
+constexpr double kResidualFloor = 0.01;
 /// A partly visible cluster link is accepted when this many times its error is acceptable.
 constexpr double kPartialVisibility = 10.0;
 /// The final gather's probe takes every this-many-th vertex.
@@ -821,17 +825,22 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     for (int it = 0; it < settings.max_iterations; ++it) {
       if (out_of_time()) break;
       gather(radiosity, indirect);
-      double change = 0.0, total = 0.0;
+      double total = 0.0;
       for (size_t e = 0; e < ne; ++e) {
         indirect[e] *= gain[e];
         next[e] = in.albedo[e] * (direct[e] + indirect[e]);
-        const Rgb delta = next[e] - radiosity[e];
-        change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e];
         total += double(next[e].average()) * mesh.element_area[e];
+      }
+      const double floor = kResidualFloor * total / area;
+      double change = 0.0;
+      for (size_t e = 0; e < ne; ++e) {
+        const Rgb delta = next[e] - radiosity[e];
+        change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e] /
+                  std::max(double(next[e].average()), floor);
       }
       radiosity.swap(next);
       ++result.iterations;
-      result.residual = total > 0.0 ? change / total : 0.0;
+      result.residual = total > 0.0 ? change / area : 0.0;
       if (result.residual < settings.tolerance) break;
     }
   };
