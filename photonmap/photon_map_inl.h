@@ -18,7 +18,8 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
     const std::optional<rc::Hit> hit = scene.intersect(ray);
     if (!hit) break;
     const rc::SurfaceInteraction si = scene.surface(ray, *hit);
-    const rc::Material& m = scene.materials[si.material];
+    rc::Material textured;
+    const rc::Material& m = scene.shading_material(si, textured);
     if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
       power *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
     const rc::Vec3 wo_world = -glm::normalize(ray.direction);

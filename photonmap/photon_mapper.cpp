@@ -127,7 +127,8 @@ rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx
       break;
     }
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
-    const rc::Material& m = scene_.materials[si.material];
+    rc::Material textured;
+    const rc::Material& m = scene_.shading_material(si, textured);
     if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
       beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
     const rc::Vec3 wo_world = -glm::normalize(ray.direction);
@@ -151,7 +152,8 @@ rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx
 }
 
 rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo_world, rc::SampleContext& ctx) const {
-  const rc::Material& m = scene_.materials[si.material];
+  rc::Material textured;
+  const rc::Material& m = scene_.shading_material(si, textured);
   const rc::Frame frame = rc::Frame::from_normal(si.ns);
   const rc::Vec3 wo = frame.to_local(wo_world);
   const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
@@ -205,7 +207,8 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
         break;
       }
       const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
-      const rc::Material& mj = scene_.materials[sj.material];
+      rc::Material textured_j;
+      const rc::Material& mj = scene_.shading_material(sj, textured_j);
       if (mj.kind == rc::MaterialKind::dielectric && !sj.front_face && !mj.absorption.is_black())
         g *= rc::exp(mj.absorption * (-hit->t * glm::length(ray.direction)));
       if (mj.is_emissive()) {

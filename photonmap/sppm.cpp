@@ -31,6 +31,7 @@ struct PixelState {
   rc::Vec3 position{0.0f}, lit_side{0.0f}, wo{0.0f};  ///< wo in the shading frame
   rc::Frame frame;
   uint32_t material = 0;
+  rc::Vec2 uv{0.0f};  ///< where the material's textures are read
   rc::Rgb beta{0.0f};
   // Gathered this iteration.
   rc::Rgb phi{0.0f};
@@ -95,7 +96,8 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
             break;
           }
           const rc::SurfaceInteraction si = scene.surface(ray, *hit);
-          const rc::Material& m = scene.materials[si.material];
+          rc::Material textured;
+          const rc::Material& m = scene.shading_material(si, textured);
           if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
             beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
           const rc::Vec3 wo_world = -glm::normalize(ray.direction);
@@ -111,6 +113,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
             ps.wo = wo;
             ps.frame = frame;
             ps.material = si.material;
+            ps.uv = si.uv;
             ps.beta = beta;
             break;
           }
@@ -164,7 +167,11 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
       for (int x = 0; x < width; ++x) {
         PixelState& ps = state[size_t(y) * width + x];
         if (!ps.visible) continue;
-        const rc::Material& m = scene.materials[ps.material];
+        rc::SurfaceInteraction at;
+        at.material = ps.material;
+        at.uv = ps.uv;
+        rc::Material textured;
+        const rc::Material& m = scene.shading_material(at, textured);
         rc::Rgb phi(0.0f);
         uint32_t m_count = 0;
         index.for_each_within(ps.position, ps.radius * ps.radius, [&](Neighbour nb) {

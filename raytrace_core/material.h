@@ -5,6 +5,7 @@
 #include <string>
 
 #include "raytrace_core/rgb.h"
+#include "raytrace_core/texture.h"
 
 namespace gilt::raytrace_core {
 
@@ -27,6 +28,12 @@ struct Material {
   Rgb absorption{0.0f};   ///< absorption coefficient σa per scene unit inside (dielectric)
   Rgb emission{0.0f};     ///< emitted radiance, W·sr⁻¹·m⁻², from the front face
   bool two_sided_emission = false;  ///< emit from both faces
+  /// Base colour: `albedo` is multiplied by this texture's linear RGB where it is set (glTF's
+  /// baseColorFactor × baseColorTexture; MTL's Kd × map_Kd, as the MTL specification has it).
+  TextureRef albedo_texture;
+
+  /// True when some parameter varies over the surface and must be looked up at each point.
+  bool is_textured() const { return albedo_texture.valid(); }
 
   /// True when the surface emits light.
   bool is_emissive() const { return !emission.is_black(); }

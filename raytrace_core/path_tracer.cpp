@@ -35,7 +35,8 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
       break;
     }
     const SurfaceInteraction si = scene.surface(ray, *hit);
-    const Material& m = scene.materials[si.material];
+    Material textured;
+    const Material& m = scene.shading_material(si, textured);
 
     // Leaving the inside of a dielectric: attenuate by its absorption over the segment.
     if (m.kind == MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())

@@ -145,7 +145,13 @@ void Scene::commit() {
         m.absorption.b < 0 || m.exponent < 0)
       throw InputError(id + ": reflectance, emission, absorption and exponent must not be negative");
     if (m.kind == MaterialKind::dielectric && !(m.ior > 0.0f)) throw InputError(id + ": ior must be positive");
+    const TextureRef& t = m.albedo_texture;
+    if (t.image >= int32_t(textures.size()) || t.image < -1)
+      throw InputError(id + ": refers to texture " + std::to_string(t.image) + " but there are " + std::to_string(textures.size()));
+    for (float x : t.map)
+      if (!std::isfinite(x)) throw InputError(id + ": texture transform must be finite");
   }
+  if (!textures.empty()) texture_set_ = std::make_unique<TextureSet>(textures);
   auto check_material = [&](uint32_t material, const std::string& what) {
     if (material >= materials.size())
       throw InputError(where + ": " + what + " refers to material " + std::to_string(material) + " but there are " +
@@ -161,6 +167,11 @@ void Scene::commit() {
     if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
       throw InputError(where + ": " + what + ": has " + std::to_string(mesh.normals.size()) + " normals for " +
                        std::to_string(mesh.positions.size()) + " positions");
+    if (mesh.uvs.empty() && mesh.material < materials.size() && materials[mesh.material].is_textured() &&
+        !mesh.indices.empty())
+      warnings.push_back(where + ": " + what + ": has no texture coordinates, so its material's texture reads one texel");
+    for (Vec2& uv : mesh.uvs)
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = Vec2(0.0f);
     if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
       throw InputError(where + ": " + what + ": has " + std::to_string(mesh.uvs.size()) + " texture coordinates for " +
                        std::to_string(mesh.positions.size()) + " positions");
@@ -439,6 +450,29 @@ float Scene::primitive_area(uint32_t geom_id, uint32_t prim_id) const {
 const Material& Scene::primitive_material(uint32_t geom_id, uint32_t prim_id) const {
   if (geom_id == sphere_geom_id()) return materials[spheres[prim_id].material];
   return materials[meshes[geom_id].material];
+}
+
+const Material& Scene::shading_material(const SurfaceInteraction& si, Material& scratch, Vec2 duv_dx, Vec2 duv_dy) const {
+  const Material& m = materials[si.material];
+  if (!m.is_textured() || !texture_set_) return m;
+  // Field by field rather than `scratch = m`, so a long name is not copied at every hit.
+  scratch.kind = m.kind;
+  scratch.specular = m.specular;
+  scratch.exponent = m.exponent;
+  scratch.ior = m.ior;
+  scratch.absorption = m.absorption;
+  scratch.emission = m.emission;
+  scratch.two_sided_emission = m.two_sided_emission;
+  scratch.albedo_texture = TextureRef{};
+  const TextureRef& t = m.albedo_texture;
+  scratch.albedo = m.albedo * texture_set_->lookup(t.image, t.st(si.uv), t.st_delta(duv_dx), t.st_delta(duv_dy)).rgb;
+  return scratch;
+}
+
+Rgb Scene::mean_albedo(const Material& m, Vec2 uv0, Vec2 uv1, Vec2 uv2) const {
+  if (!m.is_textured() || !texture_set_) return m.albedo;
+  const TextureRef& t = m.albedo_texture;
+  return m.albedo * texture_set_->triangle_mean(t.image, t.st(uv0), t.st(uv1), t.st(uv2)).rgb;
 }
 
 size_t Scene::triangle_count() const {

@@ -98,6 +98,7 @@ class Scene {
   std::vector<TriangleMesh> meshes;
   std::vector<Sphere> spheres;
   std::vector<Material> materials;
+  std::vector<TextureImage> textures;  ///< the images materials read (TextureRef::image)
   std::vector<Light> punctual_lights;  ///< point, spot, directional and environment lights
   std::optional<Camera> camera;        ///< the scene's own camera, if it has one
   RenderDefaults render;
@@ -141,6 +142,15 @@ class Scene {
   float primitive_area(uint32_t geom_id, uint32_t prim_id) const;
   /// Material of one primitive.
   const Material& primitive_material(uint32_t geom_id, uint32_t prim_id) const;
+  /// The material as it is at one surface point: the scene's own when it is not textured,
+  /// else `scratch` filled with its parameters looked up at si.uv (footprint: the (u, v)
+  /// derivatives duv_dx, duv_dy; zero for the finest level).
+  const Material& shading_material(const SurfaceInteraction& si, Material& scratch, Vec2 duv_dx = Vec2(0.0f),
+                                   Vec2 duv_dy = Vec2(0.0f)) const;
+  /// Mean albedo of a material over a triangle with texture coordinates uv0, uv1, uv2.
+  Rgb mean_albedo(const Material& m, Vec2 uv0, Vec2 uv1, Vec2 uv2) const;
+  /// The scene's opened textures (null when it has none).
+  const TextureSet* texture_set() const { return texture_set_.get(); }
   /// Surface point on a triangle at barycentrics (b1, b2) of its second and third vertex.
   SurfaceInteraction triangle_point(uint32_t geom_id, uint32_t prim_id, Vec2 barycentrics) const;
   /// Point on sphere `prim_id` in the direction `dir` (unit) from its centre.
@@ -158,6 +168,7 @@ class Scene {
   bool committed_ = false;
   std::vector<int32_t> first_light_of_mesh_;  // light index of triangle 0 of an emissive mesh, or −1
   std::vector<int32_t> light_of_sphere_;      // light index of each sphere, or −1
+  std::unique_ptr<TextureSet> texture_set_;
 };
 
 }  // namespace gilt::raytrace_core

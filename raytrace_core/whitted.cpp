@@ -21,7 +21,8 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
   const std::optional<Hit> hit = scene.intersect(ray);
   if (!hit) return environment_radiance(scene);
   const SurfaceInteraction si = scene.surface(ray, *hit);
-  const Material& m = scene.materials[si.material];
+  Material textured;
+  const Material& m = scene.shading_material(si, textured);
   const Vec3 wo_world = -glm::normalize(ray.direction);
   Rgb radiance = m.is_emissive() ? emitted_radiance(m, si.ng, wo_world) : Rgb(0.0f);
   const Frame frame = Frame::from_normal(si.ns);

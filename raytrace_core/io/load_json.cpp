@@ -214,8 +214,15 @@ class JsonSceneReader {
       fail(at(p, "file"), e.what());
     }
     const auto offset = static_cast<uint32_t>(scene_.materials.size());
-    if (!override_material)
-      for (Material& m : part.materials) scene_.materials.push_back(std::move(m));
+    if (!override_material) {
+      // The file's images join the scene's, its materials' references shifted past those there.
+      const auto texture_offset = int32_t(scene_.textures.size());
+      for (TextureImage& t : part.textures) scene_.textures.push_back(std::move(t));
+      for (Material& m : part.materials) {
+        if (m.albedo_texture.valid()) m.albedo_texture.image += texture_offset;
+        scene_.materials.push_back(std::move(m));
+      }
+    }
     const auto file_offset = int32_t(scene_.model_files.size());
     for (std::string& f : part.model_files) scene_.model_files.push_back(std::move(f));
     for (TriangleMesh& mesh : part.meshes) {
