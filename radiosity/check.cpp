@@ -39,6 +39,9 @@ void CheckSettings::validate() const {
 
 /// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings).
 constexpr float kSameSide = 0.8660254f;
+/// Least albedo (per channel) at which path-traced radiance is turned back into irradiance: a
+/// texel black in some channel carries no information about the light there.
+constexpr float kInvertibleAlbedo = 1e-4f;
 
 CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings) {
   settings.validate();
@@ -77,8 +80,13 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
       const std::optional<rc::Hit> hit = scene.intersect(ray);
       if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &m) continue;
       // Only the surface on the vertex's side of a crease (vertices are split at 30°) counts.
-      if (glm::dot(scene.surface(ray, *hit).ng, n) < kSameSide) continue;
-      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / m.albedo;  // E = π L / ρ
+      const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+      if (glm::dot(si.ng, n) < kSameSide) continue;
+      // E = π L / ρ, with ρ the (textured) albedo where the path starts, which scales all it finds.
+      rc::Material textured;
+      const Rgb rho = scene.shading_material(si, textured).albedo;
+      if (!(std::min({rho.r, rho.g, rho.b}) > kInvertibleAlbedo)) continue;
+      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / rho;
       sum += e;
       sum_squares += e * e;
       ++taken;
@@ -183,7 +191,10 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
       const std::optional<rc::Hit> hit = scene.intersect(ray);
       // Something lies on the point, or coincides with its face (a duplicate, facing either way).
       if (!hit || hit->geom_id != f.mesh || hit->prim_id != f.triangle) return;
-      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / m.albedo;
+      rc::Material textured;
+      const Rgb rho = scene.shading_material(scene.surface(ray, *hit), textured).albedo;
+      if (!(std::min({rho.r, rho.g, rho.b}) > kInvertibleAlbedo)) return;  // a texel black in some channel
+      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / rho;
       sum += e;
       sum_squares += e * e;
       ++taken;

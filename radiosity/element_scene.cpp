@@ -8,6 +8,8 @@ rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh) {
   rc::Scene out;
   out.name = scene.name;
   out.materials = scene.materials;
+  // Its rays ask only whether something is in the way; textures are read in the input scene.
+  for (rc::Material& m : out.materials) m.albedo_texture = rc::TextureRef{};
   rc::TriangleMesh elements;
   elements.name = "radiosity elements";
   elements.positions = mesh.positions;

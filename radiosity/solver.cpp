@@ -20,6 +20,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "radiosity/element_albedo.h"
 #include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
 #include "raytrace_core/error.h"
@@ -645,11 +646,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
                        [&](const rc::Bounds3& box) { return reach.overlaps(box); });
   };
-  auto element_albedo = [&] {
-    std::vector<Rgb> out(mesh.element_count());
-    for (size_t e = 0; e < out.size(); ++e) out[e] = albedo(mesh.element_material[e]);
-    return out;
-  };
+  auto element_albedo = [&] { return element_reflectance(scene, mesh); };
 
   // Pass 1, direct light: every vertex gathers from the punctual lights and from the emitting
   // patches. Sharp shadows and near-field falloff show up here, so this is where the mesh is
@@ -699,7 +696,10 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       // vertex count times the emitter count.
       std::vector<Rgb> emission(mesh.element_count());
       for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
-      const std::vector<Rgb> rho = element_albedo();
+      // The materials' own albedo is enough here (it only weighs links in the tree walk), and the
+      // textured means cost a few seconds per 100,000 elements at every refinement step.
+      std::vector<Rgb> rho(mesh.element_count());
+      for (size_t e = 0; e < rho.size(); ++e) rho[e] = albedo(mesh.element_material[e]);
       const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, {}, may_be_blocked, {}, {}};
       uint64_t tree_rays = 0;
       const std::vector<Rgb> e = emitted_irradiance(input, emission, first_vertex, hs, settings.visibility_samples, &tree_rays);
@@ -745,14 +745,27 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
   sol.vertex_direct = sol.vertex_irradiance;
   sol.vertex_punctual = direct_delta;
+  sol.element_albedo = element_albedo();
+  sol.vertex_albedo.assign(nv, Rgb(0.0f));
+  {
+    std::vector<float> weight(nv, 0.0f);
+    for (size_t e = 0; e < ne; ++e)
+      for (uint32_t v : mesh.elements[e]) {
+        sol.vertex_albedo[v] += sol.element_albedo[e] * mesh.element_area[e];
+        weight[v] += mesh.element_area[e];
+      }
+    for (size_t v = 0; v < nv; ++v)
+      sol.vertex_albedo[v] = weight[v] > 0.0f ? sol.vertex_albedo[v] * (1.0f / weight[v]) : albedo(mesh.vertex_material[v]);
+  }
   // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
   // and has not shot yet.
   auto shoot_progressive = [&] {
     std::vector<Rgb> unshot(ne);
+    const std::vector<Rgb>& element_rho = sol.element_albedo;
     double emitted_power = 0.0;
     for (size_t e = 0; e < ne; ++e) {
       const auto& el = mesh.elements[e];
-      const Rgb rho = albedo(mesh.element_material[e]);
+      const Rgb rho = element_rho[e];
       emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
       emitted_power += double((rho * (direct_punctual[el[0]] + direct_punctual[el[1]] + direct_punctual[el[2]])).average()) /
                        3.0 * mesh.element_area[e];
@@ -807,7 +820,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
       for (size_t e = 0; e < ne; ++e) {
         const auto& el = mesh.elements[e];
-        unshot[e] += albedo(mesh.element_material[e]) * (received[el[0]] + received[el[1]] + received[el[2]]) *
+        unshot[e] += element_rho[e] * (received[el[0]] + received[el[1]] + received[el[2]]) *
                      (1.0f / 3.0f);
       }
       last_shot = elapsed() - shot_start;
@@ -819,7 +832,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       double area = 0.0;
       for (size_t e = 0; e < ne; ++e) {
         unshot_sum += unshot[e] * mesh.element_area[e];
-        reflectance_sum += albedo(mesh.element_material[e]) * mesh.element_area[e];
+        reflectance_sum += element_rho[e] * mesh.element_area[e];
         area += mesh.element_area[e];
       }
       if (area > 0.0) {
@@ -831,7 +844,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   };
   if (hierarchical) {
     // Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex.
-    const std::vector<Rgb> rho = element_albedo();
+    const std::vector<Rgb>& rho = sol.element_albedo;
     // What each element reflects of the direct light: its own mean of the lights' irradiance,
     // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
     uint64_t element_rays = 0;
@@ -879,7 +892,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
 
   sol.vertex_radiosity.resize(nv);
   for (size_t v = 0; v < nv; ++v)
-    sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + albedo(mesh.vertex_material[v]) * sol.vertex_irradiance[v];
+    sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + sol.vertex_albedo[v] * sol.vertex_irradiance[v];
   sol.element_radiosity.resize(ne);
   for (size_t e = 0; e < ne; ++e) {
     const auto& el = mesh.elements[e];

@@ -62,6 +62,8 @@ struct Solution {
   std::vector<Rgb> vertex_direct;      ///< the part of E straight from the lights and emitting surfaces
   std::vector<Rgb> vertex_punctual;    ///< the part of E straight from point, spot and directional lights
   std::vector<Rgb> element_radiosity;  ///< mean of the element's vertices (exported per face)
+  std::vector<Rgb> element_albedo;     ///< reflectance, textured materials' mean over the element
+  std::vector<Rgb> vertex_albedo;      ///< area-weighted mean of the vertex's elements' reflectance
   /// Per element: the mean over it of E straight from the lights (stratified points) and the
   /// emitting surfaces (its vertices' mean); what it reflects into the scene. Hierarchical
   /// solver only (empty otherwise).

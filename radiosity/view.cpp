@@ -71,7 +71,7 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   vertex_radiance_.resize(nv);
   vertex_indirect_.resize(nv);
   for (size_t v = 0; v < nv; ++v) {
-    const Rgb rho = scene.materials[mesh.vertex_material[v]].albedo;
+    const Rgb rho = v < solution.vertex_albedo.size() ? solution.vertex_albedo[v] : scene.materials[mesh.vertex_material[v]].albedo;
     vertex_radiance_[v] = solution.vertex_radiance(v);
     if (ambient) vertex_radiance_[v] += rho * solution.ambient * (1.0f / rc::kPi);
     Rgb indirect = solution.vertex_irradiance[v] - solution.vertex_direct[v];
@@ -150,7 +150,8 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
     if (!hit) return via_specular ? out + beta * environment_ : out;
     const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
-    const rc::Material& mj = scene_.materials[sj.material];
+    rc::Material textured;
+    const rc::Material& mj = scene_.shading_material(sj, textured);
     const Vec3 wo_world = -glm::normalize(ray.direction);
     absorb(mj, sj, *hit, ray, beta);
     if (via_specular && mj.is_emissive()) out += beta * rc::emitted_radiance(mj, sj.ng, wo_world);
@@ -221,7 +222,8 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
     if (!hit) return radiance + beta * environment_;
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
-    const rc::Material& m = scene_.materials[si.material];
+    rc::Material textured;
+    const rc::Material& m = scene_.shading_material(si, textured);
     const Vec3 wo_world = -glm::normalize(ray.direction);
     absorb(m, si, *hit, ray, beta);
     // Only the camera and delta bounces lead here, so emission seen is never sampled twice.

@@ -1,0 +1,219 @@
+// Image textures: sRGB decoding before filtering, lookups through Scene::shading_material, and
+// the radiosity elements' mean reflectance. Images are written as binary PPM files (which
+// OpenImageIO reads) into a fresh temporary folder, which is also the texture cache.
+//
+// Tolerances: the linear copies are half floats (11-bit significand, relative error ≤ 2⁻¹¹ ≈
+// 5e-4), so a texel of 1.0 or 0.0 reads back within 1e-3 once filtering weights are summed.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "radiosity/element_albedo.h"
+#include "radiosity/mesh.h"
+#include "raytrace_core/error.h"
+#include "raytrace_core/scene.h"
+#include "raytrace_core/texture.h"
+
+namespace gilt {
+namespace {
+
+namespace fs = std::filesystem;
+namespace rc = raytrace_core;
+
+class Textures : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("gilt_textures_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::create_directories(dir_);
+    ::setenv("GILT_TEXTURE_CACHE", (dir_ / "cache").c_str(), 1);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  /// Writes an 8-bit RGB image, rows top to bottom, as a binary PPM; returns its path.
+  std::string ppm(const std::string& name, int width, int height, const std::vector<unsigned char>& rgb) {
+    const fs::path path = dir_ / name;
+    std::ofstream out(path, std::ios::binary);
+    out << "P6\n" << width << ' ' << height << "\n255\n";
+    out.write(reinterpret_cast<const char*>(rgb.data()), std::streamsize(rgb.size()));
+    return path.string();
+  }
+  fs::path dir_;
+};
+
+constexpr float kHalfTolerance = 1e-3f;
+
+/// A unit quad in the z = 0 plane facing +z, UVs (x, y), with `material`.
+rc::TriangleMesh quad(uint32_t material) {
+  rc::TriangleMesh m;
+  m.name = "quad";
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.material = material;
+  return m;
+}
+
+TEST_F(Textures, DecodesSrgbBeforeReading) {
+  // Texels red, blue and the sRGB code 188, read at their centres (bilinear is exact there).
+  const std::string file = ppm("rb.ppm", 3, 1, {255, 0, 0, 0, 0, 255, 188, 188, 188});
+  rc::TextureSet set({rc::TextureImage{file, true, rc::TextureWrap::clamp, rc::TextureWrap::clamp}});
+  const rc::Texel red = set.lookup(0, {1.0f / 6.0f, 0.5f});
+  const rc::Texel blue = set.lookup(0, {0.5f, 0.5f});
+  const rc::Texel grey = set.lookup(0, {5.0f / 6.0f, 0.5f});
+  EXPECT_NEAR(red.rgb.r, 1.0f, kHalfTolerance);
+  EXPECT_NEAR(red.rgb.b, 0.0f, kHalfTolerance);
+  EXPECT_NEAR(blue.rgb.b, 1.0f, kHalfTolerance);
+  EXPECT_NEAR(blue.rgb.r, 0.0f, kHalfTolerance);
+  // sRGB's curve at 188/255: ((0.73725 + 0.055) / 1.055)^2.4 = 0.50289.
+  EXPECT_NEAR(grey.rgb.g, 0.50289f, kHalfTolerance);
+  // The same file read as data is not decoded: 188/255 = 0.7373.
+  rc::TextureSet data({rc::TextureImage{file, false, rc::TextureWrap::clamp, rc::TextureWrap::clamp}});
+  EXPECT_NEAR(data.lookup(0, {5.0f / 6.0f, 0.5f}).rgb.g, 188.0f / 255.0f, kHalfTolerance);
+}
+
+TEST_F(Textures, FiltersLinearValuesNotCodes) {
+  // A 4 × 4 checker of black and white: its mean is 0.5 in linear light. Averaging the codes
+  // (127.5) and decoding after would give 0.212.
+  std::vector<unsigned char> texels;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) texels.push_back((x + y) % 2 ? 255 : 0);
+  rc::TextureSet set({rc::TextureImage{ppm("checker.ppm", 4, 4, texels)}});
+  // A footprint as large as the image reads its coarsest level, the mean.
+  const rc::Texel whole = set.lookup(0, {0.5f, 0.5f}, {1.0f, 0.0f}, {0.0f, 1.0f});
+  EXPECT_NEAR(whole.rgb.g, 0.5f, kHalfTolerance);
+  // The stratified mean over a triangle covering half the image: each half of a 4 × 4 checker
+  // split along the diagonal is black and white in equal parts but for the diagonal's own
+  // texels; 64 strata filtered over their shares give the mean within a few per cent.
+  const rc::Texel half = set.triangle_mean(0, {0, 0}, {1, 0}, {1, 1});
+  EXPECT_NEAR(half.rgb.g, 0.5f, 0.05f);
+}
+
+TEST_F(Textures, ShadingMaterialMultipliesTheAlbedoByTheTexel) {
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("textured", rc::Rgb(0.8f, 0.6f, 0.4f));
+  scene.textures.push_back(rc::TextureImage{ppm("rb.ppm", 2, 1, {255, 0, 0, 0, 0, 255})});
+  m.albedo_texture.image = 0;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(quad(0));
+  scene.commit();
+  ASSERT_NE(scene.texture_set(), nullptr);
+  rc::Material scratch;
+  // (u, v) = (0.25, 0.5) is in the red texel, (0.75, 0.5) in the blue one.
+  rc::SurfaceInteraction at_left = scene.triangle_point(0, 0, {0.25f, 0.25f});
+  at_left.uv = {0.25f, 0.5f};
+  const rc::Material& red = scene.shading_material(at_left, scratch);
+  EXPECT_NEAR(red.albedo.r, 0.8f, 0.8f * kHalfTolerance);
+  EXPECT_NEAR(red.albedo.g, 0.0f, kHalfTolerance);
+  EXPECT_NEAR(red.albedo.b, 0.0f, kHalfTolerance);
+  rc::SurfaceInteraction at_right = at_left;
+  at_right.uv = {0.75f, 0.5f};
+  const rc::Material& blue = scene.shading_material(at_right, scratch);
+  EXPECT_NEAR(blue.albedo.b, 0.4f, 0.4f * kHalfTolerance);
+  EXPECT_NEAR(blue.albedo.r, 0.0f, kHalfTolerance);
+  // The surface point's own UVs come from the mesh: barycentrics (0.5, 0.25) of triangle 0
+  // (corners (0,0), (1,0), (1,1)) are uv (0.75, 0.25), in the blue half.
+  const rc::SurfaceInteraction hit = scene.triangle_point(0, 0, {0.5f, 0.25f});
+  EXPECT_NEAR(hit.uv.x, 0.75f, 1e-6f);
+  EXPECT_NEAR(scene.shading_material(hit, scratch).albedo.b, 0.4f, 0.4f * kHalfTolerance);
+  // An untextured material is returned as it is, not copied.
+  rc::Scene plain;
+  plain.materials.push_back(rc::Material::make_diffuse("plain", rc::Rgb(0.5f)));
+  plain.meshes.push_back(quad(0));
+  plain.commit();
+  EXPECT_EQ(&plain.shading_material(plain.triangle_point(0, 0, {0.2f, 0.2f}), scratch), &plain.materials[0]);
+}
+
+TEST_F(Textures, TransformMapsUvToImage) {
+  // OBJ's convention (t = 1 − v) composed with a scale of 2 in s.
+  rc::TextureRef flip;
+  flip.map = {1, 0, 0, 0, -1, 1};
+  const rc::TextureRef scaled = flip.then({2, 0, 0, 0, 1, 0});
+  const rc::Vec2 st = scaled.st({0.25f, 0.25f});
+  EXPECT_FLOAT_EQ(st.x, 0.5f);
+  EXPECT_FLOAT_EQ(st.y, 0.75f);
+  const rc::Vec2 d = scaled.st_delta({0.1f, 0.1f});
+  EXPECT_FLOAT_EQ(d.x, 0.2f);
+  EXPECT_FLOAT_EQ(d.y, -0.1f);
+}
+
+TEST_F(Textures, UnreadableImageIsAnInputError) {
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("textured", rc::Rgb(0.5f));
+  m.albedo_texture.image = 0;
+  scene.materials.push_back(m);
+  scene.textures.push_back(rc::TextureImage{(dir_ / "missing.png").string()});
+  scene.meshes.push_back(quad(0));
+  try {
+    scene.commit();
+    ADD_FAILURE() << "a missing texture file was accepted";
+  } catch (const rc::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.png"), std::string::npos) << e.what();
+  }
+  // A reference past the scene's textures is refused too.
+  rc::Scene bad;
+  bad.materials.push_back(m);
+  bad.meshes.push_back(quad(0));
+  EXPECT_THROW(bad.commit(), rc::InputError);
+}
+
+TEST_F(Textures, ElementsReflectTheTexturesMeanOverThem) {
+  // A quad whose texture is red on its left half and blue on its right (64 texels across, so
+  // the filters blur the step over a few hundredths of the quad): the elements' area-weighted
+  // mean reflectance is the texture's mean times the albedo, and elements wholly on one side,
+  // at least 0.05 from the step, take that side's colour. The strata (16 per element, each
+  // filtered over its share) err only on elements straddling the step, with errors of both
+  // signs; the total is checked to 2 %.
+  std::vector<unsigned char> texels;
+  for (int x = 0; x < 64; ++x) texels.insert(texels.end(), {x < 32 ? (unsigned char)255 : (unsigned char)0, 0, x < 32 ? (unsigned char)0 : (unsigned char)255});
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("textured", rc::Rgb(0.9f));
+  // Clamped: repeating would blend the blue right edge into the red left one.
+  scene.textures.push_back(rc::TextureImage{ppm("rb.ppm", 64, 1, texels), true, rc::TextureWrap::clamp, rc::TextureWrap::clamp});
+  m.albedo_texture.image = 0;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(quad(0));
+  scene.commit();
+  const radiosity::RadiosityMesh mesh = radiosity::build_mesh(scene, radiosity::MeshSettings{.max_edge = 0.1f});
+  const std::vector<rc::Rgb> rho = radiosity::element_reflectance(scene, mesh);
+  ASSERT_EQ(rho.size(), mesh.element_count());
+  rc::Rgb sum(0.0f);
+  double area = 0.0;
+  int pure_left = 0, pure_right = 0;
+  for (size_t e = 0; e < rho.size(); ++e) {
+    sum += rho[e] * mesh.element_area[e];
+    area += mesh.element_area[e];
+    float lo = 1.0f, hi = 0.0f;
+    for (uint32_t v : mesh.elements[e]) {
+      lo = std::min(lo, mesh.positions[v].x);
+      hi = std::max(hi, mesh.positions[v].x);
+    }
+    if (hi < 0.45f) {
+      ++pure_left;
+      EXPECT_NEAR(rho[e].r, 0.9f, 0.9f * kHalfTolerance);
+      EXPECT_NEAR(rho[e].b, 0.0f, kHalfTolerance);
+    } else if (lo > 0.55f) {
+      ++pure_right;
+      EXPECT_NEAR(rho[e].b, 0.9f, 0.9f * kHalfTolerance);
+      EXPECT_NEAR(rho[e].r, 0.0f, kHalfTolerance);
+    }
+  }
+  EXPECT_GT(pure_left, 10);
+  EXPECT_GT(pure_right, 10);
+  const rc::Rgb mean = sum * float(1.0 / area);
+  EXPECT_NEAR(mean.r, 0.45f, 0.02f * 0.45f);
+  EXPECT_NEAR(mean.b, 0.45f, 0.02f * 0.45f);
+  EXPECT_NEAR(mean.g, 0.0f, kHalfTolerance);
+}
+
+}  // namespace
+}  // namespace gilt
