@@ -2,6 +2,8 @@
 //
 // tinyobjloader reads "nan" as 0 and skips faces with out-of-range indices with a warning, so a
 // first pass over the text checks coordinates and face indices and reports the offending line.
+// It also takes a name (newmtl, usemtl, map_Kd) to run to the end of its line and a '#' after a
+// face for one more corner, so it is handed the text with every comment already cut off.
 //
 // MTL → Material (documented in docs/scene-format.md):
 //   Ke                                  → emission (emitted radiance, front face only)
@@ -13,8 +15,10 @@
 //   Ks ≠ 0, Ns ≥ 1000, Kd = 0           → mirror, reflectance Ks (a lobe that sharp is a mirror)
 //   Ks ≠ 0, Ns ≥ 1000, Kd ≠ 0           → glossy with exponent Ns
 //   otherwise                           → diffuse, albedo Kd
+//   map_Kd (diffuse and glossy)         → albedo texture: albedo = Kd × texel; -o, -s, -clamp kept
 // Kd and Ks are clamped to [0, 1] and, where Kd + Ks > 1 in a channel, both are scaled down so the
-// sum is 1 (energy conservation), with a warning. Ka and texture maps are ignored.
+// sum is 1 (energy conservation), with a warning. Ka and map_Ka are ignored; other maps are
+// ignored with one warning per file.
 
 #include <algorithm>
 #include <cctype>
@@ -159,6 +163,245 @@ void check_obj_text(const fs::path& path) {
     if (f.index > static_cast<long>(counts[f.part])) out_of_range(f.line, f.part, f.index);
 }
 
+/// The file's text with each line cut at its first '#' and stripped of trailing blanks (a '\r'
+/// included, which tinyobjloader would otherwise keep at the end of a texture name). Line breaks
+/// stay, so the line numbers in tinyobjloader's messages still match the file. False when the
+/// file cannot be opened.
+bool read_without_comments(const fs::path& path, std::string& text) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  text.clear();
+  std::string line;
+  while (std::getline(in, line)) {
+    size_t end = std::min(line.find('#'), line.size());
+    while (end > 0 && std::isspace(static_cast<unsigned char>(line[end - 1]))) --end;
+    text.append(line, 0, end);
+    text += '\n';
+  }
+  return true;
+}
+
+/// A map_Kd statement: the file name as written and the options the loader honours.
+struct DiffuseMap {
+  std::string name;                 ///< empty: the material has no map_Kd
+  float scale[2] = {1.0f, 1.0f};    ///< -s u v
+  float offset[2] = {0.0f, 0.0f};   ///< -o u v
+  bool clamp = false;               ///< -clamp on
+  bool linear = false;              ///< -colorspace linear (tinyobjloader's extension)
+  bool kd_given = false;            ///< the material has a Kd line of its own
+};
+
+/// Parses what follows "map_Kd" on a comment-free line: options, then the file name, which runs
+/// to the end of the line (names may hold spaces). We read the options ourselves because
+/// tinyobjloader always takes three numbers after -o, -s and -t, so "-s 2 2 -o 0.5 0" loses
+/// the -o; the MTL format lets the v and w numbers be left out. Throws InputError "file:line".
+DiffuseMap parse_map_kd(std::string_view rest, const fs::path& path, size_t line_no) {
+  const auto fail = [&](const std::string& what) {
+    throw InputError(path.string() + ":" + std::to_string(line_no) + ": map_Kd " + what);
+  };
+  const auto is_blank = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  size_t i = 0;
+  // The next blank-separated token, without consuming it.
+  const auto peek = [&]() {
+    size_t a = i;
+    while (a < rest.size() && is_blank(rest[a])) ++a;
+    size_t b = a;
+    while (b < rest.size() && !is_blank(rest[b])) ++b;
+    return std::pair<size_t, size_t>(a, b);
+  };
+  const auto next = [&]() {
+    const auto [a, b] = peek();
+    i = b;
+    return rest.substr(a, b - a);
+  };
+  // Up to `most` numbers, at least one; the missing ones keep their defaults.
+  const auto numbers = [&](std::string_view option, float* out, int most) {
+    int n = 0;
+    for (double x = 0.0; n < most;) {
+      const auto [a, b] = peek();
+      if (!finite_number(rest.substr(a, b - a), x)) break;
+      if (n < 2) out[n] = float(x);  // w, the third, has no use on a surface
+      i = b;
+      ++n;
+    }
+    if (n == 0) fail(std::string(option) + " needs a number");
+  };
+  DiffuseMap map;
+  for (;;) {
+    const auto [a, b] = peek();
+    const std::string_view option = rest.substr(a, b - a);
+    if (option.empty()) fail("names no file");
+    if (option == "-s" || option == "-o" || option == "-t") {
+      i = b;
+      float ignored[2] = {0.0f, 0.0f};
+      numbers(option, option == "-s" ? map.scale : option == "-o" ? map.offset : ignored, 3);
+    } else if (option == "-mm") {
+      i = b;
+      float ignored[2] = {0.0f, 1.0f};
+      numbers(option, ignored, 2);
+    } else if (option == "-clamp" || option == "-blendu" || option == "-blendv" || option == "-cc") {
+      i = b;
+      const std::string_view value = next();
+      if (value != "on" && value != "off") fail(std::string(option) + " needs on or off");
+      if (option == "-clamp") map.clamp = value == "on";
+    } else if (option == "-colorspace" || option == "-boost" || option == "-bm" || option == "-texres" ||
+               option == "-imfchan" || option == "-type") {
+      i = b;
+      const std::string_view value = next();
+      if (value.empty()) fail(std::string(option) + " needs a value");
+      if (option == "-colorspace") map.linear = value == "linear";
+    } else {
+      map.name = std::string(rest.substr(a));
+      return map;
+    }
+  }
+}
+
+/// Reads the MTL files an OBJ names, from the OBJ's folder, without their comments. For each
+/// material it notes the folder of its MTL file (texture names are relative to that) and its
+/// map_Kd as parse_map_kd reads it.
+class MtlReader : public tinyobj::MaterialReader {
+ public:
+  explicit MtlReader(fs::path obj_folder) : obj_folder_(std::move(obj_folder)) {}
+
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* material_map, std::string* warn, std::string* err) override {
+    const fs::path path = obj_folder_ / name;
+    std::string text;
+    if (!read_without_comments(path, text)) {
+      if (warn) *warn += "material file " + path.string() + " not found\n";
+      return false;
+    }
+    // tinyobjloader adds a material at each "newmtl" with a name, in order; so does this scan.
+    std::vector<DiffuseMap> maps;
+    std::istringstream lines(text);
+    std::string line;
+    for (size_t line_no = 1; std::getline(lines, line); ++line_no) {
+      const std::vector<std::string_view> tokens = split_whitespace(line);
+      if (tokens.size() >= 2 && tokens[0] == "newmtl") {
+        maps.emplace_back();
+      } else if (!tokens.empty() && tokens[0] == "Kd" && !maps.empty()) {
+        maps.back().kd_given = true;
+      } else if (tokens.size() >= 1 && tokens[0] == "map_Kd" && !maps.empty() && error_.empty()) {
+        const size_t at = size_t(tokens[0].data() - line.data()) + tokens[0].size();
+        try {
+          const bool kd_given = maps.back().kd_given;
+          maps.back() = parse_map_kd(std::string_view(line).substr(at), path, line_no);
+          maps.back().kd_given = kd_given;
+        } catch (const InputError& e) {
+          error_ = e.what();  // thrown once tinyobjloader has returned, not through it
+        }
+      }
+    }
+    const size_t first = materials->size();
+    std::istringstream in(text);
+    tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+    folder_of_material.resize(materials->size(), path.parent_path());
+    if (maps.size() != materials->size() - first) {
+      // The two readers disagree on where materials begin: take tinyobjloader's reading.
+      maps.assign(materials->size() - first, DiffuseMap{});
+      for (size_t k = 0; k < maps.size(); ++k) {
+        const tinyobj::material_t& mtl = (*materials)[first + k];
+        const tinyobj::texture_option_t& o = mtl.diffuse_texopt;
+        maps[k].name = mtl.diffuse_texname;
+        maps[k].scale[0] = float(o.scale[0]), maps[k].scale[1] = float(o.scale[1]);
+        maps[k].offset[0] = float(o.origin_offset[0]), maps[k].offset[1] = float(o.origin_offset[1]);
+        maps[k].clamp = o.clamp;
+        maps[k].linear = o.colorspace == "linear";
+        maps[k].kd_given = true;
+      }
+    }
+    // A texture without Kd gets tinyobjloader's default Kd of 0.6 (as Assimp's too), but its
+    // "Kd seen" flag outlives the material that set it, leaving later ones at 0: set it here.
+    for (size_t k = 0; k < maps.size(); ++k)
+      if (!maps[k].name.empty() && !maps[k].kd_given)
+        for (tinyobj::real_t& c : (*materials)[first + k].diffuse) c = tinyobj::real_t(0.6);
+    diffuse_map_of_material.insert(diffuse_map_of_material.end(), maps.begin(), maps.end());
+    return true;
+  }
+
+  /// Throws the first malformed map_Kd found, if any.
+  void throw_if_failed() const {
+    if (!error_.empty()) throw InputError(error_);
+  }
+
+  std::vector<fs::path> folder_of_material;        ///< the MTL file's folder, per material read
+  std::vector<DiffuseMap> diffuse_map_of_material;  ///< map_Kd, per material read
+
+ private:
+  fs::path obj_folder_;
+  std::string error_;
+};
+
+/// The image file an MTL names, looked for relative to the MTL's folder (or as it is, when
+/// absolute). MTL files written on Windows separate folders with '\', so that spelling is tried
+/// with '/' too. Empty when there is no such file.
+std::string find_texture_file(const fs::path& folder, const std::string& name) {
+  std::vector<std::string> spellings{name};
+  if (name.find('\\') != std::string::npos) {
+    std::string slashed = name;
+    std::replace(slashed.begin(), slashed.end(), '\\', '/');
+    spellings.push_back(slashed);
+  }
+  for (const std::string& spelling : spellings) {
+    const fs::path candidate = (folder / spelling).lexically_normal();
+    std::error_code ec;
+    if (fs::is_regular_file(candidate, ec)) return candidate.string();
+  }
+  return {};
+}
+
+/// Index of `image` in the scene's textures, added when no equal entry is there yet, so that
+/// materials sharing a file (sibenik's walls all read kamen.png) open and cache it once.
+int32_t texture_index(std::vector<TextureImage>& textures, const TextureImage& image) {
+  for (size_t i = 0; i < textures.size(); ++i) {
+    const TextureImage& t = textures[i];
+    if (t.file == image.file && t.srgb == image.srgb && t.wrap_s == image.wrap_s && t.wrap_t == image.wrap_t)
+      return int32_t(i);
+  }
+  textures.push_back(image);
+  return int32_t(textures.size() - 1);
+}
+
+/// The texture reference of a map_Kd: the image, and the map from OBJ's (u, v) to OpenImageIO's
+/// (s, t). The -s and -o options act on (u, v) first (u' = scale·u + offset, as most MTL
+/// readers take them), then v' is flipped because OBJ's v runs up the image and t runs down it.
+TextureRef diffuse_texture_ref(int32_t image, const DiffuseMap& map) {
+  TextureRef ref;
+  ref.image = image;
+  ref.map = {map.scale[0], 0.0f, map.offset[0], 0.0f, map.scale[1], map.offset[1]};
+  return ref.then({1.0f, 0.0f, 0.0f, 0.0f, -1.0f, 1.0f});
+}
+
+/// The kinds of map the loader cannot use that `mtl` names, in words for the warning.
+void unused_maps(const tinyobj::material_t& mtl, std::vector<std::string>& kinds) {
+  const std::pair<const std::string*, const char*> maps[] = {
+      {&mtl.specular_texname, "specular maps (map_Ks)"},
+      {&mtl.specular_highlight_texname, "exponent maps (map_Ns)"},
+      {&mtl.bump_texname, "bump maps"},
+      {&mtl.normal_texname, "normal maps (norm)"},
+      {&mtl.displacement_texname, "displacement maps (disp)"},
+      {&mtl.alpha_texname, "alpha maps (map_d)"},
+      {&mtl.reflection_texname, "reflection maps (refl)"},
+      {&mtl.emissive_texname, "emission maps (map_Ke)"},
+      {&mtl.roughness_texname, "roughness maps (map_Pr)"},
+      {&mtl.metallic_texname, "metallic maps (map_Pm)"},
+      {&mtl.sheen_texname, "sheen maps (map_Ps)"},
+  };
+  for (const auto& [name, kind] : maps)
+    if (!name->empty() && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) kinds.push_back(kind);
+}
+
+/// "a", "a and b", "a, b and c".
+std::string join_words(const std::vector<std::string>& words) {
+  std::string out;
+  for (size_t i = 0; i < words.size(); ++i) {
+    if (i > 0) out += i + 1 == words.size() ? " and " : ", ";
+    out += words[i];
+  }
+  return out;
+}
+
 Rgb rgb(const tinyobj::real_t c[3]) { return {float(c[0]), float(c[1]), float(c[2])}; }
 
 bool is_one_of(int value, std::initializer_list<int> set) {
@@ -221,32 +464,60 @@ void load_obj(const fs::path& path, Scene& scene) {
   const std::string file = path.string();
   check_obj_text(path);
 
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(file, config)) {
-    const std::string error = reader.Error();
+  std::string obj_text;
+  if (!read_without_comments(path, obj_text)) throw InputError(file + ": cannot open file");
+  std::istringstream obj_stream(obj_text);
+  MtlReader mtl_reader(path.parent_path());
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> mtls;
+  std::string warning, error;
+  if (!tinyobj::LoadObj(&attrib, &shapes, &mtls, &warning, &error, &obj_stream, &mtl_reader,
+                        /*triangulate=*/true, /*default_vcols_fallback=*/false))
     throw InputError(file + ": " + (error.empty() ? std::string("cannot read OBJ file") : error));
-  }
-  std::istringstream warnings(reader.Warning());
+  std::istringstream warnings(warning);
   for (std::string w; std::getline(warnings, w);)
     if (!w.empty()) scene.warnings.push_back(file + ": " + w);
 
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
-  const std::vector<tinyobj::material_t>& mtls = reader.GetMaterials();
+  mtl_reader.throw_if_failed();
+
   const auto first_material = static_cast<uint32_t>(scene.materials.size());
-  bool textures = false;
-  for (const tinyobj::material_t& mtl : mtls) {
-    scene.materials.push_back(convert_material(mtl, file, scene.warnings));
-    textures = textures || !mtl.diffuse_texname.empty() || !mtl.specular_texname.empty() ||
-               !mtl.bump_texname.empty() || !mtl.emissive_texname.empty() || !mtl.alpha_texname.empty();
+  std::vector<std::string> ignored_maps;
+  for (size_t i = 0; i < mtls.size(); ++i) {
+    const tinyobj::material_t& mtl = mtls[i];
+    Material m = convert_material(mtl, file, scene.warnings);
+    unused_maps(mtl, ignored_maps);
+    const bool read = i < mtl_reader.diffuse_map_of_material.size();
+    const DiffuseMap diffuse = read ? mtl_reader.diffuse_map_of_material[i] : DiffuseMap{};
+    if (!diffuse.name.empty() && (m.kind == MaterialKind::mirror || m.kind == MaterialKind::dielectric)) {
+      const char* kind = "map_Kd of mirror and glass materials";
+      if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end())
+        ignored_maps.push_back(kind);
+    } else if (!diffuse.name.empty() && m.albedo.is_black()) {
+      scene.warnings.push_back(file + ": material '" + mtl.name + "': Kd is black, so map_Kd " +
+                               diffuse.name + " would not show; left untextured");
+    } else if (!diffuse.name.empty()) {
+      const fs::path folder = read ? mtl_reader.folder_of_material[i] : path.parent_path();
+      TextureImage image;
+      image.file = find_texture_file(folder, diffuse.name);
+      if (image.file.empty()) {
+        const std::string where = folder.empty() ? std::string(".") : folder.string();
+        scene.warnings.push_back(file + ": material '" + mtl.name + "': texture '" + diffuse.name +
+                                 "' not found in " + where + "; left untextured");
+      } else {
+        image.srgb = !diffuse.linear;
+        image.wrap_s = image.wrap_t = diffuse.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+        m.albedo_texture = diffuse_texture_ref(texture_index(scene.textures, image), diffuse);
+      }
+    }
+    scene.materials.push_back(std::move(m));
   }
-  if (textures) scene.warnings.push_back(file + ": texture maps are ignored");
+  if (!ignored_maps.empty())
+    scene.warnings.push_back(file + ": " + join_words(ignored_maps) + " are ignored");
 
   // Gather the triangles of each material (−1: faces without usemtl, or with an unknown name).
   std::map<int, std::vector<tinyobj::index_t>> corners_of;
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+  for (const tinyobj::shape_t& shape : shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     size_t offset = 0;
     for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
@@ -275,12 +546,20 @@ void load_obj(const fs::path& path, Scene& scene) {
       mesh.name = stem + ":default";
       scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
     }
-    // Shading normals and uvs only when every corner of the mesh has one.
-    bool has_normals = true, has_uvs = true;
+    // Shading normals and uvs only when every corner of the mesh has one; but a textured
+    // material keeps the uvs its faces have, corners without one reading the texture at (0, 0).
+    bool has_normals = true, all_uvs = true, some_uvs = false;
+    size_t corners_without_uv = 0;
     for (const tinyobj::index_t& c : corners) {
       has_normals = has_normals && c.normal_index >= 0;
-      has_uvs = has_uvs && c.texcoord_index >= 0;
+      all_uvs = all_uvs && c.texcoord_index >= 0;
+      some_uvs = some_uvs || c.texcoord_index >= 0;
+      if (c.texcoord_index < 0) ++corners_without_uv;
     }
+    const bool has_uvs = all_uvs || (some_uvs && scene.materials[mesh.material].is_textured());
+    if (has_uvs && !all_uvs)
+      scene.warnings.push_back(file + ": mesh '" + mesh.name + "': " + std::to_string(corners_without_uv) +
+                               " face corner(s) without texture coordinates read the texture at (0, 0)");
     std::map<Corner, uint32_t> vertex_of;
     mesh.indices.reserve(corners.size());
     for (const tinyobj::index_t& c : corners) {
@@ -288,9 +567,10 @@ void load_obj(const fs::path& path, Scene& scene) {
       auto [it, inserted] = vertex_of.try_emplace(key, static_cast<uint32_t>(mesh.positions.size()));
       if (inserted) {
         const size_t v = size_t(c.vertex_index), t = size_t(c.texcoord_index), n = size_t(c.normal_index);
+        const bool uv = has_uvs && c.texcoord_index >= 0;
         // check_obj_text vouches for the indices; this guards against the two parsers disagreeing.
         if (3 * v + 2 >= attrib.vertices.size() || (has_normals && 3 * n + 2 >= attrib.normals.size()) ||
-            (has_uvs && 2 * t + 1 >= attrib.texcoords.size()))
+            (uv && 2 * t + 1 >= attrib.texcoords.size()))
           throw InputError(file +
                            ": a face refers to a vertex, normal or texture coordinate that does not exist");
         mesh.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
@@ -299,7 +579,8 @@ void load_obj(const fs::path& path, Scene& scene) {
         if (has_normals)
           mesh.normals.emplace_back(attrib.normals[3 * n], attrib.normals[3 * n + 1],
                                     attrib.normals[3 * n + 2]);
-        if (has_uvs) mesh.uvs.emplace_back(attrib.texcoords[2 * t], attrib.texcoords[2 * t + 1]);
+        if (uv) mesh.uvs.emplace_back(attrib.texcoords[2 * t], attrib.texcoords[2 * t + 1]);
+        else if (has_uvs) mesh.uvs.emplace_back(0.0f, 0.0f);
       }
       mesh.indices.push_back(it->second);
     }

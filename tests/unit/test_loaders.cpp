@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
+#include "raytrace_core/io/image_io.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::raytrace_core {
@@ -30,6 +33,8 @@ class Loaders : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("gilt_loaders_" + std::to_string(::getpid()) + "_" +
                                         std::to_string(counter++) + "_" + info->name());
     fs::create_directories(dir_);
+    // Linear copies of sRGB textures go with the test's files rather than into $HOME's cache.
+    ::setenv("GILT_TEXTURE_CACHE", (dir_ / "texture-cache").c_str(), 1);
   }
   void TearDown() override {
     std::error_code ec;
@@ -184,6 +189,203 @@ TEST_F(Loaders, ObjAndMtlCommentsAfterNumbers) {
   const std::string bad_obj =
       write("bad.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
   EXPECT_CONTAINS(error_of([&] { load_scene(bad_obj); }), "bad.mtl:2:");
+}
+
+// A comment may also follow a name (newmtl, usemtl, map_Kd) or a face, which tinyobjloader would
+// otherwise read as part of the name or as one more corner; McGuire's files also end lines in CRLF.
+TEST_F(Loaders, ObjCommentsAfterNamesAndFaces) {
+  write("named.mtl",
+        "newmtl blue # Blue\r\n    Ka 0.161 0.133 0.427 # Blue\r\n    Kd 0.161 0.133 0.427 # Blue\r\n"
+        "    map_Kd wall.png # the wall\r\n");
+  write("wall.png", "not read before commit");
+  const std::string obj = write("named.obj",
+                                "mtllib named.mtl # lib\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nvt 0 0\r\n"
+                                "usemtl blue # wall\r\nf 1/1 2/1 3/1 # one triangle\r\n");
+  const Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.meshes[0].triangle_count(), 1u);
+  const Material& m = scene.materials[scene.meshes[0].material];
+  EXPECT_EQ(m.name, "blue");
+  EXPECT_NEAR(m.albedo.b, 0.427f, 1e-6f);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_EQ(fs::path(scene.textures[0].file).filename(), "wall.png");
+  EXPECT_FALSE(has_warning(scene, "not found"));
+}
+
+/// The albedo_texture map of a material, for comparing with an expected one.
+void expect_map(const TextureRef& ref, const std::array<float, 6>& expected) {
+  for (size_t k = 0; k < 6; ++k) EXPECT_NEAR(ref.map[k], expected[k], 1e-6f) << "map[" << k << "]";
+}
+
+const char* kTexturedQuad = R"(mtllib textured.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vt 0.5 0.5
+usemtl wood
+f 1/1 2/2 3/3 4/4
+usemtl other
+f 1/1 2/2 3/3
+f 1/5 3/3 4/4
+)";
+
+// map_Kd becomes the albedo texture: the file found next to the MTL, sRGB, repeating, and OBJ's
+// upward v flipped into OpenImageIO's downward t.
+TEST_F(Loaders, ObjMapKdBecomesAlbedoTexture) {
+  write("textures/wood.png", "not read before commit");
+  write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd textures/wood.png\nnewmtl other\nKd 1 1 1\n");
+  const std::string obj = write("textured.obj", kTexturedQuad);
+  const Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_EQ(scene.textures[0].file, (dir_ / "textures" / "wood.png").lexically_normal().string());
+  EXPECT_TRUE(scene.textures[0].srgb);
+  EXPECT_EQ(scene.textures[0].wrap_s, TextureWrap::repeat);
+  EXPECT_EQ(scene.textures[0].wrap_t, TextureWrap::repeat);
+  const TriangleMesh& wood = mesh_named(scene, "textured:wood");
+  const Material& m = scene.materials[wood.material];
+  EXPECT_EQ(m.albedo, Rgb(0.5f));
+  EXPECT_EQ(m.albedo_texture.image, 0);
+  expect_map(m.albedo_texture, {1, 0, 0, 0, -1, 1});
+  EXPECT_EQ(wood.uvs.size(), wood.positions.size());
+  // Position 1 appears with two texture coordinates in `other`: the seam splits the vertex.
+  const TriangleMesh& other = mesh_named(scene, "textured:other");
+  EXPECT_FALSE(scene.materials[other.material].is_textured());
+  EXPECT_EQ(other.positions.size(), 5u);
+  EXPECT_FALSE(has_warning(scene, "texture maps are ignored"));
+  EXPECT_FALSE(has_warning(scene, "map_Kd"));
+}
+
+// -s and -o act on (u, v) before the flip: u' = 2u + 0.5, v' = 2v + 0, so s = 2u + 0.5 and
+// t = 1 − v' = −2v + 1. -clamp on clamps both axes.
+TEST_F(Loaders, ObjMapKdScaleOffsetAndClamp) {
+  write("wood.png", "not read before commit");
+  write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd -s 2 2 -o 0.5 0 -clamp on wood.png\n");
+  const std::string obj = write("textured.obj", kTexturedQuad);
+  const Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_EQ(scene.textures[0].wrap_s, TextureWrap::clamp);
+  EXPECT_EQ(scene.textures[0].wrap_t, TextureWrap::clamp);
+  const TextureRef& ref = scene.materials[mesh_named(scene, "textured:wood").material].albedo_texture;
+  expect_map(ref, {2, 0, 0.5f, 0, -2, 1});
+  const Vec2 st = ref.st(Vec2(0.25f, 0.25f));  // s = 2·0.25 + 0.5 = 1, t = 1 − 2·0.25 = 0.5
+  EXPECT_NEAR(st.x, 1.0f, 1e-6f);
+  EXPECT_NEAR(st.y, 0.5f, 1e-6f);
+
+  // An option without its number is an error on the MTL's line, not a file named "-s".
+  write("bad.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd -s wood.png\n");
+  const std::string bad =
+      write("bad.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wood\nf 1 2 3\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene_file(bad); }), "bad.mtl:3: map_Kd -s needs a number");
+}
+
+TEST_F(Loaders, ObjMissingTextureWarnsAndLeavesMaterialUntextured) {
+  write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd nothere.png\n");
+  const std::string obj = write("textured.obj", kTexturedQuad);
+  const Scene scene = load_scene_file(obj);
+  EXPECT_TRUE(scene.textures.empty());
+  EXPECT_FALSE(scene.materials[mesh_named(scene, "textured:wood").material].is_textured());
+  EXPECT_TRUE(has_warning(scene, "nothere.png"));
+  const Scene committed = load_scene(obj);  // and the scene still commits
+  EXPECT_EQ(committed.triangle_count(), 4u);
+}
+
+// Materials naming the same file (once as a Windows-style path) share one image; the maps the
+// loader cannot use are named once per file, in one warning. A textured material without Kd
+// gets Kd 0.6, also after a material that had one.
+TEST_F(Loaders, ObjMaterialsSharingATextureShareOneImage) {
+  write("tex/stone.png", "not read before commit");
+  write("tex/stone-bump.png", "not read before commit");
+  write("shared.mtl",
+        "newmtl wall\nKd 0.8 0.8 0.8\nmap_Kd tex/stone.png\nbump tex/stone-bump.png\n"
+        "newmtl pillar\nmap_Kd tex\\stone.png\nmap_bump tex/stone-bump.png\nmap_d tex/stone.png\n");
+  const std::string obj = write("shared.obj",
+                                "mtllib shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                "usemtl wall\nf 1/1 2/2 3/3\nusemtl pillar\nf 1/1 3/3 2/2\n");
+  const Scene scene = load_scene_file(obj);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_EQ(scene.materials[mesh_named(scene, "shared:wall").material].albedo_texture.image, 0);
+  EXPECT_EQ(scene.materials[mesh_named(scene, "shared:pillar").material].albedo_texture.image, 0);
+  EXPECT_EQ(scene.materials[mesh_named(scene, "shared:pillar").material].albedo, Rgb(0.6f));
+  int ignored = 0;
+  for (const std::string& w : scene.warnings)
+    if (w.find("are ignored") != std::string::npos) {
+      ++ignored;
+      EXPECT_CONTAINS(w, "bump maps");
+      EXPECT_CONTAINS(w, "alpha maps (map_d)");
+      EXPECT_EQ(w.find("map_Kd"), std::string::npos) << w;
+    }
+  EXPECT_EQ(ignored, 1);
+}
+
+// A textured material keeps the uvs its faces have; corners without one read (0, 0).
+TEST_F(Loaders, ObjTexturedMeshWithSomeCornersLackingUvs) {
+  write("wood.png", "not read before commit");
+  write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd wood.png\n");
+  const std::string obj = write("textured.obj",
+                                "mtllib textured.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0.5 0.5\n"
+                                "usemtl wood\nf 1/1 2/1 3/1\nf 2 4 3\n");
+  const Scene scene = load_scene_file(obj);
+  const TriangleMesh& mesh = mesh_named(scene, "textured:wood");
+  ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
+  EXPECT_EQ(mesh.positions.size(), 6u);  // (v, vt) and (v, none) are different vertices
+  EXPECT_EQ(mesh.uvs[0], Vec2(0.5f, 0.5f));
+  EXPECT_EQ(mesh.uvs[5], Vec2(0.0f, 0.0f));
+  EXPECT_TRUE(has_warning(scene, "3 face corner(s) without texture coordinates"));
+}
+
+/// The surface point of mesh `geom_id` whose texture coordinates are `uv`.
+SurfaceInteraction point_at_uv(const Scene& scene, uint32_t geom_id, Vec2 uv) {
+  const TriangleMesh& mesh = scene.meshes[geom_id];
+  for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const Vec2 a = mesh.uvs[mesh.indices[3 * t]], b = mesh.uvs[mesh.indices[3 * t + 1]],
+               c = mesh.uvs[mesh.indices[3 * t + 2]];
+    // Solve uv = a + b1 (b − a) + b2 (c − a) by Cramer's rule.
+    const Vec2 e1 = b - a, e2 = c - a, d = uv - a;
+    const float det = e1.x * e2.y - e1.y * e2.x;
+    if (det == 0.0f) continue;
+    const float b1 = (d.x * e2.y - d.y * e2.x) / det, b2 = (e1.x * d.y - e1.y * d.x) / det;
+    if (b1 >= 0.0f && b2 >= 0.0f && b1 + b2 <= 1.0f) return scene.triangle_point(geom_id, t, Vec2(b1, b2));
+  }
+  throw std::runtime_error("no triangle covers that uv");
+}
+
+// Kd × map_Kd at two points of a quad textured with a 2×1 image, red texel left, blue right.
+// Saturated primaries survive the sRGB → linear conversion exactly (code 255 → 1, 0 → 0); the
+// remaining error is the linear copy's half floats and the bilinear weights at a texel's centre,
+// well inside 1e-3.
+TEST_F(Loaders, ObjTextureAlbedoAtPoints) {
+  Image image;
+  image.width = 2;
+  image.height = 1;
+  image.pixels = {Rgb(1, 0, 0), Rgb(0, 0, 1)};
+  write_image((dir_ / "redblue.png").string(), image);  // 8-bit sRGB
+  write("quad.mtl", "newmtl painted\nKd 0.5 0.8 0.6\nmap_Kd redblue.png\n");
+  const std::string obj = write("quad.obj",
+                                "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl painted\nf 1/1 2/2 3/3 4/4\n");
+  const Scene scene = load_scene(obj);
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  ASSERT_NE(scene.texture_set(), nullptr);
+  const auto albedo_at = [&](Vec2 uv) {
+    const SurfaceInteraction si = point_at_uv(scene, 0, uv);
+    EXPECT_NEAR(si.uv.x, uv.x, 1e-6f);
+    EXPECT_NEAR(si.uv.y, uv.y, 1e-6f);
+    Material scratch;
+    return scene.shading_material(si, scratch).albedo;
+  };
+  // u = 0.25 and 0.75 are the texel centres; v = 0.5 the middle of the one row.
+  const Rgb left = albedo_at(Vec2(0.25f, 0.5f)), right = albedo_at(Vec2(0.75f, 0.5f));
+  EXPECT_NEAR(left.r, 0.5f, 1e-3f);
+  EXPECT_NEAR(left.g, 0.0f, 1e-3f);
+  EXPECT_NEAR(left.b, 0.0f, 1e-3f);
+  EXPECT_NEAR(right.r, 0.0f, 1e-3f);
+  EXPECT_NEAR(right.g, 0.0f, 1e-3f);
+  EXPECT_NEAR(right.b, 0.6f, 1e-3f);
 }
 
 TEST_F(Loaders, ObjFaceIndexOutOfRange) {
