@@ -9,9 +9,24 @@
 namespace gilt::raytrace_core {
 namespace {
 
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                void*) {
-  return true;  // textures are not used: do not decode them
+// tinygltf hands every image's encoded bytes to this callback, which would normally decode them.
+// Nothing is decoded: OpenImageIO reads textures from files when the scene is committed. Bytes
+// are kept only where nothing else keeps them, a data: URI's (tinygltf drops what it decoded):
+// a file's bytes are read again by OpenImageIO, and a buffer view's stay in the model's buffer.
+bool keep_encoded_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                        const unsigned char* bytes, int size, void*) {
+  if (!image->uri.empty() || image->bufferView >= 0 || !bytes || size <= 0) return true;
+  image->image.assign(bytes, bytes + size);
+  image->as_is = true;
+  return true;
+}
+
+/// True for tinygltf's notes on an image file it could not find or read: load_gltf reports those
+/// itself, with the path it resolved. (Buffers are required, so their misses are errors instead.)
+bool is_image_file_note(const std::string& line) {
+  return line.rfind("File not found : ", 0) == 0 || line.rfind("File read error : ", 0) == 0 ||
+         line.rfind("File is empty : ", 0) == 0 ||
+         line.rfind("Failed to load external 'uri' for image[", 0) == 0;
 }
 
 std::string trim(std::string s) {
@@ -24,7 +39,7 @@ std::string trim(std::string s) {
 tinygltf::Model read_gltf_file(const std::string& file, std::vector<std::string>* warnings) {
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skip_image, nullptr);
+  loader.SetImageLoader(keep_encoded_image, nullptr);
   std::string error, warning;
   bool ok = false;
   try {
@@ -36,7 +51,8 @@ tinygltf::Model read_gltf_file(const std::string& file, std::vector<std::string>
   if (warnings) {
     std::istringstream lines(warning);
     for (std::string w; std::getline(lines, w);)
-      if (!trim(w).empty()) warnings->push_back(file + ": " + trim(w));
+      if (!trim(w).empty() && !is_image_file_note(w))
+        warnings->push_back(file + ": " + trim(w));
   }
   if (!ok) throw InputError(file + ": " + (error.empty() ? std::string("cannot read glTF file") : trim(error)));
   return model;

@@ -1,7 +1,13 @@
 #pragma once
 // Reading a glTF 2.0 file (.gltf with its buffers, or .glb) into tinygltf's model, for the scene
 // loader and for the writers that edit the user's own model (radiosity's --onto input and
-// --lightmap). Images are not decoded: nothing here uses their pixels.
+// --lightmap). Images are not decoded here: the scene loader hands image files to OpenImageIO.
+// What each tinygltf::Image holds afterwards:
+//   - an image in a file of its own: `uri` as written in the file (not percent-decoded), no bytes;
+//   - an image in a buffer view (GLB files): `bufferView`, `mimeType`, no bytes (they are in the
+//     buffer already);
+//   - an image in a data: URI: `uri` empty, `as_is` set and the encoded bytes (PNG, JPEG, ...) in
+//     `image`, `mimeType` from the URI's header.
 
 #include <string>
 #include <vector>
@@ -11,8 +17,9 @@
 namespace gilt::raytrace_core {
 
 /// The model in `file` (.glb read as binary, anything else as text). tinygltf's warnings, one
-/// per line, are appended to *warnings when given. Throws InputError naming the file when it
-/// cannot be read or parsed.
+/// per line, are appended to *warnings when given, except its notes on image files it cannot
+/// find (the scene loader resolves image paths itself and names the missing ones). Throws
+/// InputError naming the file when it cannot be read or parsed.
 tinygltf::Model read_gltf_file(const std::string& file, std::vector<std::string>* warnings = nullptr);
 
 }  // namespace gilt::raytrace_core

@@ -1,6 +1,7 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf: the node hierarchy of the default scene with its
-// transforms, triangle primitives, materials, the first perspective camera and
-// KHR_lights_punctual lights. Textures, skins, morph targets and animations are ignored.
+// transforms, triangle primitives, materials with their base-colour textures, the first
+// perspective camera and KHR_lights_punctual lights. Other textures (normal, emissive,
+// metallic-roughness, occlusion, extensions'), skins, morph targets and animations are ignored.
 //
 // Material mapping (documented in docs/scene-format.md); base = baseColorFactor.rgb,
 // m = metallicFactor, r = roughnessFactor:
@@ -15,11 +16,27 @@
 //   emission = emissiveFactor × KHR_materials_emissive_strength; doubleSided → two-sided emission
 // Photometric light units are read as radiometric: point/spot intensity (cd) as W·sr⁻¹,
 // directional illuminance (lx) as W·m⁻², i.e. no 683 lm/W factor.
+//
+// Base-colour textures: baseColorTexture becomes Material::albedo_texture over an sRGB
+// TextureImage with the sampler's wrap modes. It scales the diffuse albedo (a glossy material's
+// specular colour stays untextured) and is ignored, with a warning, on mirrors and glass. Its UV
+// set (textureInfo.texCoord, or the KHR_texture_transform's own) is the one read into
+// TriangleMesh::uvs for the primitives of that material. glTF's UVs already have OpenImageIO's
+// origin (top-left), so the map is the identity unless KHR_texture_transform gives one. Image
+// files are handed to OpenImageIO as they are; images embedded in the glTF (data: URIs, buffer
+// views) are first written to the texture cache folder under a name made from their content.
+
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -53,6 +70,80 @@ const tinygltf::Value& extension(const tinygltf::ExtensionMap& extensions, const
 
 Rgb rgb_or(const std::vector<double>& v, Rgb fallback) {
   return v.size() >= 3 ? Rgb(float(v[0]), float(v[1]), float(v[2])) : fallback;
+}
+
+/// A URI's %XX escapes replaced by the bytes they stand for (a malformed escape is kept as written).
+std::string percent_decode(const std::string& uri) {
+  const auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  std::string out;
+  out.reserve(uri.size());
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+      out += char(hex(uri[i + 1]) * 16 + hex(uri[i + 2]));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+/// File extension for an embedded image: from its declared MIME type, else from its first bytes
+/// (a data:application/octet-stream URI declares none). Empty when neither tells.
+std::string image_extension(const std::string& mime_type, const unsigned char* bytes, size_t size) {
+  if (mime_type == "image/png") return ".png";
+  if (mime_type == "image/jpeg") return ".jpg";
+  if (mime_type == "image/webp") return ".webp";
+  if (mime_type == "image/bmp") return ".bmp";
+  if (mime_type == "image/gif") return ".gif";
+  const auto starts = [&](std::initializer_list<unsigned char> magic, size_t at = 0) {
+    return size >= at + magic.size() && std::equal(magic.begin(), magic.end(), bytes + at);
+  };
+  if (starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'})) return ".png";
+  if (starts({0xff, 0xd8, 0xff})) return ".jpg";
+  if (starts({'R', 'I', 'F', 'F'}) && starts({'W', 'E', 'B', 'P'}, 8)) return ".webp";
+  if (starts({'G', 'I', 'F', '8'})) return ".gif";
+  if (starts({'B', 'M'})) return ".bmp";
+  return {};
+}
+
+/// FNV-1a over bytes: a name for cached content that is the same in every run and build.
+uint64_t content_hash(const unsigned char* bytes, size_t size) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (size_t i = 0; i < size; ++i) h = (h ^ bytes[i]) * 0x100000001b3ull;
+  return h;
+}
+
+/// True when `path` holds exactly these bytes.
+bool file_holds(const fs::path& path, const unsigned char* bytes, size_t size) {
+  std::error_code ec;
+  if (fs::file_size(path, ec) != size || ec) return false;
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<unsigned char> held((std::istreambuf_iterator<char>(in)),
+                                        std::istreambuf_iterator<char>());
+  return held.size() == size && std::equal(held.begin(), held.end(), bytes);
+}
+
+/// The texture wrap mode of a glTF sampler's wrapS or wrapT value.
+bool wrap_mode(int gl_wrap, TextureWrap& out) {
+  switch (gl_wrap) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT:
+      out = TextureWrap::repeat;
+      return true;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+      out = TextureWrap::clamp;
+      return true;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+      out = TextureWrap::mirror;
+      return true;
+    default:
+      return false;
+  }
 }
 
 Material convert_material(const tinygltf::Material& gm, const std::string& name) {
@@ -107,16 +198,43 @@ class GltfLoader {
     first_material_ = static_cast<uint32_t>(scene_.materials.size());
     file_index_ = int32_t(scene_.model_files.size());
     scene_.model_files.push_back(file_);
-    bool textures = false;
+    image_files_.assign(model_.images.size(), ImageFile{});
+    std::vector<std::string> ignored;  // kinds of texture the file has and gilt does not read
+    const auto note_ignored = [&](bool present, const std::string& kind) {
+      if (present && std::find(ignored.begin(), ignored.end(), kind) == ignored.end())
+        ignored.push_back(kind);
+    };
     for (size_t i = 0; i < model_.materials.size(); ++i) {
       const tinygltf::Material& gm = model_.materials[i];
-      scene_.materials.push_back(
-          convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name));
-      textures = textures || gm.pbrMetallicRoughness.baseColorTexture.index >= 0 ||
-                 gm.emissiveTexture.index >= 0 || gm.normalTexture.index >= 0 ||
-                 gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
+      Material m = convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name);
+      int uv_set = 0;
+      // A mirror's or glass's base colour tints what it reflects or transmits, which a texture on
+      // Material::albedo cannot express: left out, as the OBJ loader leaves out their map_Kd.
+      const bool has_base_texture = gm.pbrMetallicRoughness.baseColorTexture.index >= 0;
+      note_ignored(has_base_texture && m.is_specular(), "base colour of mirror and glass materials");
+      if (has_base_texture && !m.is_specular())
+        m.albedo_texture = base_color_texture(
+            gm.pbrMetallicRoughness.baseColorTexture,
+            "materials[" + std::to_string(i) + "].pbrMetallicRoughness.baseColorTexture", uv_set);
+      uv_set_of_material_.push_back(m.albedo_texture.valid() ? uv_set : 0);
+      scene_.materials.push_back(std::move(m));
+      note_ignored(gm.normalTexture.index >= 0, "normal");
+      note_ignored(gm.emissiveTexture.index >= 0, "emissive");
+      note_ignored(gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0, "metallic-roughness");
+      note_ignored(gm.occlusionTexture.index >= 0, "occlusion");
+      // Extensions' textures, e.g. KHR_materials_transmission's transmissionTexture.
+      for (const auto& [name, value] : gm.extensions)
+        if (value.IsObject())
+          for (const std::string& key : value.Keys())
+            note_ignored(
+                key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.Get(key).IsObject(),
+                name + " " + key);
     }
-    if (textures) scene_.warnings.push_back(file_ + ": textures are ignored");
+    if (!ignored.empty()) {
+      std::string list;
+      for (const std::string& kind : ignored) list += (list.empty() ? "" : ", ") + kind;
+      scene_.warnings.push_back(file_ + ": these textures are ignored: " + list);
+    }
 
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
@@ -137,6 +255,186 @@ class GltfLoader {
 
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(file_ + ": " + what); }
+
+  /// A glTF image as a file OpenImageIO can open: `path` empty when there is none (warned once).
+  struct ImageFile {
+    bool resolved = false;
+    std::string path;
+  };
+
+  /// The reference a base colour textureInfo (at JSON path `where`) makes, or an invalid one when
+  /// its image cannot be had; `uv_set` is set to the TEXCOORD set it reads.
+  TextureRef base_color_texture(const tinygltf::TextureInfo& info, const std::string& where, int& uv_set) {
+    if (size_t(info.index) >= model_.textures.size())
+      fail(where + ".index: texture " + std::to_string(info.index) + " does not exist");
+    uv_set = info.texCoord;
+    TextureRef ref;
+    const tinygltf::Value& transform = extension(info.extensions, "KHR_texture_transform");
+    if (transform.IsObject())
+      ref.map = texture_transform(transform, where + ".extensions.KHR_texture_transform", uv_set);
+    if (uv_set < 0) fail(where + ".texCoord: must not be negative");
+
+    const std::string texture_where = "textures[" + std::to_string(info.index) + "]";
+    const tinygltf::Texture& texture = model_.textures[size_t(info.index)];
+    if (texture.source < 0) {  // e.g. only a KHR_texture_basisu or EXT_texture_webp source
+      if (std::find(sourceless_.begin(), sourceless_.end(), info.index) == sourceless_.end()) {
+        sourceless_.push_back(info.index);
+        scene_.warnings.push_back(file_ + ": " + texture_where +
+                                  " has no image gilt can read; its materials are untextured");
+      }
+      return TextureRef{};
+    }
+    if (size_t(texture.source) >= model_.images.size())
+      fail(texture_where + ".source: image " + std::to_string(texture.source) + " does not exist");
+    TextureImage image;
+    image.file = image_file(texture.source);
+    if (image.file.empty()) return TextureRef{};
+    image.srgb = true;  // glTF stores base colour sRGB-encoded
+    if (texture.sampler >= 0) {
+      if (size_t(texture.sampler) >= model_.samplers.size())
+        fail(texture_where + ".sampler: sampler " + std::to_string(texture.sampler) + " does not exist");
+      const tinygltf::Sampler& sampler = model_.samplers[size_t(texture.sampler)];
+      const std::string sampler_where = "samplers[" + std::to_string(texture.sampler) + "]";
+      if (!wrap_mode(sampler.wrapS, image.wrap_s))
+        fail(sampler_where + ".wrapS: unknown wrap mode " + std::to_string(sampler.wrapS));
+      if (!wrap_mode(sampler.wrapT, image.wrap_t))
+        fail(sampler_where + ".wrapT: unknown wrap mode " + std::to_string(sampler.wrapT));
+    }
+    // Textures sharing a file and wrap modes share one opened image (the Cesium truck's body and
+    // wheels read one atlas through two textures).
+    for (size_t i = 0; i < scene_.textures.size() && !ref.valid(); ++i) {
+      const TextureImage& t = scene_.textures[i];
+      if (t.file == image.file && t.srgb == image.srgb && t.wrap_s == image.wrap_s &&
+          t.wrap_t == image.wrap_t)
+        ref.image = int32_t(i);
+    }
+    if (!ref.valid()) {
+      ref.image = int32_t(scene_.textures.size());
+      scene_.textures.push_back(std::move(image));
+    }
+    return ref;
+  }
+
+  /// KHR_texture_transform as the affine map from UV to (s, t): offset · rotation · scale. The
+  /// rotation turns UVs counter-clockwise as seen in UV space, whose v axis points down:
+  ///   s =  cos r · sx u + sin r · sy v + ox
+  ///   t = −sin r · sx u + cos r · sy v + oy
+  /// This is the extension's own example (offset [0, 1], rotation π/2, scale 0.5 reads the
+  /// image's lower-left quadrant turned a quarter clockwise) and what its sample model and the
+  /// common viewers do. (The README's GLSL listing, read as column-major, is the transpose; that
+  /// listing is the known erratum, KhronosGroup/glTF#1563.) A texCoord given here overrides the
+  /// textureInfo's.
+  std::array<float, 6> texture_transform(const tinygltf::Value& t, const std::string& where,
+                                         int& uv_set) const {
+    const auto pair = [&](const char* key, double fallback) -> std::array<double, 2> {
+      if (!t.Has(key)) return {fallback, fallback};
+      const tinygltf::Value& v = t.Get(key);
+      if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
+        fail(where + "." + key + ": expected an array of two numbers");
+      return {v.Get(0).GetNumberAsDouble(), v.Get(1).GetNumberAsDouble()};
+    };
+    const std::array<double, 2> offset = pair("offset", 0.0), scale = pair("scale", 1.0);
+    double rotation = 0.0;
+    if (t.Has("rotation")) {
+      if (!t.Get("rotation").IsNumber()) fail(where + ".rotation: expected a number");
+      rotation = t.Get("rotation").GetNumberAsDouble();
+    }
+    if (t.Has("texCoord")) {
+      const tinygltf::Value& v = t.Get("texCoord");
+      if (!v.IsNumber() || v.GetNumberAsDouble() != std::floor(v.GetNumberAsDouble()) ||
+          v.GetNumberAsDouble() < 0.0 || v.GetNumberAsDouble() > 1e6)
+        fail(where + ".texCoord: expected a non-negative integer");
+      uv_set = int(v.GetNumberAsDouble());
+    }
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    const std::array<float, 6> map{float(c * scale[0]),  float(s * scale[1]), float(offset[0]),
+                                   float(-s * scale[0]), float(c * scale[1]), float(offset[1])};
+    for (float x : map)
+      if (!std::isfinite(x)) fail(where + ": offset, rotation and scale must be finite");
+    return map;
+  }
+
+  /// The file of glTF image `index` (checked by the caller), resolved on first use; empty, with a
+  /// warning the first time, when there is none.
+  const std::string& image_file(int index) {
+    ImageFile& out = image_files_[size_t(index)];
+    if (out.resolved) return out.path;
+    out.resolved = true;
+    const tinygltf::Image& image = model_.images[size_t(index)];
+    const std::string where = "images[" + std::to_string(index) + "]";
+    const auto unusable = [&](const std::string& why) -> const std::string& {
+      scene_.warnings.push_back(file_ + ": " + where + ": " + why + "; materials using it are untextured");
+      return out.path;
+    };
+    if (image.bufferView >= 0) {
+      if (size_t(image.bufferView) >= model_.bufferViews.size())
+        fail(where + ".bufferView: buffer view " + std::to_string(image.bufferView) + " does not exist");
+      const tinygltf::BufferView& view = model_.bufferViews[size_t(image.bufferView)];
+      if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
+        fail(where + ".bufferView: buffer view has no buffer");
+      const std::vector<unsigned char>& buffer = model_.buffers[size_t(view.buffer)].data;
+      if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+        fail(where + ".bufferView: reaches past the end of its buffer");
+      if (view.byteLength == 0) return unusable("empty buffer view");
+      out.path = cached_image(buffer.data() + view.byteOffset, view.byteLength, image.mimeType, where);
+      if (out.path.empty()) return unusable("image of unknown type (mimeType '" + image.mimeType + "')");
+      return out.path;
+    }
+    if (image.as_is && !image.image.empty()) {  // a data: URI, decoded by tinygltf
+      out.path = cached_image(image.image.data(), image.image.size(), image.mimeType, where);
+      if (out.path.empty()) return unusable("embedded image of unknown type");
+      return out.path;
+    }
+    if (image.uri.rfind("data:", 0) == 0)  // a data: URI of a type tinygltf does not take, e.g. image/webp
+      return unusable("data URI of a type gilt cannot read ('" + image.uri.substr(0, image.uri.find(',')) +
+                      "')");
+    if (image.uri.empty()) return unusable("no uri and no buffer view");
+    const fs::path relative = percent_decode(image.uri);
+    const fs::path path = relative.is_absolute() ? relative : fs::path(file_).parent_path() / relative;
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return unusable("no image file '" + path.string() + "'");
+    out.path = path.string();
+    return out.path;
+  }
+
+  /// An embedded image's encoded bytes as a file in the texture cache folder, named by content,
+  /// so one image is written once however often it is loaded. Empty when its type is unknown.
+  std::string cached_image(const unsigned char* bytes, size_t size, const std::string& mime_type,
+                           const std::string& where) const {
+    const std::string ext = image_extension(mime_type, bytes, size);
+    if (ext.empty()) return {};
+    char name[64];
+    std::snprintf(name, sizeof name, "gltf-%016llx-%zu",
+                  static_cast<unsigned long long>(content_hash(bytes, size)), size);
+    const fs::path folder = texture_cache_folder();
+    const fs::path target = folder / (name + ext);
+    if (file_holds(target, bytes, size)) return target.string();
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (ec) fail(where + ": texture cache folder " + folder.string() + " cannot be made: " + ec.message());
+    // Written under a name of this process and call, then renamed into place: a reader (another
+    // process loading the same model) never sees a half-written image, and two writers of the
+    // same one do not collide.
+    static std::atomic<unsigned> counter{0};
+    const fs::path partial =
+        folder / (std::string(name) + ".part" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    {
+      std::ofstream file(partial, std::ios::binary | std::ios::trunc);
+      file.write(reinterpret_cast<const char*>(bytes), std::streamsize(size));
+      file.close();
+      if (!file) {
+        fs::remove(partial, ec);
+        fail(where + ": texture cache file " + partial.string() + " cannot be written");
+      }
+    }
+    fs::rename(partial, target, ec);
+    if (ec) {
+      const std::string why = ec.message();
+      fs::remove(partial, ec);
+      fail(where + ": texture cache file " + target.string() + " cannot be written: " + why);
+    }
+    return target.string();
+  }
 
   static glm::mat4 local_transform(const tinygltf::Node& node) {
     glm::mat4 m(1.0f);
@@ -229,6 +527,31 @@ class GltfLoader {
     return out;
   }
 
+  /// Texture coordinates: float, or normalized unsigned byte or short scaled to [0, 1] (the
+  /// three component types glTF allows for TEXCOORD_n). Empty for anything else.
+  std::vector<Vec2> read_uvs(int index, const std::string& what) const {
+    if (index < 0 || size_t(index) >= model_.accessors.size()) return {};
+    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+    if (a.type != TINYGLTF_TYPE_VEC2) return {};
+    if (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) return read_floats<2>(index, what);
+    const bool byte = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    if (!a.normalized || (!byte && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)) return {};
+    size_t stride = 0;
+    const unsigned char* data = elements(index, what, stride);
+    std::vector<Vec2> out(a.count);
+    for (size_t i = 0; i < a.count; ++i) {
+      const unsigned char* p = data + i * stride;
+      if (byte) {
+        out[i] = Vec2(float(p[0]) / 255.0f, float(p[1]) / 255.0f);
+      } else {
+        uint16_t v[2];
+        std::memcpy(v, p, sizeof v);
+        out[i] = Vec2(float(v[0]) / 65535.0f, float(v[1]) / 65535.0f);
+      }
+    }
+    return out;
+  }
+
   std::vector<uint32_t> read_indices(int index, const std::string& what) const {
     size_t stride = 0;
     const unsigned char* data = elements(index, what, stride);
@@ -289,15 +612,22 @@ class GltfLoader {
       mesh.normals = read_floats<3>(it->second, what + " NORMAL");
       if (mesh.normals.size() != n) fail(what + ": NORMAL and POSITION counts differ");
     }
-    if (const auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
-      const bool is_float =
-          it->second >= 0 && size_t(it->second) < model_.accessors.size() &&
-          model_.accessors[size_t(it->second)].componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
-      if (is_float) mesh.uvs = read_floats<2>(it->second, what + " TEXCOORD_0");
+    // The UV set the material's base colour texture reads (TEXCOORD_0 when it has none).
+    const int uv_set = prim.material >= 0 && size_t(prim.material) < uv_set_of_material_.size()
+                           ? uv_set_of_material_[size_t(prim.material)]
+                           : 0;
+    const std::string uv_name = "TEXCOORD_" + std::to_string(uv_set);
+    if (const auto it = prim.attributes.find(uv_name); it != prim.attributes.end()) {
+      mesh.uvs = read_uvs(it->second, what + " " + uv_name);
       if (mesh.uvs.size() != n) {
         mesh.uvs.clear();
-        scene_.warnings.push_back(file_ + ": " + what + ": TEXCOORD_0 is not float VEC2 per vertex; dropped");
+        scene_.warnings.push_back(
+            file_ + ": " + what + ": " + uv_name +
+            " is not float or normalized unsigned byte or short VEC2 per vertex; dropped");
       }
+    } else if (uv_set != 0) {
+      scene_.warnings.push_back(file_ + ": " + what + ": has no " + uv_name +
+                                ", which its material's base colour texture reads");
     }
     std::vector<uint32_t> corners(n);
     if (prim.indices >= 0) {
@@ -384,6 +714,9 @@ class GltfLoader {
   Scene& scene_;
   std::vector<bool> on_path_;  // nodes on the current root-to-node path, to catch cycles
   uint32_t first_material_ = 0;
+  std::vector<int> uv_set_of_material_;  // TEXCOORD set each glTF material's base colour texture reads
+  std::vector<ImageFile> image_files_;   // per glTF image, resolved on first use
+  std::vector<int> sourceless_;          // textures without an image, warned about already
   int default_material_ = -1;
   int32_t file_index_ = -1;
   bool camera_done_ = false;
