@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
@@ -122,7 +123,22 @@ void run_info(const InfoOptions& o) {
   const size_t bvh = scene.triangle_count() * 96 + scene.spheres.size() * 96;
   bytes += bvh + scene.spheres.size() * sizeof(rc::Sphere);
   const rc::Bounds3& b = scene.bounds();
-  const std::vector<MethodPlan> plans = plan_methods(scene);
+  std::vector<MethodPlan> plans = plan_methods(scene);
+  // Textures: the images the materials read, at the linear half-float copies' size with their
+  // MIP levels (4/3 of the finest).
+  const size_t textured = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
+                                               [](const rc::Material& m) { return m.is_textured(); }));
+  const size_t texels = scene.texture_set() ? scene.texture_set()->texel_count() : 0;
+  const size_t texture_bytes = texels * 2 * 4 / 3;
+  if (textured > 0)
+    for (MethodPlan& p : plans) {
+      if (p.method == "radiosity")
+        p.runs.push_back("albedo textures: each element reflects its texture's mean over it; the view reads texels per pixel");
+      else if (p.method == "photon" || p.method == "sppm")
+        p.runs.push_back("albedo textures: read where photons land and at the points the camera sees");
+      else
+        p.runs.push_back("albedo textures: read at every hit (MIP-mapped, bilinear)");
+    }
 
   if (o.json) {
     nlohmann::json j = {{"command", "info"},
@@ -135,6 +151,8 @@ void run_info(const InfoOptions& o) {
                         {"materials", materials},
                         {"emissive_materials", emissive},
                         {"bounds", {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}}},
+                        {"textures", {{"images", scene.textures.size()}, {"textured_materials", textured},
+                                      {"texels", texels}, {"memory_estimate_bytes", texture_bytes}}},
                         {"memory_estimate_bytes", bytes}};
     for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};
     std::cout << j.dump() << std::endl;
@@ -150,6 +168,9 @@ void run_info(const InfoOptions& o) {
   std::printf("\n  materials:");
   for (const auto& [kind, n] : materials) std::printf(" %zu %s;", n, kind.c_str());
   std::printf(" %zu emissive\n", emissive);
+  if (!scene.textures.empty())
+    std::printf("  textures:  %zu image(s) read by %zu material(s): %.1f Mtexel channels, about %.1f MB as linear half floats with MIP levels\n",
+                scene.textures.size(), textured, double(texels) / 1e6, double(texture_bytes) / 1e6);
   if (bytes < 1000000) std::printf("  memory:    about %.1f kB (geometry and BVH, estimated)\n", double(bytes) / 1e3);
   else std::printf("  memory:    about %.1f MB (geometry and BVH, estimated)\n", double(bytes) / 1e6);
   for (const MethodPlan& p : plans) {
