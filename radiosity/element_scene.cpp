@@ -9,7 +9,10 @@ rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh) {
   out.name = scene.name;
   out.materials = scene.materials;
   // Its rays ask only whether something is in the way; textures are read in the input scene.
-  for (rc::Material& m : out.materials) m.albedo_texture = rc::TextureRef{};
+  for (rc::Material& m : out.materials) {
+    m.albedo_texture = m.alpha_texture = rc::TextureRef{};
+    m.alpha_mode = rc::AlphaMode::opaque;
+  }
   rc::TriangleMesh elements;
   elements.name = "radiosity elements";
   elements.positions = mesh.positions;

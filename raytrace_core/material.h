@@ -17,6 +17,13 @@ enum class MaterialKind : uint8_t {
   dielectric,  ///< smooth glass: Fresnel reflection and refraction with `ior`, Beer–Lambert `absorption`
 };
 
+/// How a surface's coverage (alpha) is read (glTF's alphaMode; MTL's map_d is a mask).
+enum class AlphaMode : uint8_t {
+  opaque,  ///< alpha is ignored
+  mask,    ///< a cutout: where alpha < alpha_cutoff, rays pass through as if nothing were there
+  blend,   ///< stochastic transparency: a ray stops with probability alpha, else passes
+};
+
 /// A material. Emission is independent of the scattering kind: any surface may emit.
 struct Material {
   std::string name;
@@ -32,8 +39,17 @@ struct Material {
   /// baseColorFactor × baseColorTexture; MTL's Kd × map_Kd, as the MTL specification has it).
   TextureRef albedo_texture;
 
+  /// Coverage: `alpha` times the alpha texture where set (its alpha channel, or its first
+  /// channel when it has none), read by `alpha_mode`.
+  AlphaMode alpha_mode = AlphaMode::opaque;
+  float alpha = 1.0f;
+  float alpha_cutoff = 0.5f;
+  TextureRef alpha_texture;
+
   /// True when some parameter varies over the surface and must be looked up at each point.
   bool is_textured() const { return albedo_texture.valid(); }
+  /// True when rays may pass through parts of the surface.
+  bool has_coverage() const { return alpha_mode != AlphaMode::opaque && (alpha < 1.0f || alpha_texture.valid()); }
 
   /// True when the surface emits light.
   bool is_emissive() const { return !emission.is_black(); }

@@ -10,6 +10,7 @@
 #include <embree3/rtcore.h>
 
 #include <cmath>
+#include <cstring>
 #include <algorithm>
 #include <string>
 
@@ -116,8 +117,68 @@ bool finite3(const Vec3& v) { return is_finite(v); }
 
 }  // namespace
 
+/// What a mesh whose material has coverage needs to answer, at a hit, whether the ray stops.
+struct AlphaTest {
+  const TriangleMesh* mesh = nullptr;
+  const TextureSet* textures = nullptr;
+  const Material* material = nullptr;
+  bool alpha_in_rgb = false;  ///< the alpha texture has no alpha channel: its first one is coverage
+
+  float coverage(uint32_t prim, float b1, float b2) const {
+    float a = material->alpha;
+    if (material->alpha_texture.valid() && textures) {
+      const uint32_t* c = &mesh->indices[3 * size_t(prim)];
+      const Vec2 uv = mesh->uvs.empty() ? Vec2(b1, b2)
+                                        : (1.0f - b1 - b2) * mesh->uvs[c[0]] + b1 * mesh->uvs[c[1]] + b2 * mesh->uvs[c[2]];
+      const Texel t = textures->lookup(material->alpha_texture.image, material->alpha_texture.st(uv));
+      a *= alpha_in_rgb ? t.rgb.r : t.alpha;
+    }
+    return a;
+  }
+};
+
+namespace {
+
+/// A number in [0, 1) fixed by the ray and the primitive: BLEND's stochastic choice, the same
+/// every time the same ray meets the same triangle (so results do not depend on threads).
+float coverage_sample(const Vec3& o, const Vec3& d, uint32_t geom, uint32_t prim) {
+  uint64_t h = 0x9e3779b97f4a7c15ull ^ (uint64_t(geom) << 32 | prim);
+  for (float f : {o.x, o.y, o.z, d.x, d.y, d.z}) {
+    uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    h = (h ^ bits) * 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+  }
+  h *= 0xc4ceb9fe1a85ec53ull;
+  h ^= h >> 33;
+  return float(h >> 40) * 0x1p-24f;
+}
+
+/// Embree's filter for intersection and occlusion alike: rejects a hit where the surface is
+/// not there (below the cutoff, or not chosen by its alpha).
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  const auto& test = *static_cast<const AlphaTest*>(args->geometryUserPtr);
+  const uint32_t prim = RTCHitN_primID(args->hit, args->N, 0);
+  const float a = test.coverage(prim, RTCHitN_u(args->hit, args->N, 0), RTCHitN_v(args->hit, args->N, 0));
+  bool keep;
+  if (test.material->alpha_mode == AlphaMode::mask) {
+    keep = a >= test.material->alpha_cutoff;
+  } else {
+    const Vec3 o(RTCRayN_org_x(args->ray, args->N, 0), RTCRayN_org_y(args->ray, args->N, 0), RTCRayN_org_z(args->ray, args->N, 0));
+    const Vec3 d(RTCRayN_dir_x(args->ray, args->N, 0), RTCRayN_dir_y(args->ray, args->N, 0), RTCRayN_dir_z(args->ray, args->N, 0));
+    keep = coverage_sample(o, d, RTCHitN_geomID(args->hit, args->N, 0), prim) < a;
+  }
+  if (!keep) args->valid[0] = 0;
+}
+
+}  // namespace
+
+struct AlphaTest;
+
 struct Scene::Impl {
   RTCScene scene = nullptr;
+  std::vector<std::unique_ptr<AlphaTest>> alpha_tests;  // Embree's user data for cut-out meshes
   std::vector<Sphere> spheres;  // Embree's user data: a stable copy that survives moves of Scene
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -145,11 +206,15 @@ void Scene::commit() {
         m.absorption.b < 0 || m.exponent < 0)
       throw InputError(id + ": reflectance, emission, absorption and exponent must not be negative");
     if (m.kind == MaterialKind::dielectric && !(m.ior > 0.0f)) throw InputError(id + ": ior must be positive");
-    const TextureRef& t = m.albedo_texture;
-    if (t.image >= int32_t(textures.size()) || t.image < -1)
-      throw InputError(id + ": refers to texture " + std::to_string(t.image) + " but there are " + std::to_string(textures.size()));
-    for (float x : t.map)
-      if (!std::isfinite(x)) throw InputError(id + ": texture transform must be finite");
+    for (const TextureRef* t : {&m.albedo_texture, &m.alpha_texture}) {
+      if (t->image >= int32_t(textures.size()) || t->image < -1)
+        throw InputError(id + ": refers to texture " + std::to_string(t->image) + " but there are " +
+                         std::to_string(textures.size()));
+      for (float x : t->map)
+        if (!std::isfinite(x)) throw InputError(id + ": texture transform must be finite");
+    }
+    if (!(m.alpha >= 0.0f && m.alpha <= 1.0f) || !(m.alpha_cutoff >= 0.0f && m.alpha_cutoff <= 1.0f))
+      throw InputError(id + ": alpha and alpha cutoff must lie in [0, 1]");
   }
   if (!textures.empty()) texture_set_ = std::make_unique<TextureSet>(textures);
   auto check_material = [&](uint32_t material, const std::string& what) {
@@ -237,6 +302,17 @@ void Scene::commit() {
     auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                               3 * sizeof(uint32_t), mesh.triangle_count()));
     std::copy(mesh.indices.begin(), mesh.indices.end(), ib);
+    if (const Material& m = materials[mesh.material]; m.has_coverage()) {
+      auto test = std::make_unique<AlphaTest>();
+      test->mesh = &mesh;  // the vector's elements stay put when the Scene is moved
+      test->textures = texture_set_.get();
+      test->material = &m;
+      test->alpha_in_rgb = m.alpha_texture.valid() && texture_set_ && texture_set_->channels(m.alpha_texture.image) % 2 == 1;
+      rtcSetGeometryUserData(geom, test.get());
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+      impl_->alpha_tests.push_back(std::move(test));
+    }
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(impl_->scene, geom, static_cast<unsigned>(gi));
     rtcReleaseGeometry(geom);

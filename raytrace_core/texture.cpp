@@ -151,6 +151,8 @@ TextureSet::TextureSet(const std::vector<TextureImage>& images) : impl_(std::mak
 
 TextureSet::~TextureSet() = default;
 
+int TextureSet::channels(int32_t image) const { return impl_->channels[size_t(image)]; }
+
 Texel TextureSet::lookup(int32_t image, Vec2 st, Vec2 dx, Vec2 dy) const {
   OIIO::TextureSystem& ts = *impl_->system;
   const size_t i = size_t(image);

@@ -76,6 +76,8 @@ class TextureSet {
   /// Width × height × channels of each image's finest level, summed.
   size_t texel_count() const { return texels_; }
   size_t size() const { return images_.size(); }
+  /// Channels of one image (1 grey, 2 grey and alpha, 3 RGB, 4 RGBA).
+  int channels(int32_t image) const;
 
  private:
   struct Impl;

@@ -16,6 +16,7 @@
 //   Ks ≠ 0, Ns ≥ 1000, Kd ≠ 0           → glossy with exponent Ns
 //   otherwise                           → diffuse, albedo Kd
 //   map_Kd (diffuse and glossy)         → albedo texture: albedo = Kd × texel; -o, -s, -clamp kept
+//   map_d (not on mirrors and glass)    → alpha MASK at 0.5 (a cut-out), the image read as data
 // Kd and Ks are clamped to [0, 1] and, where Kd + Ks > 1 in a channel, both are scaled down so the
 // sum is 1 (energy conservation), with a warning. Ka and map_Ka are ignored; other maps are
 // ignored with one warning per file.
@@ -381,7 +382,6 @@ void unused_maps(const tinyobj::material_t& mtl, std::vector<std::string>& kinds
       {&mtl.bump_texname, "bump maps"},
       {&mtl.normal_texname, "normal maps (norm)"},
       {&mtl.displacement_texname, "displacement maps (disp)"},
-      {&mtl.alpha_texname, "alpha maps (map_d)"},
       {&mtl.reflection_texname, "reflection maps (refl)"},
       {&mtl.emissive_texname, "emission maps (map_Ke)"},
       {&mtl.roughness_texname, "roughness maps (map_Pr)"},
@@ -508,6 +508,31 @@ void load_obj(const fs::path& path, Scene& scene) {
         image.srgb = !diffuse.linear;
         image.wrap_s = image.wrap_t = diffuse.clamp ? TextureWrap::clamp : TextureWrap::repeat;
         m.albedo_texture = diffuse_texture_ref(texture_index(scene.textures, image), diffuse);
+      }
+    }
+    // map_d: a cut-out (leaves, fences), its image read as data; coverage below one half is not
+    // there. Its options are tinyobjloader's reading (-s, -o, -clamp).
+    if (!mtl.alpha_texname.empty() && m.is_specular()) {
+      const char* kind = "map_d of mirror and glass materials";
+      if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end()) ignored_maps.push_back(kind);
+    } else if (!mtl.alpha_texname.empty()) {
+      const fs::path folder = read ? mtl_reader.folder_of_material[i] : path.parent_path();
+      TextureImage image;
+      image.file = find_texture_file(folder, mtl.alpha_texname);
+      if (image.file.empty()) {
+        const std::string where = folder.empty() ? std::string(".") : folder.string();
+        scene.warnings.push_back(file + ": material '" + mtl.name + "': map_d '" + mtl.alpha_texname +
+                                 "' not found in " + where + "; left opaque");
+      } else {
+        const tinyobj::texture_option_t& o = mtl.alpha_texopt;
+        DiffuseMap map;
+        map.scale[0] = float(o.scale[0]), map.scale[1] = float(o.scale[1]);
+        map.offset[0] = float(o.origin_offset[0]), map.offset[1] = float(o.origin_offset[1]);
+        image.srgb = false;
+        image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+        m.alpha_mode = AlphaMode::mask;
+        m.alpha_cutoff = 0.5f;
+        m.alpha_texture = diffuse_texture_ref(texture_index(scene.textures, image), map);
       }
     }
     scene.materials.push_back(std::move(m));

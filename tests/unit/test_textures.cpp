@@ -17,6 +17,7 @@
 #include "radiosity/element_albedo.h"
 #include "radiosity/mesh.h"
 #include "raytrace_core/error.h"
+#include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/scene.h"
 #include "raytrace_core/texture.h"
 
@@ -131,6 +132,79 @@ TEST_F(Textures, ShadingMaterialMultipliesTheAlbedoByTheTexel) {
   plain.meshes.push_back(quad(0));
   plain.commit();
   EXPECT_EQ(&plain.shading_material(plain.triangle_point(0, 0, {0.2f, 0.2f}), scratch), &plain.materials[0]);
+}
+
+TEST_F(Textures, MaskCutsOutWhereAlphaIsBelowTheCutoff) {
+  // A grey (one-channel) coverage image: the left texel 0, the right one 255. Read as data, its
+  // first channel is the coverage. Rays down onto the quad's left half pass through; on the
+  // right they stop, for closest hits and shadow rays alike.
+  const fs::path file = dir_ / "mask.pgm";
+  {
+    std::ofstream out(file, std::ios::binary);
+    out << "P5\n2 1\n255\n";
+    out.put(char(0)).put(char(255));
+  }
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("leaf", rc::Rgb(0.5f));
+  scene.textures.push_back(rc::TextureImage{file.string(), false, rc::TextureWrap::clamp, rc::TextureWrap::clamp});
+  m.alpha_mode = rc::AlphaMode::mask;
+  m.alpha_texture.image = 0;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(quad(0));
+  scene.commit();
+  for (float x : {0.05f, 0.2f, 0.4f}) {
+    const rc::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    EXPECT_FALSE(scene.intersect(ray).has_value()) << x;
+    EXPECT_FALSE(scene.occluded(ray)) << x;
+  }
+  for (float x : {0.6f, 0.8f, 0.95f}) {
+    const rc::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    EXPECT_TRUE(scene.intersect(ray).has_value()) << x;
+    EXPECT_TRUE(scene.occluded(ray)) << x;
+  }
+}
+
+TEST_F(Textures, ObjMapDIsACutout) {
+  // The same mask as above through an OBJ's map_d: OBJ's v runs up, and the mask's two texels
+  // lie side by side, so the left half of the quad is cut away.
+  {
+    std::ofstream out(dir_ / "mask.pgm", std::ios::binary);
+    out << "P5\n2 1\n255\n";
+    out.put(char(0)).put(char(255));
+  }
+  std::ofstream(dir_ / "leaf.mtl") << "newmtl leaf\nKd 0.5 0.5 0.5\nmap_d mask.pgm\n";
+  std::ofstream(dir_ / "leaf.obj") << "mtllib leaf.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3 4/4\n";
+  rc::Scene scene = rc::load_scene((dir_ / "leaf.obj").string());
+  ASSERT_EQ(scene.materials.size(), 1u);
+  EXPECT_EQ(scene.materials[0].alpha_mode, rc::AlphaMode::mask);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_FALSE(scene.textures[0].srgb);
+  EXPECT_FALSE(scene.occluded(rc::Ray{{0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
+  EXPECT_TRUE(scene.occluded(rc::Ray{{0.75f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
+}
+
+TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
+  // Constant alpha 0.3, BLEND: each ray stops with probability 0.3, fixed by the ray itself. Over
+  // n = 20,000 rays the fraction's standard deviation is √(0.3 · 0.7 / n) = 0.0032; 4 of them.
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("veil", rc::Rgb(0.5f));
+  m.alpha_mode = rc::AlphaMode::blend;
+  m.alpha = 0.3f;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(quad(0));
+  scene.commit();
+  const int n = 20000;
+  int hits = 0, blocked = 0;
+  for (int i = 0; i < n; ++i) {
+    const float x = (float(i % 200) + 0.5f) / 200.0f, y = (float(i / 200) + 0.5f) / 100.0f;
+    const rc::Ray ray{{x, y, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    hits += scene.intersect(ray).has_value();
+    blocked += scene.occluded(ray);
+  }
+  EXPECT_NEAR(double(hits) / n, 0.3, 4 * 0.0032);
+  // The same ray meets the same choice in both queries.
+  EXPECT_EQ(hits, blocked);
 }
 
 TEST_F(Textures, TransformMapsUvToImage) {
