@@ -45,6 +45,9 @@ struct Material {
   float alpha = 1.0f;
   float alpha_cutoff = 0.5f;
   TextureRef alpha_texture;
+  /// An alpha texture without an alpha channel holds coverage in its first channel (MTL's
+  /// map_d); else (glTF's base colour) such a texture is fully opaque.
+  bool alpha_in_colour = false;
 
   /// True when some parameter varies over the surface and must be looked up at each point.
   bool is_textured() const { return albedo_texture.valid(); }

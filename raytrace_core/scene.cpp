@@ -307,7 +307,8 @@ void Scene::commit() {
       test->mesh = &mesh;  // the vector's elements stay put when the Scene is moved
       test->textures = texture_set_.get();
       test->material = &m;
-      test->alpha_in_rgb = m.alpha_texture.valid() && texture_set_ && texture_set_->channels(m.alpha_texture.image) % 2 == 1;
+      test->alpha_in_rgb = m.alpha_in_colour && m.alpha_texture.valid() && texture_set_ &&
+                           texture_set_->channels(m.alpha_texture.image) % 2 == 1;
       rtcSetGeometryUserData(geom, test.get());
       rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
       rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);

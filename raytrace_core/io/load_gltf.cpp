@@ -217,6 +217,18 @@ class GltfLoader {
             gm.pbrMetallicRoughness.baseColorTexture,
             "materials[" + std::to_string(i) + "].pbrMetallicRoughness.baseColorTexture", uv_set);
       uv_set_of_material_.push_back(m.albedo_texture.valid() ? uv_set : 0);
+      // alphaMode: coverage is baseColorFactor's alpha times the base colour texture's.
+      if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
+        m.alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::mask : AlphaMode::blend;
+        const auto& factor = gm.pbrMetallicRoughness.baseColorFactor;
+        m.alpha = factor.size() == 4 ? std::clamp(float(factor[3]), 0.0f, 1.0f) : 1.0f;
+        if (!(gm.alphaCutoff >= 0.0 && gm.alphaCutoff <= 1.0))
+          fail("materials[" + std::to_string(i) + "].alphaCutoff: must lie in [0, 1]");
+        m.alpha_cutoff = float(gm.alphaCutoff);
+        m.alpha_texture = m.albedo_texture;
+      } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
+        fail("materials[" + std::to_string(i) + "].alphaMode: unknown mode " + gm.alphaMode);
+      }
       scene_.materials.push_back(std::move(m));
       note_ignored(gm.normalTexture.index >= 0, "normal");
       note_ignored(gm.emissiveTexture.index >= 0, "emissive");

@@ -532,6 +532,7 @@ void load_obj(const fs::path& path, Scene& scene) {
         image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
         m.alpha_mode = AlphaMode::mask;
         m.alpha_cutoff = 0.5f;
+        m.alpha_in_colour = true;
         m.alpha_texture = diffuse_texture_ref(texture_index(scene.textures, image), map);
       }
     }

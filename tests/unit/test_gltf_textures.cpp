@@ -519,5 +519,35 @@ TEST_F(GltfTextures, OtherTexturesWarnedInOneLine) {
   EXPECT_FALSE(has_warning(load_scene_file(write("base_only.gltf", quad.gltf())), "ignored"));
 }
 
+TEST_F(GltfTextures, AlphaModeMaskAndBlendComeFromTheBaseColour) {
+  // MASK with baseColorFactor alpha 0.3 under the default cutoff 0.5: the quad is cut away
+  // entirely. With cutoff 0.2 it is whole. BLEND keeps the factor as the stopping probability.
+  QuadModel quad;
+  quad.textures = "[]";
+  const auto load_with = [&](const std::string& material) {
+    quad.materials = "[" + material + "]";
+    return load_scene(write("alpha.gltf", quad.gltf()));
+  };
+  const auto stops_at_centre = [](const Scene& scene) {
+    const Bounds3& b = scene.bounds();
+    const Vec3 c = 0.5f * (b.lo + b.hi), size = b.hi - b.lo;
+    const int axis = size.x <= size.y && size.x <= size.z ? 0 : size.y <= size.z ? 1 : 2;  // the quad's normal
+    Vec3 from = c, dir(0.0f);
+    from[axis] += 1.0f;
+    dir[axis] = -1.0f;
+    return scene.occluded(Ray{from, dir, 2.0f});
+  };
+  const std::string factor = R"("pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.3]})";
+  const Scene masked = load_with("{" + factor + R"(, "alphaMode": "MASK"})");
+  EXPECT_EQ(masked.materials[0].alpha_mode, AlphaMode::mask);
+  EXPECT_FLOAT_EQ(masked.materials[0].alpha, 0.3f);
+  EXPECT_FALSE(stops_at_centre(masked));
+  EXPECT_TRUE(stops_at_centre(load_with("{" + factor + R"(, "alphaMode": "MASK", "alphaCutoff": 0.2})")));
+  EXPECT_EQ(load_with("{" + factor + R"(, "alphaMode": "BLEND"})").materials[0].alpha_mode, AlphaMode::blend);
+  // OPAQUE (the default) ignores alpha.
+  EXPECT_TRUE(stops_at_centre(load_with("{" + factor + "}")));
+  EXPECT_NE(error_of([&] { load_with("{" + factor + R"(, "alphaMode": "CUTOUT"})"); }).find("alphaMode"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace gilt::raytrace_core

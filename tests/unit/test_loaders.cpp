@@ -302,7 +302,7 @@ TEST_F(Loaders, ObjMaterialsSharingATextureShareOneImage) {
   write("tex/stone-bump.png", "not read before commit");
   write("shared.mtl",
         "newmtl wall\nKd 0.8 0.8 0.8\nmap_Kd tex/stone.png\nbump tex/stone-bump.png\n"
-        "newmtl pillar\nmap_Kd tex\\stone.png\nmap_bump tex/stone-bump.png\nmap_d tex/stone.png\n");
+        "newmtl pillar\nmap_Kd tex\\stone.png\nmap_bump tex/stone-bump.png\nmap_Ks tex/stone.png\n");
   const std::string obj = write("shared.obj",
                                 "mtllib shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                                 "usemtl wall\nf 1/1 2/2 3/3\nusemtl pillar\nf 1/1 3/3 2/2\n");
@@ -316,7 +316,7 @@ TEST_F(Loaders, ObjMaterialsSharingATextureShareOneImage) {
     if (w.find("are ignored") != std::string::npos) {
       ++ignored;
       EXPECT_CONTAINS(w, "bump maps");
-      EXPECT_CONTAINS(w, "alpha maps (map_d)");
+      EXPECT_CONTAINS(w, "specular maps (map_Ks)");
       EXPECT_EQ(w.find("map_Kd"), std::string::npos) << w;
     }
   EXPECT_EQ(ignored, 1);

@@ -149,6 +149,7 @@ TEST_F(Textures, MaskCutsOutWhereAlphaIsBelowTheCutoff) {
   scene.textures.push_back(rc::TextureImage{file.string(), false, rc::TextureWrap::clamp, rc::TextureWrap::clamp});
   m.alpha_mode = rc::AlphaMode::mask;
   m.alpha_texture.image = 0;
+  m.alpha_in_colour = true;
   scene.materials.push_back(m);
   scene.meshes.push_back(quad(0));
   scene.commit();
