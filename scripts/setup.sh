@@ -67,7 +67,9 @@ case "$job" in
       cmake -S "$root" -B "$asan_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGILT_SANITIZE=ON \
         -DGILT_BUILD_BENCH=OFF ${CMAKE_ARGS:-}
       cmake --build "$asan_dir" -j "$jobs"
-      UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
+      # new_delete_type_mismatch=0: OpenImageIO 2.4's TextureSystem::destroy deletes its 184-byte
+      # implementation through a pointer to the 1-byte interface (its bug, not gilt's).
+      UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1:new_delete_type_mismatch=0 \
         LSAN_OPTIONS=suppressions=$root/tests/lsan.supp \
         ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -L unit
     fi

@@ -52,6 +52,7 @@ std::vector<unsigned char> read_bytes(const fs::path& path) {
 
 template <typename T>
 void append(std::vector<unsigned char>& out, const std::vector<T>& values) {
+  if (values.empty()) return;  // memcpy from an empty vector's null data() is undefined
   const size_t at = out.size();
   out.resize(at + values.size() * sizeof(T));
   std::memcpy(out.data() + at, values.data(), values.size() * sizeof(T));
