@@ -42,6 +42,7 @@ const char* material_kind_name(rc::MaterialKind k) {
     case rc::MaterialKind::glossy: return "glossy";
     case rc::MaterialKind::mirror: return "mirror";
     case rc::MaterialKind::dielectric: return "dielectric";
+    case rc::MaterialKind::metallic_roughness: return "metallic-roughness";
   }
   return "?";
 }
@@ -130,6 +131,17 @@ void run_info(const InfoOptions& o) {
                                                [](const rc::Material& m) { return m.is_textured(); }));
   const size_t texels = scene.texture_set() ? scene.texture_set()->texel_count() : 0;
   const size_t texture_bytes = texels * 2 * 4 / 3;
+  // What each method does with glTF's metallic-roughness materials.
+  const bool metallic_roughness = materials.count(material_kind_name(rc::MaterialKind::metallic_roughness)) > 0;
+  if (metallic_roughness)
+    for (MethodPlan& p : plans) {
+      if (p.method == "radiosity")
+        p.runs.push_back("metallic-roughness: elements reflect the diffuse part; direct light in the view sees the whole BRDF");
+      else if (p.method == "photon" || p.method == "sppm")
+        p.runs.push_back("metallic-roughness: photons scatter by the whole BRDF; the final gather reads the diffuse part");
+      else
+        p.runs.push_back("metallic-roughness: GGX specular over a Lambertian base, sampled by visible normals");
+    }
   if (textured > 0)
     for (MethodPlan& p : plans) {
       if (p.method == "radiosity")

@@ -90,7 +90,9 @@ MapNeeds map_needs(const rc::Scene& scene) {
   auto visit = [&](uint32_t material) {
     const rc::Material& m = scene.materials[material];
     if (m.is_specular()) specular = true;
-    else if (m.albedo.max_component() > 1e-4f || m.kind == rc::MaterialKind::glossy) reflective = true;
+    else if (rc::diffuse_reflectance(m).max_component() > 1e-4f || m.kind == rc::MaterialKind::glossy ||
+             m.kind == rc::MaterialKind::metallic_roughness)
+      reflective = true;
   };
   for (const rc::TriangleMesh& m : scene.meshes) visit(m.material);
   for (const rc::Sphere& s : scene.spheres) visit(s.material);

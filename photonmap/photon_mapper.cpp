@@ -237,7 +237,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       }
       // A diffuse or glossy hit: its reflected light from the precomputed irradiance.
       const rc::Vec3 side = glm::dot(-dir, sj.ng) > 0.0f ? sj.ng : -sj.ng;
-      gathered += g * mj.albedo * irradiance(sj.p, side, ctx.rng) * rc::kInvPi;
+      gathered += g * rc::diffuse_reflectance(mj) * irradiance(sj.p, side, ctx.rng) * rc::kInvPi;
       break;
     }
   }

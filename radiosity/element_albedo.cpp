@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "raytrace_core/bsdf.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/sampling.h"
 
@@ -33,8 +34,8 @@ std::vector<rc::Rgb> element_reflectance(const rc::Scene& scene, const Radiosity
     for (size_t e = chunk * 256; e < std::min(ne, chunk * 256 + 256); ++e) {
       const rc::Material& m = scene.materials[mesh.element_material[e]];
       const uint32_t s = mesh.element_surface[e];
-      if (!m.is_textured() || !textures || s >= scene.meshes.size()) {
-        out[e] = m.albedo;  // untextured, or a sphere (whose texture has no seam-free UVs here)
+      if (!m.albedo_texture.valid() || !textures || s >= scene.meshes.size()) {
+        out[e] = rc::diffuse_reflectance(m);  // untextured, or a sphere (whose texture has no seam-free UVs here)
         continue;
       }
       const rc::TriangleMesh& input = scene.meshes[s];
@@ -59,10 +60,10 @@ std::vector<rc::Rgb> element_reflectance(const rc::Scene& scene, const Radiosity
           ++found;
         }
       if (found > 0) {
-        out[e] = m.albedo * sum * (1.0f / float(found));
+        out[e] = rc::diffuse_reflectance(m) * sum * (1.0f / float(found));
       } else {
         // No input face near (should not happen): the image's mean, from its coarsest level.
-        out[e] = m.albedo * textures->lookup(t.image, rc::Vec2(0.5f), rc::Vec2(1.0f, 0.0f), rc::Vec2(0.0f, 1.0f)).rgb;
+        out[e] = rc::diffuse_reflectance(m) * textures->lookup(t.image, rc::Vec2(0.5f), rc::Vec2(1.0f, 0.0f), rc::Vec2(0.0f, 1.0f)).rgb;
       }
     }
   });

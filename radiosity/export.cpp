@@ -9,8 +9,12 @@
 // Materials are written so that gilt's own loaders read them back as the same kind:
 //   MTL   Kd albedo, Ks specular, Ns exponent (1000, the sharpest, for a mirror), Ni ior, d 1,
 //         Tf = exp(−σa) for a dielectric, Ke emission; illum 1 diffuse, 2 glossy, 3 mirror,
-//         7 dielectric. Two-sided emission has no MTL equivalent.
-//   glTF  baseColorFactor albedo, metallicFactor 0, roughnessFactor 1, emissiveFactor emission
+//         7 dielectric; metallic-roughness as illum 2 with the PBR extension's Pr and Pm. Two-sided
+//         emission has no MTL equivalent.
+//   glTF  baseColorFactor albedo; metallic-roughness materials their metallicFactor and
+//         roughnessFactor; others metallicFactor 0, roughnessFactor 1 and
+//         KHR_materials_specular's specularFactor 0, which makes the specification's BRDF exactly
+//         Lambertian (F0 = 0); emissiveFactor emission
 //         scaled into [0, 1] with KHR_materials_emissive_strength carrying the scale when the
 //         emission exceeds 1, doubleSided for two-sided emission.
 // Only materials that some element uses are written.
@@ -251,6 +255,10 @@ std::string encode_mtl(const std::vector<Material>& materials, const std::vector
       case rc::MaterialKind::dielectric:
         illum = 7;
         break;
+      case rc::MaterialKind::metallic_roughness:  // Pr and Pm below; Ns the Phong equivalent of α
+        illum = 2;
+        ns = std::clamp(2.0f / std::max(1e-6f, rc::sqr(rc::sqr(mat.roughness))) - 2.0f, 1.0f, 1e4f);
+        break;
     }
     out += "\nnewmtl " + names[m] + "\n";
     append_line(out, "Kd", mat.albedo);
@@ -262,6 +270,13 @@ std::string encode_mtl(const std::vector<Material>& materials, const std::vector
     out += "\nd 1\n";
     if (mat.kind == rc::MaterialKind::dielectric) append_line(out, "Tf", rc::exp(mat.absorption * -1.0f));
     append_line(out, "Ke", mat.emission);
+    if (mat.kind == rc::MaterialKind::metallic_roughness) {
+      out += "Pr";
+      append_float(out, mat.roughness);
+      out += "\nPm";
+      append_float(out, mat.metallic);
+      out += "\n";
+    }
     out += "illum " + std::to_string(illum) + "\n";
   }
   return out;
@@ -337,8 +352,19 @@ tinygltf::Material gltf_material(const Material& m, const std::string& name, tin
   tinygltf::Material out;
   out.name = name;
   out.pbrMetallicRoughness.baseColorFactor = {m.albedo.r, m.albedo.g, m.albedo.b, 1.0};
-  out.pbrMetallicRoughness.metallicFactor = 0.0;
-  out.pbrMetallicRoughness.roughnessFactor = 1.0;
+  const bool pbr = m.kind == rc::MaterialKind::metallic_roughness;
+  out.pbrMetallicRoughness.metallicFactor = pbr ? m.metallic : 0.0;
+  out.pbrMetallicRoughness.roughnessFactor = pbr ? m.roughness : 1.0;
+  const auto use_extension = [&](const std::string& used) {
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), used) == model.extensionsUsed.end())
+      model.extensionsUsed.push_back(used);
+  };
+  if (!pbr) {  // Lambertian: no specular layer at all
+    tinygltf::Value::Object specular;
+    specular["specularFactor"] = tinygltf::Value(0.0);
+    out.extensions["KHR_materials_specular"] = tinygltf::Value(std::move(specular));
+    use_extension("KHR_materials_specular");
+  }
   out.doubleSided = m.two_sided_emission;
   const float strength = m.emission.max_component();
   if (strength > 1.0f) {
@@ -347,10 +373,7 @@ tinygltf::Material gltf_material(const Material& m, const std::string& name, tin
     tinygltf::Value::Object extension;
     extension["emissiveStrength"] = tinygltf::Value(double(strength));
     out.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(std::move(extension));
-    const std::string used = "KHR_materials_emissive_strength";
-    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), used) ==
-        model.extensionsUsed.end())
-      model.extensionsUsed.push_back(used);
+    use_extension("KHR_materials_emissive_strength");
   } else if (strength > 0.0f) {
     out.emissiveFactor = {m.emission.r, m.emission.g, m.emission.b};
   }

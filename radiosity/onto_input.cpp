@@ -8,6 +8,7 @@
 
 #include "radiosity/element_scene.h"
 #include "radiosity/view.h"
+#include "raytrace_core/bsdf.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/error.h"
@@ -62,7 +63,7 @@ std::optional<Rgb> SolutionAtInput::operator()(const rc::Material& m, const Vec3
       if (cos_theta > 0.0f && !ls.radiance.is_black() && !scene_.occluded(ls.shadow_ray)) e += ls.radiance * cos_theta;
     }
   }
-  const Rgb radiosity = m.emission * rc::kPi + m.albedo * e;
+  const Rgb radiosity = m.emission * rc::kPi + rc::diffuse_reflectance(m) * e;
   return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
 }
 

@@ -23,6 +23,7 @@
 #include "radiosity/element_albedo.h"
 #include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
+#include "raytrace_core/bsdf.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
@@ -625,7 +626,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   RadiosityMesh& mesh = sol.mesh;
   Receivers receivers(scene, mesh);
   sol.convex_enclosure = receivers.occluders.empty();
-  auto albedo = [&](uint32_t material) { return scene.materials[material].albedo; };
+  auto albedo = [&](uint32_t material) { return rc::diffuse_reflectance(scene.materials[material]); };
   auto emitted = [&](uint32_t material) { return scene.materials[material].emission * kPi; };  // B0 = π Le
   auto is_emitter = [&](uint32_t e) { return !scene.materials[mesh.element_material[e]].emission.is_black(); };
   const int strata = std::max(1, int(std::round(std::sqrt(double(settings.visibility_samples)))));

@@ -71,7 +71,7 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   vertex_radiance_.resize(nv);
   vertex_indirect_.resize(nv);
   for (size_t v = 0; v < nv; ++v) {
-    const Rgb rho = v < solution.vertex_albedo.size() ? solution.vertex_albedo[v] : scene.materials[mesh.vertex_material[v]].albedo;
+    const Rgb rho = v < solution.vertex_albedo.size() ? solution.vertex_albedo[v] : rc::diffuse_reflectance(scene.materials[mesh.vertex_material[v]]);
     vertex_radiance_[v] = solution.vertex_radiance(v);
     if (ambient) vertex_radiance_[v] += rho * solution.ambient * (1.0f / rc::kPi);
     Rgb indirect = solution.vertex_irradiance[v] - solution.vertex_direct[v];
@@ -170,15 +170,15 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
       const Vec3 lit = above ? sj.ng : -sj.ng;
       const std::optional<Location> at = locate_on(sj, lit);
       if (at && !element_direct_.empty())
-        return out + beta * mj.albedo * (element_direct_[at->element] + indirect_at(*at)) * (1.0f / rc::kPi);
+        return out + beta * rc::diffuse_reflectance(mj) * (element_direct_[at->element] + indirect_at(*at)) * (1.0f / rc::kPi);
       out += beta * rc::estimate_direct(scene_, sj, mj, fj, wo, above, ctx.rng, ctx.rays);
-      if (at) return out + beta * mj.albedo * indirect_at(*at) * (1.0f / rc::kPi);
+      if (at) return out + beta * rc::diffuse_reflectance(mj) * indirect_at(*at) * (1.0f / rc::kPi);
       // No element stands for this side of the surface: one more diffuse bounce from here.
       if (diffuse_left-- == 0) return out;
       Vec3 next = fj.to_world(rc::sample_cosine_hemisphere(ctx.rng.uniform2()));
       if (!above) next = -next;
       if (glm::dot(next, lit) <= 0.0f) return out;
-      beta *= mj.albedo;  // Lambertian: f cos / pdf
+      beta *= rc::diffuse_reflectance(mj);  // Lambertian: f cos / pdf
       ray = rc::spawn_ray(sj, next);
       via_specular = false;
       continue;
@@ -243,9 +243,9 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
         // The solution's light comes from diffuse surfaces in view (mirrors and glass block it);
         // what arrives through them, the gather ray brings.
         const Rgb through = has_specular_ ? gather(si, frame, wo_above, ctx, true) : Rgb(0.0f);
-        return radiance + beta * m.albedo * (*e + through) * (1.0f / rc::kPi);
+        return radiance + beta * rc::diffuse_reflectance(m) * (*e + through) * (1.0f / rc::kPi);
       }
-      return radiance + beta * m.albedo * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
+      return radiance + beta * rc::diffuse_reflectance(m) * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
     }
     if (!scatter_specular(m, si, frame, wo, ctx.rng, beta, ray)) return radiance;
   }

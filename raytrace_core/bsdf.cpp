@@ -5,11 +5,18 @@
 //   Mirror and smooth dielectric: delta lobes with the exact unpolarised Fresnel equations
 //     (Born & Wolf, "Principles of Optics", §1.5), 1/η² radiance scaling across a refractive
 //     interface as in Veach 1997, "Robust Monte Carlo Methods for Light Transport Simulation", §5.2.
+//   Metallic-roughness: glTF 2.0's appendix B, term by term (V = wo, L = wi, H their half vector):
+//       f = (1 − m)·[(1 − F_d)·c/π + F_d·S] + m·F_c·S,   S = D(H)·G2(V, L) / (4 |N·V| |N·L|),
+//       F_d = F0 + (1 − F0)(1 − |V·H|)⁵ with F0 = ((η − 1)/(η + 1))²,  F_c = c + (1 − c)(1 − |V·H|)⁵,
+//     with c the base colour, m the metalness, GGX D and separable Smith G2 of α = r²
+//     (microfacet.h). It is sampled by a one-sample mixture of visible-normal sampling (Heitz
+//     2018) and the cosine-weighted hemisphere, the lobe chosen by its Fresnel weight at wo.
 
 #include "raytrace_core/bsdf.h"
 
 #include <algorithm>
 
+#include "raytrace_core/microfacet.h"
 #include "raytrace_core/sampling.h"
 
 namespace gilt::raytrace_core {
@@ -71,6 +78,61 @@ Vec3 sample_phong_lobe(const Vec3& wo, float n, Vec2 u) {
   return Frame::from_normal(glm::normalize(mirror_direction(wo))).to_world(local);
 }
 
+// ---- Metallic-roughness (wo, wi on the +z side). ----
+
+float dielectric_f0(float ior) {
+  const float eta = ior > 0.0f && std::isfinite(ior) ? ior : 1.5f;
+  return sqr((eta - 1.0f) / (eta + 1.0f));
+}
+
+GgxDistribution ggx_of(const Material& m) { return GgxDistribution(sqr(std::clamp(m.roughness, 0.0f, 1.0f))); }
+
+float clamped_metallic(const Material& m) { return m.metallic > 0.0f ? std::min(m.metallic, 1.0f) : 0.0f; }  // NaN → 0
+
+Rgb metallic_roughness_eval_front(const Material& m, const Vec3& wo, const Vec3& wi) {
+  const Vec3 sum = wo + wi;
+  const float len2 = glm::dot(sum, sum);
+  if (!(len2 > 0.0f)) return Rgb(0.0f);
+  const Vec3 h = sum / std::sqrt(len2);
+  const GgxDistribution ggx = ggx_of(m);
+  const float metal = clamped_metallic(m);
+  const float weight = schlick_weight(std::fabs(glm::dot(wo, h)));
+  const float f0 = dielectric_f0(m.ior);
+  const float f_dielectric = f0 + (1.0f - f0) * weight;
+  const Rgb f_conductor = m.albedo + (Rgb(1.0f) - m.albedo) * weight;
+  const float specular = ggx.d(h) * ggx.g2(wo, wi) / (4.0f * wo.z * wi.z);
+  const Rgb dielectric = m.albedo * ((1.0f - f_dielectric) * kInvPi) + Rgb(f_dielectric * specular);
+  return dielectric * (1.0f - metal) + f_conductor * (metal * specular);
+}
+
+// Probability of drawing from the specular lobe rather than the diffuse one: the two lobes'
+// weights at wo, with the normal standing in for the half vector; < 0 when nothing reflects.
+float metallic_roughness_specular_probability(const Material& m, const Vec3& wo) {
+  const float metal = clamped_metallic(m);
+  const float weight = schlick_weight(wo.z);
+  const float f0 = dielectric_f0(m.ior);
+  const float f_dielectric = f0 + (1.0f - f0) * weight;
+  const float base = std::clamp(m.albedo.average(), 0.0f, 1.0f);
+  const float specular = (1.0f - metal) * f_dielectric + metal * (base + (1.0f - base) * weight);
+  const float diffuse = (1.0f - metal) * (1.0f - f_dielectric) * base;
+  return specular + diffuse > 0.0f ? specular / (specular + diffuse) : -1.0f;
+}
+
+float metallic_roughness_pdf_front(const Material& m, const Vec3& wo, const Vec3& wi) {
+  const float ps = metallic_roughness_specular_probability(m, wo);
+  if (ps < 0.0f) return 0.0f;
+  float specular_pdf = 0.0f;
+  const Vec3 sum = wo + wi;
+  const float len2 = glm::dot(sum, sum);
+  if (len2 > 0.0f) {
+    const Vec3 h = sum / std::sqrt(len2);
+    const float cos_oh = glm::dot(wo, h);
+    // Reflection maps h to wi with Jacobian 1 / (4 wo·h).
+    if (cos_oh > 0.0f) specular_pdf = ggx_of(m).visible_d(wo, h) / (4.0f * cos_oh);
+  }
+  return ps * specular_pdf + (1.0f - ps) * cosine_hemisphere_pdf(wi.z);
+}
+
 std::optional<BsdfSample> sample_reflective(const Material& m, Vec3 wo, float u_lobe, Vec2 u) {
   if (wo.z == 0.0f) return std::nullopt;
   const bool flipped = wo.z < 0.0f;
@@ -79,6 +141,10 @@ std::optional<BsdfSample> sample_reflective(const Material& m, Vec3 wo, float u_
   Vec3 wi;
   if (m.kind == MaterialKind::diffuse) {
     wi = sample_cosine_hemisphere(u);
+  } else if (m.kind == MaterialKind::metallic_roughness) {
+    const float ps = metallic_roughness_specular_probability(m, wo);
+    if (ps < 0.0f) return std::nullopt;
+    wi = u_lobe < ps ? reflect_about(wo, ggx_of(m).sample_visible(wo, u)) : sample_cosine_hemisphere(u);
   } else {
     const float ps = specular_lobe_probability(m);
     if (ps < 0.0f) return std::nullopt;
@@ -90,6 +156,9 @@ std::optional<BsdfSample> sample_reflective(const Material& m, Vec3 wo, float u_
   if (m.kind == MaterialKind::diffuse) {
     s.f = m.albedo * kInvPi;
     s.pdf = cosine_hemisphere_pdf(wi.z);
+  } else if (m.kind == MaterialKind::metallic_roughness) {
+    s.f = metallic_roughness_eval_front(m, wo, wi);
+    s.pdf = metallic_roughness_pdf_front(m, wo, wi);
   } else {
     s.f = glossy_eval_front(m, wo, wi);
     s.pdf = glossy_pdf_front(m, wo, wi);
@@ -125,6 +194,15 @@ std::optional<BsdfSample> sample_dielectric(const Material& m, const Vec3& wo, f
     s.f = Rgb(reflectance / std::fabs(cos_o));
     s.pdf = reflectance;
   } else {
+    if (m.thin_walled) {  // an infinitely thin sheet: through, unbent, the same medium behind
+      const float cos_i = std::fabs(cos_o);
+      s.wi = -wo;
+      s.f = m.transmission_tint * ((1.0f - reflectance) / cos_i);
+      s.pdf = 1.0f - reflectance;
+      s.transmission = true;
+      if (!(s.pdf > 0.0f) || !s.f.is_finite() || s.f.is_black()) return std::nullopt;
+      return s;
+    }
     // eta_rel = IOR on wi's side / IOR on wo's side. Entering (wo outside, z > 0): eta;
     // leaving (wo inside): 1/eta. Snell: sin θi = sin θo / eta_rel.
     const bool entering = cos_o > 0.0f;
@@ -141,7 +219,7 @@ std::optional<BsdfSample> sample_dielectric(const Material& m, const Vec3& wo, f
     // (Veach 1997, §5.2), so that f·|cos θi|/pdf sums to R + T = 1 over the two branches.
     float scale = transmittance / cos_t;
     if (mode == TransportMode::radiance) scale /= eta_rel * eta_rel;
-    s.f = Rgb(scale);
+    s.f = m.transmission_tint * scale;
     s.pdf = transmittance;
     s.transmission = true;
   }
@@ -158,6 +236,9 @@ Rgb bsdf_eval(const Material& m, const Vec3& wo, const Vec3& wi) {
       return m.albedo * kInvPi;
     case MaterialKind::glossy:
       return wo.z > 0.0f ? glossy_eval_front(m, wo, wi) : glossy_eval_front(m, flip_z(wo), flip_z(wi));
+    case MaterialKind::metallic_roughness:
+      return wo.z > 0.0f ? metallic_roughness_eval_front(m, wo, wi)
+                         : metallic_roughness_eval_front(m, flip_z(wo), flip_z(wi));
     case MaterialKind::mirror:
     case MaterialKind::dielectric:
       return Rgb(0.0f);
@@ -172,6 +253,9 @@ float bsdf_pdf(const Material& m, const Vec3& wo, const Vec3& wi) {
       return cosine_hemisphere_pdf(std::fabs(wi.z));
     case MaterialKind::glossy:
       return wo.z > 0.0f ? glossy_pdf_front(m, wo, wi) : glossy_pdf_front(m, flip_z(wo), flip_z(wi));
+    case MaterialKind::metallic_roughness:
+      return wo.z > 0.0f ? metallic_roughness_pdf_front(m, wo, wi)
+                         : metallic_roughness_pdf_front(m, flip_z(wo), flip_z(wi));
     case MaterialKind::mirror:
     case MaterialKind::dielectric:
       return 0.0f;
@@ -184,6 +268,7 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, const Vec3& wo, float u
   switch (m.kind) {
     case MaterialKind::diffuse:
     case MaterialKind::glossy:
+    case MaterialKind::metallic_roughness:
       return sample_reflective(m, wo, u_lobe, u);
     case MaterialKind::mirror:
       return sample_mirror(m, wo);
@@ -191,6 +276,20 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, const Vec3& wo, float u
       return sample_dielectric(m, wo, u_lobe, mode);
   }
   return std::nullopt;
+}
+
+Rgb diffuse_reflectance(const Material& m) {
+  switch (m.kind) {
+    case MaterialKind::diffuse:
+    case MaterialKind::glossy:
+      return m.albedo;
+    case MaterialKind::metallic_roughness:
+      return m.albedo * ((1.0f - clamped_metallic(m)) * (1.0f - dielectric_f0(m.ior)));
+    case MaterialKind::mirror:
+    case MaterialKind::dielectric:
+      return Rgb(0.0f);
+  }
+  return Rgb(0.0f);
 }
 
 float fresnel_dielectric(float cos_i, float eta) {

@@ -40,6 +40,12 @@ float bsdf_pdf(const Material& m, const Vec3& wo, const Vec3& wi);
 std::optional<BsdfSample> bsdf_sample(const Material& m, const Vec3& wo, float u_lobe, Vec2 u,
                                       TransportMode mode = TransportMode::radiance);
 
+/// Reflectance of the material's Lambertian part: what radiosity and the photon map's irradiance
+/// gather treat as diffuse. The albedo for diffuse and glossy materials; (1 − metallic)(1 − F0)
+/// times the base colour for metallic-roughness (F0 the dielectric's normal reflectance, 0.04
+/// for η = 1.5: the light the specular layer takes at normal incidence); zero for mirror and glass.
+Rgb diffuse_reflectance(const Material& m);
+
 /// Fresnel reflectance of an unpolarised dielectric interface. cos_i > 0 means arriving from the
 /// outside; eta is the inside IOR over the outside IOR.
 float fresnel_dielectric(float cos_i, float eta);

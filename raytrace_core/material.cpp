@@ -50,4 +50,16 @@ Material Material::make_glossy(std::string name, Rgb albedo, Rgb specular, float
   return m;
 }
 
+Material Material::make_metallic_roughness(std::string name, Rgb base_colour, float metallic, float roughness,
+                                           float ior) {
+  Material m;
+  m.name = std::move(name);
+  m.kind = MaterialKind::metallic_roughness;
+  m.albedo = base_colour;
+  m.metallic = metallic;
+  m.roughness = roughness;
+  m.ior = ior;
+  return m;
+}
+
 }  // namespace gilt::raytrace_core

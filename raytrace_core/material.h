@@ -15,6 +15,10 @@ enum class MaterialKind : uint8_t {
   glossy,      ///< Lambertian `albedo` plus energy-normalised Phong lobe `specular`, `exponent`
   mirror,      ///< perfect specular reflection tinted by `specular`
   dielectric,  ///< smooth glass: Fresnel reflection and refraction with `ior`, Beer–Lambert `absorption`
+  /// glTF 2.0's metallic-roughness model (its specification's appendix B): base colour `albedo`,
+  /// `metallic`, `roughness`; a GGX specular lobe with Schlick's Fresnel, over a Lambertian base
+  /// for the dielectric part (F0 from `ior`) and tinted by the base colour for the metal part.
+  metallic_roughness,
 };
 
 /// How a surface's coverage (alpha) is read (glTF's alphaMode; MTL's map_d is a mask).
@@ -33,11 +37,24 @@ struct Material {
   float exponent = 0.0f;  ///< Phong exponent n ≥ 0 (glossy)
   float ior = 1.5f;       ///< index of refraction inside, relative to outside (dielectric)
   Rgb absorption{0.0f};   ///< absorption coefficient σa per scene unit inside (dielectric)
+  float metallic = 0.0f;  ///< metal fraction in [0, 1] (metallic_roughness)
+  float roughness = 1.0f; ///< perceptual roughness in [0, 1]; GGX α = roughness² (metallic_roughness)
+  /// Dielectric: transmitted light is multiplied by this colour (glTF's base colour of a
+  /// transmissive material; white for MTL glass).
+  Rgb transmission_tint{1.0f};
+  /// Dielectric: an infinitely thin sheet (glTF transmission without KHR_materials_volume) —
+  /// transmitted rays pass straight through, unbent, and no medium lies behind the surface.
+  bool thin_walled = false;
   Rgb emission{0.0f};     ///< emitted radiance, W·sr⁻¹·m⁻², from the front face
   bool two_sided_emission = false;  ///< emit from both faces
   /// Base colour: `albedo` is multiplied by this texture's linear RGB where it is set (glTF's
   /// baseColorFactor × baseColorTexture; MTL's Kd × map_Kd, as the MTL specification has it).
   TextureRef albedo_texture;
+  /// metallic_roughness: metallic × the texture's blue channel, roughness × its green (linear data).
+  TextureRef metallic_roughness_texture;
+  /// Emission is multiplied by this texture's linear RGB where it is set (glTF's emissiveTexture,
+  /// MTL's map_Ke).
+  TextureRef emission_texture;
 
   /// Coverage: `alpha` times the alpha texture where set (its alpha channel, or its first
   /// channel when it has none), read by `alpha_mode`.
@@ -50,7 +67,9 @@ struct Material {
   bool alpha_in_colour = false;
 
   /// True when some parameter varies over the surface and must be looked up at each point.
-  bool is_textured() const { return albedo_texture.valid(); }
+  bool is_textured() const {
+    return albedo_texture.valid() || metallic_roughness_texture.valid() || emission_texture.valid();
+  }
   /// True when rays may pass through parts of the surface.
   bool has_coverage() const { return alpha_mode != AlphaMode::opaque && (alpha < 1.0f || alpha_texture.valid()); }
 
@@ -65,6 +84,8 @@ struct Material {
   static Material make_mirror(std::string name, Rgb reflectance = Rgb(1.0f));
   static Material make_dielectric(std::string name, float ior, Rgb absorption = Rgb(0.0f));
   static Material make_glossy(std::string name, Rgb albedo, Rgb specular, float exponent);
+  static Material make_metallic_roughness(std::string name, Rgb base_colour, float metallic, float roughness,
+                                          float ior = 1.5f);
 };
 
 }  // namespace gilt::raytrace_core

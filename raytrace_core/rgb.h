@@ -30,6 +30,7 @@ struct Rgb {
   bool is_finite() const { return std::isfinite(r) && std::isfinite(g) && std::isfinite(b); }
   /// Largest channel.
   constexpr float max_component() const { return std::max(r, std::max(g, b)); }
+  constexpr float min_component() const { return std::min(r, std::min(g, b)); }
   /// Mean of the three channels: the scalar used for power and Russian roulette.
   constexpr float average() const { return (r + g + b) * (1.0f / 3.0f); }
   /// Rec.709 luminance Y.

@@ -161,8 +161,16 @@ class JsonSceneReader {
         object(j, p, {"kind", "ior", "absorption", "emission", "two_sided"});
         m = Material::make_dielectric(name, number(j, "ior", p, 1.5f), colour(j, "absorption", p, Rgb(0.0f)));
         if (!(m.ior > 0.0f)) fail(at(p, "ior"), "must be positive");
+      } else if (kind == "metallic_roughness") {
+        object(j, p, {"kind", "albedo", "metallic", "roughness", "ior", "emission", "two_sided"});
+        m = Material::make_metallic_roughness(name, reflectance(j, "albedo", p, Rgb(0.8f)), number(j, "metallic", p, 0.0f),
+                                              number(j, "roughness", p, 0.5f), number(j, "ior", p, 1.5f));
+        if (!(m.metallic >= 0.0f && m.metallic <= 1.0f)) fail(at(p, "metallic"), "must lie in [0, 1]");
+        if (!(m.roughness >= 0.0f && m.roughness <= 1.0f)) fail(at(p, "roughness"), "must lie in [0, 1]");
+        if (!(m.ior >= 1.0f)) fail(at(p, "ior"), "must be at least 1");
       } else {
-        fail(at(p, "kind"), "unknown kind '" + kind + "' (expected diffuse, glossy, mirror or dielectric)");
+        fail(at(p, "kind"),
+             "unknown kind '" + kind + "' (expected diffuse, glossy, mirror, dielectric or metallic_roughness)");
       }
       m.emission = colour(j, "emission", p, Rgb(0.0f));
       if (const Json* two_sided = field(j, "two_sided")) {

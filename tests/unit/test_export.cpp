@@ -483,7 +483,9 @@ void ExportTest::check_gltf(const std::string& file, bool binary) {
   EXPECT_EQ(wall.pbrMetallicRoughness.metallicFactor, 0.0);
   EXPECT_EQ(wall.pbrMetallicRoughness.roughnessFactor, 1.0);
   EXPECT_EQ(wall.emissiveFactor, (std::vector<double>{0.0, 0.0, 0.0}));
-  EXPECT_TRUE(wall.extensions.empty());
+  // Lambertian: the specification's BRDF without its specular layer.
+  ASSERT_EQ(wall.extensions.size(), 1u);
+  EXPECT_EQ(wall.extensions.at("KHR_materials_specular").Get("specularFactor").GetNumberAsDouble(), 0.0);
   const tinygltf::Material& lamp = model.materials[1];
   EXPECT_EQ(lamp.pbrMetallicRoughness.baseColorFactor, (std::vector<double>{0.5, 0.5, 0.5, 1.0}));
   ASSERT_EQ(lamp.extensions.count("KHR_materials_emissive_strength"), 1u);
