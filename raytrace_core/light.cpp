@@ -94,7 +94,9 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
       if (!(pdf > 0.0f) || !(dist > 0.0f) || !std::isfinite(pdf)) return ls;
       ls.wi = d / dist;
       ls.pdf = pdf;
-      ls.radiance = emitted_radiance(scene.primitive_material(light.geom_id, light.prim_id), q.ng, -ls.wi);
+      const Material& m = scene.primitive_material(light.geom_id, light.prim_id);
+      ls.radiance = emitted_radiance(m, q.ng, -ls.wi);
+      if (m.emission_texture.valid() && !ls.radiance.is_black()) ls.radiance = scene.emission_at(m, q.uv);
       ls.shadow_ray = spawn_shadow_ray(ref, q);
       return ls;
     }
@@ -171,7 +173,7 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
       }
       const Vec3 w = Frame::from_normal(n).to_world(sample_cosine_hemisphere(u_direction));
       // Le cos / (1/A · cos/π · 1/sides) = Le π A · sides.
-      es.power = m.emission * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
+      es.power = scene.emission_at(m, q.uv) * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
       SurfacePoint from = q;
       from.ng = n;
       es.ray = spawn_ray(from, w);
@@ -220,7 +222,7 @@ Rgb light_power(const Scene& scene, const Light& light) {
     case LightKind::area_sphere: {
       const Material& m = scene.primitive_material(light.geom_id, light.prim_id);
       const float sides = m.two_sided_emission ? 2.0f : 1.0f;
-      return m.emission * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
+      return scene.mean_emission(light.geom_id, light.prim_id) * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
     }
     case LightKind::point: return light.intensity * (4.0f * kPi);
     case LightKind::spot:

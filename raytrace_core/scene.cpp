@@ -206,7 +206,12 @@ void Scene::commit() {
         m.absorption.b < 0 || m.exponent < 0)
       throw InputError(id + ": reflectance, emission, absorption and exponent must not be negative");
     if (m.kind == MaterialKind::dielectric && !(m.ior > 0.0f)) throw InputError(id + ": ior must be positive");
-    for (const TextureRef* t : {&m.albedo_texture, &m.alpha_texture}) {
+    if (!(m.metallic >= 0.0f && m.metallic <= 1.0f) || !(m.roughness >= 0.0f && m.roughness <= 1.0f))
+      throw InputError(id + ": metallic and roughness must lie in [0, 1]");
+    if (!m.transmission_tint.is_finite() || m.transmission_tint.min_component() < 0.0f ||
+        m.transmission_tint.max_component() > 1.0f)
+      throw InputError(id + ": transmission tint must lie in [0, 1]");
+    for (const TextureRef* t : {&m.albedo_texture, &m.alpha_texture, &m.metallic_roughness_texture, &m.emission_texture}) {
       if (t->image >= int32_t(textures.size()) || t->image < -1)
         throw InputError(id + ": refers to texture " + std::to_string(t->image) + " but there are " +
                          std::to_string(textures.size()));
@@ -538,18 +543,47 @@ const Material& Scene::shading_material(const SurfaceInteraction& si, Material& 
   scratch.exponent = m.exponent;
   scratch.ior = m.ior;
   scratch.absorption = m.absorption;
-  scratch.emission = m.emission;
+  scratch.transmission_tint = m.transmission_tint;
+  scratch.thin_walled = m.thin_walled;
   scratch.two_sided_emission = m.two_sided_emission;
-  scratch.albedo_texture = TextureRef{};
-  const TextureRef& t = m.albedo_texture;
-  scratch.albedo = m.albedo * texture_set_->lookup(t.image, t.st(si.uv), t.st_delta(duv_dx), t.st_delta(duv_dy)).rgb;
+  scratch.albedo_texture = scratch.metallic_roughness_texture = scratch.emission_texture = TextureRef{};
+  const auto read = [&](const TextureRef& t) {
+    return texture_set_->lookup(t.image, t.st(si.uv), t.st_delta(duv_dx), t.st_delta(duv_dy));
+  };
+  scratch.albedo = m.albedo_texture.valid() ? m.albedo * read(m.albedo_texture).rgb : m.albedo;
+  scratch.metallic = m.metallic;
+  scratch.roughness = m.roughness;
+  if (m.metallic_roughness_texture.valid()) {  // glTF: roughness in green, metalness in blue
+    const Rgb t = read(m.metallic_roughness_texture).rgb;
+    scratch.roughness = m.roughness * std::clamp(t.g, 0.0f, 1.0f);
+    scratch.metallic = m.metallic * std::clamp(t.b, 0.0f, 1.0f);
+  }
+  scratch.emission = emission_at(m, si.uv);
   return scratch;
 }
 
+Rgb Scene::emission_at(const Material& m, Vec2 uv) const {
+  if (!m.emission_texture.valid() || !texture_set_ || m.emission.is_black()) return m.emission;
+  const TextureRef& t = m.emission_texture;
+  return m.emission * clamp(texture_set_->lookup(t.image, t.st(uv)).rgb, 0.0f, kInfinity);
+}
+
 Rgb Scene::mean_albedo(const Material& m, Vec2 uv0, Vec2 uv1, Vec2 uv2) const {
-  if (!m.is_textured() || !texture_set_) return m.albedo;
+  if (!m.albedo_texture.valid() || !texture_set_) return m.albedo;
   const TextureRef& t = m.albedo_texture;
   return m.albedo * texture_set_->triangle_mean(t.image, t.st(uv0), t.st(uv1), t.st(uv2)).rgb;
+}
+
+Rgb Scene::mean_emission(uint32_t geom_id, uint32_t prim_id) const {
+  const Material& m = primitive_material(geom_id, prim_id);
+  if (!m.emission_texture.valid() || !texture_set_ || m.emission.is_black() || geom_id == sphere_geom_id())
+    return m.emission;
+  const TriangleMesh& mesh = meshes[geom_id];
+  if (mesh.uvs.empty()) return emission_at(m, Vec2(0.0f));
+  const TextureRef& t = m.emission_texture;
+  const Vec2 a = t.st(mesh.uvs[mesh.indices[3 * prim_id]]), b = t.st(mesh.uvs[mesh.indices[3 * prim_id + 1]]),
+             c = t.st(mesh.uvs[mesh.indices[3 * prim_id + 2]]);
+  return m.emission * clamp(texture_set_->triangle_mean(t.image, a, b, c).rgb, 0.0f, kInfinity);
 }
 
 size_t Scene::triangle_count() const {

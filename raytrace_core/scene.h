@@ -149,6 +149,10 @@ class Scene {
                                    Vec2 duv_dy = Vec2(0.0f)) const;
   /// Mean albedo of a material over a triangle with texture coordinates uv0, uv1, uv2.
   Rgb mean_albedo(const Material& m, Vec2 uv0, Vec2 uv1, Vec2 uv2) const;
+  /// Emitted radiance factor of a material at texture coordinates uv (emission × emission texture).
+  Rgb emission_at(const Material& m, Vec2 uv) const;
+  /// Mean emitted radiance factor over one primitive: what its light's power is built from.
+  Rgb mean_emission(uint32_t geom_id, uint32_t prim_id) const;
   /// The scene's opened textures (null when it has none).
   const TextureSet* texture_set() const { return texture_set_.get(); }
   /// Surface point on a triangle at barycentrics (b1, b2) of its second and third vertex.
