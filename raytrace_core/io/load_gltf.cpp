@@ -1,30 +1,30 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf: the node hierarchy of the default scene with its
-// transforms, triangle primitives, materials with their base-colour textures, the first
-// perspective camera and KHR_lights_punctual lights. Other textures (normal, emissive,
-// metallic-roughness, occlusion, extensions'), skins, morph targets and animations are ignored.
+// transforms, triangle primitives, materials with their textures, the first perspective camera
+// and KHR_lights_punctual lights. Normal and occlusion textures, extensions' textures, skins,
+// morph targets and animations are ignored (with a warning naming them).
 //
 // Material mapping (documented in docs/scene-format.md); base = baseColorFactor.rgb,
 // m = metallicFactor, r = roughnessFactor:
 //   KHR_materials_transmission factor > 0.5 → dielectric, ior from KHR_materials_ior (1.5),
-//       σa = −ln(attenuationColor) / attenuationDistance from KHR_materials_volume
-//   m ≥ 0.9 and r ≤ 0.1                     → mirror, reflectance base
-//   r ≥ 0.9                                 → diffuse, albedo base
-//   otherwise                               → glossy: albedo 0.96·(1 − m)·base,
-//       specular 0.04·(1 − m) + m·base, Phong exponent 2/α² − 2 with α = r² (the Beckmann–Phong
-//       correspondence of Walter et al. 2007, "Microfacet Models for Refraction"), clamped to
-//       [1, 10⁴]
+//       transmission tinted by base; with KHR_materials_volume of thickness > 0 a solid with
+//       σa = −ln(attenuationColor) / attenuationDistance, else a thin sheet (light passes unbent)
+//   m = 1, r² ≤ kMinGgxAlpha, untextured     → mirror, reflectance base
+//   m = 0, KHR_materials_specular's specularFactor = 0 → diffuse (F0 = 0: exactly Lambertian)
+//   otherwise                               → metallic_roughness (the specification's appendix B,
+//       raytrace_core/bsdf.cpp), ior from KHR_materials_ior for the dielectric's F0
 //   emission = emissiveFactor × KHR_materials_emissive_strength; doubleSided → two-sided emission
 // Photometric light units are read as radiometric: point/spot intensity (cd) as W·sr⁻¹,
 // directional illuminance (lx) as W·m⁻², i.e. no 683 lm/W factor.
 //
-// Base-colour textures: baseColorTexture becomes Material::albedo_texture over an sRGB
-// TextureImage with the sampler's wrap modes. It scales the diffuse albedo (a glossy material's
-// specular colour stays untextured) and is ignored, with a warning, on mirrors and glass. Its UV
-// set (textureInfo.texCoord, or the KHR_texture_transform's own) is the one read into
-// TriangleMesh::uvs for the primitives of that material. glTF's UVs already have OpenImageIO's
-// origin (top-left), so the map is the identity unless KHR_texture_transform gives one. Image
-// files are handed to OpenImageIO as they are; images embedded in the glTF (data: URIs, buffer
-// views) are first written to the texture cache folder under a name made from their content.
+// Textures: baseColorTexture (sRGB) scales the base colour, metallicRoughnessTexture (linear;
+// roughness in green, metalness in blue) the two factors, emissiveTexture (sRGB) the emission.
+// Each reads the sampler's wrap modes. A mirror's or glass's base colour texture is ignored with
+// a warning. A material reads one UV set (textureInfo.texCoord, or the KHR_texture_transform's
+// own): its first texture's; a texture on another set is ignored with a warning. glTF's UVs
+// already have OpenImageIO's origin (top-left), so the map is the identity unless
+// KHR_texture_transform gives one. Image files are handed to OpenImageIO as they are; images
+// embedded in the glTF (data: URIs, buffer views) are first written to the texture cache folder
+// under a name made from their content.
 
 #include <unistd.h>
 
@@ -48,6 +48,7 @@
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/loaders.h"
+#include "raytrace_core/microfacet.h"
 
 namespace gilt::raytrace_core {
 
@@ -153,10 +154,11 @@ Material convert_material(const tinygltf::Material& gm, const std::string& name)
   const float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
   const double transmission =
       number_or(extension(gm.extensions, "KHR_materials_transmission"), "transmissionFactor", 0.0);
+  float ior = float(number_or(extension(gm.extensions, "KHR_materials_ior"), "ior", 1.5));
+  if (!(ior >= 1.0f) || !std::isfinite(ior)) ior = 1.5f;  // the extension allows ior = 0 ("infinite"): not glass
 
   Material m;
   if (transmission > 0.5) {
-    const float ior = float(number_or(extension(gm.extensions, "KHR_materials_ior"), "ior", 1.5));
     Rgb absorption(0.0f);
     const tinygltf::Value& volume = extension(gm.extensions, "KHR_materials_volume");
     const double distance = number_or(volume, "attenuationDistance", 0.0);
@@ -166,15 +168,18 @@ Material convert_material(const tinygltf::Material& gm, const std::string& name)
         absorption[c] = float(-std::log(std::clamp(color.Get(c).GetNumberAsDouble(), 1e-4, 1.0)) / distance);
     }
     m = Material::make_dielectric(name, ior, absorption);
-  } else if (metallic >= 0.9f && roughness <= 0.1f) {
-    m = Material::make_mirror(name, base);
-  } else if (roughness >= 0.9f) {
-    m = Material::make_diffuse(name, base);
+    // The base colour tints what the surface transmits. Without KHR_materials_volume (or with a
+    // thickness of zero) the surface is thin-walled: light passes through unbent.
+    m.transmission_tint = base;
+    m.thin_walled = !volume.IsObject() || !(number_or(volume, "thicknessFactor", 0.0) > 0.0);
+    if (m.thin_walled) m.absorption = Rgb(0.0f);
+  } else if (metallic == 1.0f && roughness * roughness <= kMinGgxAlpha && pbr.metallicRoughnessTexture.index < 0) {
+    m = Material::make_mirror(name, base);  // narrower than the GGX lobe can be: a delta lobe
+  } else if (metallic == 0.0f &&
+             number_or(extension(gm.extensions, "KHR_materials_specular"), "specularFactor", 1.0) == 0.0) {
+    m = Material::make_diffuse(name, base);  // F0 = 0: the specification's BRDF is exactly Lambertian
   } else {
-    const float alpha = roughness * roughness;
-    const float exponent = std::clamp(2.0f / (alpha * alpha) - 2.0f, 1.0f, 1e4f);
-    m = Material::make_glossy(name, base * (0.96f * (1.0f - metallic)),
-                              Rgb(0.04f * (1.0f - metallic)) + base * metallic, exponent);
+    m = Material::make_metallic_roughness(name, base, metallic, roughness, ior);
   }
   const float strength =
       float(number_or(extension(gm.extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0));
@@ -207,32 +212,51 @@ class GltfLoader {
     for (size_t i = 0; i < model_.materials.size(); ++i) {
       const tinygltf::Material& gm = model_.materials[i];
       Material m = convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name);
-      int uv_set = 0;
+      // One UV set per material: the first texture's. A texture on another set is left out.
+      int uv_set = -1;
+      const std::string where = "materials[" + std::to_string(i) + "]";
+      const auto read = [&](const tinygltf::TextureInfo& info, const std::string& key, bool srgb) {
+        int set = 0;
+        TextureRef ref = texture_ref(info, where + "." + key, set, srgb);
+        if (!ref.valid()) return ref;
+        if (uv_set >= 0 && set != uv_set) {
+          scene_.warnings.push_back(file_ + ": " + where + "." + key + " reads texture coordinate set " +
+                                    std::to_string(set) + " but the material's other textures read set " +
+                                    std::to_string(uv_set) + "; it is ignored");
+          return TextureRef{};
+        }
+        uv_set = set;
+        return ref;
+      };
       // A mirror's or glass's base colour tints what it reflects or transmits, which a texture on
       // Material::albedo cannot express: left out, as the OBJ loader leaves out their map_Kd.
       const bool has_base_texture = gm.pbrMetallicRoughness.baseColorTexture.index >= 0;
       note_ignored(has_base_texture && m.is_specular(), "base colour of mirror and glass materials");
       if (has_base_texture && !m.is_specular())
-        m.albedo_texture = base_color_texture(
-            gm.pbrMetallicRoughness.baseColorTexture,
-            "materials[" + std::to_string(i) + "].pbrMetallicRoughness.baseColorTexture", uv_set);
-      uv_set_of_material_.push_back(m.albedo_texture.valid() ? uv_set : 0);
+        m.albedo_texture = read(gm.pbrMetallicRoughness.baseColorTexture, "pbrMetallicRoughness.baseColorTexture", true);
+      const bool has_mr_texture = gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
+      if (has_mr_texture && m.kind == MaterialKind::metallic_roughness)
+        m.metallic_roughness_texture = read(gm.pbrMetallicRoughness.metallicRoughnessTexture,
+                                            "pbrMetallicRoughness.metallicRoughnessTexture", false);
+      note_ignored(has_mr_texture && m.kind != MaterialKind::metallic_roughness,
+                   "metallic-roughness of mirror and glass materials");
+      if (gm.emissiveTexture.index >= 0 && m.is_emissive())
+        m.emission_texture = read(gm.emissiveTexture, "emissiveTexture", true);
+      uv_set_of_material_.push_back(std::max(uv_set, 0));
       // alphaMode: coverage is baseColorFactor's alpha times the base colour texture's.
       if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
         m.alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::mask : AlphaMode::blend;
         const auto& factor = gm.pbrMetallicRoughness.baseColorFactor;
         m.alpha = factor.size() == 4 ? std::clamp(float(factor[3]), 0.0f, 1.0f) : 1.0f;
         if (!(gm.alphaCutoff >= 0.0 && gm.alphaCutoff <= 1.0))
-          fail("materials[" + std::to_string(i) + "].alphaCutoff: must lie in [0, 1]");
+          fail(where + ".alphaCutoff: must lie in [0, 1]");
         m.alpha_cutoff = float(gm.alphaCutoff);
         m.alpha_texture = m.albedo_texture;
       } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
-        fail("materials[" + std::to_string(i) + "].alphaMode: unknown mode " + gm.alphaMode);
+        fail(where + ".alphaMode: unknown mode " + gm.alphaMode);
       }
       scene_.materials.push_back(std::move(m));
       note_ignored(gm.normalTexture.index >= 0, "normal");
-      note_ignored(gm.emissiveTexture.index >= 0, "emissive");
-      note_ignored(gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0, "metallic-roughness");
       note_ignored(gm.occlusionTexture.index >= 0, "occlusion");
       // Extensions' textures, e.g. KHR_materials_transmission's transmissionTexture.
       for (const auto& [name, value] : gm.extensions)
@@ -276,7 +300,7 @@ class GltfLoader {
 
   /// The reference a base colour textureInfo (at JSON path `where`) makes, or an invalid one when
   /// its image cannot be had; `uv_set` is set to the TEXCOORD set it reads.
-  TextureRef base_color_texture(const tinygltf::TextureInfo& info, const std::string& where, int& uv_set) {
+  TextureRef texture_ref(const tinygltf::TextureInfo& info, const std::string& where, int& uv_set, bool srgb) {
     if (size_t(info.index) >= model_.textures.size())
       fail(where + ".index: texture " + std::to_string(info.index) + " does not exist");
     uv_set = info.texCoord;
@@ -301,7 +325,7 @@ class GltfLoader {
     TextureImage image;
     image.file = image_file(texture.source);
     if (image.file.empty()) return TextureRef{};
-    image.srgb = true;  // glTF stores base colour sRGB-encoded
+    image.srgb = srgb;  // glTF stores colours (base, emissive) sRGB-encoded, data linear
     if (texture.sampler >= 0) {
       if (size_t(texture.sampler) >= model_.samplers.size())
         fail(texture_where + ".sampler: sampler " + std::to_string(texture.sampler) + " does not exist");

@@ -190,6 +190,7 @@ struct DiffuseMap {
   bool clamp = false;               ///< -clamp on
   bool linear = false;              ///< -colorspace linear (tinyobjloader's extension)
   bool kd_given = false;            ///< the material has a Kd line of its own
+  bool pbr_given = false;           ///< the material has a Pr or Pm line (the PBR extension)
 };
 
 /// Parses what follows "map_Kd" on a comment-free line: options, then the file name, which runs
@@ -283,12 +284,15 @@ class MtlReader : public tinyobj::MaterialReader {
         maps.emplace_back();
       } else if (!tokens.empty() && tokens[0] == "Kd" && !maps.empty()) {
         maps.back().kd_given = true;
+      } else if (!tokens.empty() && (tokens[0] == "Pr" || tokens[0] == "Pm") && !maps.empty()) {
+        maps.back().pbr_given = true;
       } else if (tokens.size() >= 1 && tokens[0] == "map_Kd" && !maps.empty() && error_.empty()) {
         const size_t at = size_t(tokens[0].data() - line.data()) + tokens[0].size();
         try {
-          const bool kd_given = maps.back().kd_given;
+          const bool kd_given = maps.back().kd_given, pbr_given = maps.back().pbr_given;
           maps.back() = parse_map_kd(std::string_view(line).substr(at), path, line_no);
           maps.back().kd_given = kd_given;
+          maps.back().pbr_given = pbr_given;
         } catch (const InputError& e) {
           error_ = e.what();  // thrown once tinyobjloader has returned, not through it
         }
@@ -383,7 +387,6 @@ void unused_maps(const tinyobj::material_t& mtl, std::vector<std::string>& kinds
       {&mtl.normal_texname, "normal maps (norm)"},
       {&mtl.displacement_texname, "displacement maps (disp)"},
       {&mtl.reflection_texname, "reflection maps (refl)"},
-      {&mtl.emissive_texname, "emission maps (map_Ke)"},
       {&mtl.roughness_texname, "roughness maps (map_Pr)"},
       {&mtl.metallic_texname, "metallic maps (map_Pm)"},
       {&mtl.sheen_texname, "sheen maps (map_Ps)"},
@@ -489,6 +492,15 @@ void load_obj(const fs::path& path, Scene& scene) {
     unused_maps(mtl, ignored_maps);
     const bool read = i < mtl_reader.diffuse_map_of_material.size();
     const DiffuseMap diffuse = read ? mtl_reader.diffuse_map_of_material[i] : DiffuseMap{};
+    // The PBR extension (Pr roughness, Pm metallic): glTF's metallic-roughness model with base
+    // colour Kd. Glass and mirrors keep their kind.
+    if (diffuse.pbr_given && !m.is_specular()) {
+      const Rgb emission = m.emission;
+      m = Material::make_metallic_roughness(mtl.name, clamp(rgb(mtl.diffuse), 0.0f, 1.0f),
+                                            std::clamp(float(mtl.metallic), 0.0f, 1.0f),
+                                            std::clamp(float(mtl.roughness), 0.0f, 1.0f));
+      m.emission = emission;
+    }
     if (!diffuse.name.empty() && (m.kind == MaterialKind::mirror || m.kind == MaterialKind::dielectric)) {
       const char* kind = "map_Kd of mirror and glass materials";
       if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end())
@@ -510,31 +522,46 @@ void load_obj(const fs::path& path, Scene& scene) {
         m.albedo_texture = diffuse_texture_ref(texture_index(scene.textures, image), diffuse);
       }
     }
+    // A map other than map_Kd, with tinyobjloader's reading of its options (-s, -o, -clamp):
+    // its reference, or none (with a warning) when the file is not found.
+    const auto read_map = [&](const std::string& texname, const tinyobj::texture_option_t& o, bool srgb,
+                              const char* key, const char* fallback) -> TextureRef {
+      const fs::path folder = read ? mtl_reader.folder_of_material[i] : path.parent_path();
+      TextureImage image;
+      image.file = find_texture_file(folder, texname);
+      if (image.file.empty()) {
+        const std::string where = folder.empty() ? std::string(".") : folder.string();
+        scene.warnings.push_back(file + ": material '" + mtl.name + "': " + key + " '" + texname +
+                                 "' not found in " + where + "; " + fallback);
+        return TextureRef{};
+      }
+      DiffuseMap map;
+      map.scale[0] = float(o.scale[0]), map.scale[1] = float(o.scale[1]);
+      map.offset[0] = float(o.origin_offset[0]), map.offset[1] = float(o.origin_offset[1]);
+      image.srgb = srgb;
+      image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+      return diffuse_texture_ref(texture_index(scene.textures, image), map);
+    };
     // map_d: a cut-out (leaves, fences), its image read as data; coverage below one half is not
-    // there. Its options are tinyobjloader's reading (-s, -o, -clamp).
+    // there.
     if (!mtl.alpha_texname.empty() && m.is_specular()) {
       const char* kind = "map_d of mirror and glass materials";
       if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end()) ignored_maps.push_back(kind);
     } else if (!mtl.alpha_texname.empty()) {
-      const fs::path folder = read ? mtl_reader.folder_of_material[i] : path.parent_path();
-      TextureImage image;
-      image.file = find_texture_file(folder, mtl.alpha_texname);
-      if (image.file.empty()) {
-        const std::string where = folder.empty() ? std::string(".") : folder.string();
-        scene.warnings.push_back(file + ": material '" + mtl.name + "': map_d '" + mtl.alpha_texname +
-                                 "' not found in " + where + "; left opaque");
-      } else {
-        const tinyobj::texture_option_t& o = mtl.alpha_texopt;
-        DiffuseMap map;
-        map.scale[0] = float(o.scale[0]), map.scale[1] = float(o.scale[1]);
-        map.offset[0] = float(o.origin_offset[0]), map.offset[1] = float(o.origin_offset[1]);
-        image.srgb = false;
-        image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+      const TextureRef ref = read_map(mtl.alpha_texname, mtl.alpha_texopt, false, "map_d", "left opaque");
+      if (ref.valid()) {
         m.alpha_mode = AlphaMode::mask;
         m.alpha_cutoff = 0.5f;
         m.alpha_in_colour = true;
-        m.alpha_texture = diffuse_texture_ref(texture_index(scene.textures, image), map);
+        m.alpha_texture = ref;
       }
+    }
+    // map_Ke: the emission is Ke × the texel (sRGB, as colour maps are), as map_Kd scales Kd.
+    if (!mtl.emissive_texname.empty() && !m.is_emissive()) {
+      scene.warnings.push_back(file + ": material '" + mtl.name + "': Ke is black, so map_Ke " +
+                               mtl.emissive_texname + " would not show; ignored");
+    } else if (!mtl.emissive_texname.empty()) {
+      m.emission_texture = read_map(mtl.emissive_texname, mtl.emissive_texopt, true, "map_Ke", "emission untextured");
     }
     scene.materials.push_back(std::move(m));
   }

@@ -500,20 +500,23 @@ TEST_F(GltfTextures, OtherTexturesWarnedInOneLine) {
   quad.images = R"([{"uri": "red-blue.png"}])";
   quad.materials = R"([
     {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 0},
-     "emissiveTexture": {"index": 0}, "occlusionTexture": {"index": 0}},
+     "emissiveTexture": {"index": 0}, "emissiveFactor": [1, 1, 1], "occlusionTexture": {"index": 0}},
     {"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}}, "normalTexture": {"index": 0}},
     {"name": "chrome", "pbrMetallicRoughness": {"metallicFactor": 1, "roughnessFactor": 0,
                                                 "baseColorTexture": {"index": 0}}}])";
   const Scene scene = load_scene_file(write("others.gltf", quad.gltf()));
-  EXPECT_TRUE(scene.materials[0].is_textured());
-  EXPECT_FALSE(scene.materials[1].is_textured());
+  EXPECT_TRUE(scene.materials[0].albedo_texture.valid());
+  EXPECT_TRUE(scene.materials[0].emission_texture.valid());
+  EXPECT_TRUE(scene.materials[1].metallic_roughness_texture.valid());
+  EXPECT_FALSE(scene.materials[1].albedo_texture.valid());
   // A mirror's base colour tints its reflection, which an albedo texture cannot: left out.
   EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
   EXPECT_FALSE(scene.materials[2].is_textured());
-  EXPECT_EQ(scene.textures.size(), 1u);
+  // One image, read as colour (base, emission) and as data (metallic-roughness).
+  EXPECT_EQ(scene.textures.size(), 2u);
   ASSERT_EQ(count_warnings(scene, "ignored"), 1) << "one line per file";
-  for (const char* kind : {"normal", "emissive", "metallic-roughness", "occlusion", "mirror"})
-    EXPECT_TRUE(has_warning(scene, kind)) << kind;
+  for (const char* kind : {"normal", "occlusion", "mirror"}) EXPECT_TRUE(has_warning(scene, kind)) << kind;
+  for (const char* kind : {"emissive", "metallic-roughness"}) EXPECT_FALSE(has_warning(scene, kind)) << kind;
 
   // Nothing is said when the base colour is all there is.
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])";

@@ -53,6 +53,7 @@ fs::path write_model(const fs::path& dir) {
   write_file(dir / "data.bin", bin);
   Json model = Json::parse(R"({
     "asset": {"version": "2.0"},
+    "extensionsUsed": ["KHR_materials_specular"],
     "scene": 0,
     "scenes": [{"nodes": [0, 1, 2]}],
     "nodes": [
@@ -62,7 +63,8 @@ fs::path write_model(const fs::path& dir) {
     "meshes": [
       {"name": "floor", "primitives": [{"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]},
       {"name": "panel", "primitives": [{"attributes": {"POSITION": 1}, "indices": 2}]}],
-    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}}],
+    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0},
+                   "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}],
     "accessors": [
       {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
       {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, 0, -0.5], "max": [0.5, 0, 0.5]},
@@ -371,13 +373,15 @@ fs::path write_uv_model(const fs::path& dir, bool uv1, bool uv0_apart) {
   write_file(dir / "uv.bin", bin);
   Json model = Json::parse(R"({
     "asset": {"version": "2.0"},
+    "extensionsUsed": ["KHR_materials_specular"],
     "scene": 0,
     "scenes": [{"nodes": [0, 1]}],
     "nodes": [{"name": "floor", "mesh": 0}, {"name": "panel", "mesh": 1}],
     "meshes": [
       {"name": "floor", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 3}, "indices": 2, "material": 0}]},
       {"name": "panel", "primitives": [{"attributes": {"POSITION": 1, "TEXCOORD_0": 4}, "indices": 2, "material": 0}]}],
-    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}}],
+    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0},
+                   "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}],
     "accessors": [
       {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
       {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, 1, -0.5], "max": [0.5, 1, 0.5]},

@@ -489,8 +489,10 @@ void expect_gltf_contents(const Scene& scene) {
   EXPECT_EQ(glass.kind, MaterialKind::dielectric);
   EXPECT_FLOAT_EQ(glass.ior, 1.4f);
   EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
-  EXPECT_EQ(scene.materials[3].kind, MaterialKind::glossy);
-  EXPECT_NEAR(scene.materials[3].exponent, 30.0f, 1e-3f);  // 2/α² − 2 with α = 0.5²
+  EXPECT_TRUE(glass.thin_walled);  // no KHR_materials_volume: a sheet
+  EXPECT_EQ(scene.materials[3].kind, MaterialKind::metallic_roughness);
+  EXPECT_EQ(scene.materials[3].metallic, 0.0f);
+  EXPECT_EQ(scene.materials[3].roughness, 0.5f);
 
   ASSERT_TRUE(scene.camera.has_value());
   EXPECT_EQ(scene.camera->look_from, Vec3(0, 0, 5));

@@ -151,6 +151,7 @@ fs::path write_model(const fs::path& dir) {
   write_file(dir / "data.bin", bin);
   Json model = Json::parse(R"({
     "asset": {"version": "2.0"},
+    "extensionsUsed": ["KHR_materials_specular"],
     "scene": 0,
     "scenes": [{"nodes": [0]}],
     "nodes": [
@@ -161,7 +162,8 @@ fs::path write_model(const fs::path& dir) {
     "meshes": [
       {"name": "floor", "primitives": [{"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]},
       {"name": "panel", "primitives": [{"attributes": {"POSITION": 1}, "indices": 2, "material": 0}]}],
-    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}}],
+    "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0},
+                   "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}],
     "animations": [{
       "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}],
       "samplers": [{"input": 3, "output": 4, "interpolation": "LINEAR"}]}],
