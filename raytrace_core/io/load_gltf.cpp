@@ -205,6 +205,7 @@ class GltfLoader {
     scene_.model_files.push_back(file_);
     image_files_.assign(model_.images.size(), ImageFile{});
     std::vector<std::string> ignored;  // kinds of texture the file has and gilt does not read
+    std::vector<std::string> ignored_extensions;  // material extensions gilt does not model
     const auto note_ignored = [&](bool present, const std::string& kind) {
       if (present && std::find(ignored.begin(), ignored.end(), kind) == ignored.end())
         ignored.push_back(kind);
@@ -255,6 +256,15 @@ class GltfLoader {
       } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
         fail(where + ".alphaMode: unknown mode " + gm.alphaMode);
       }
+      // Material extensions gilt does not model are named, so that a look that differs from
+      // other renderers' is explained. KHR_materials_unlit's surfaces are lit like the rest.
+      for (const auto& [name, value] : gm.extensions) {
+        const bool read = name == "KHR_materials_transmission" || name == "KHR_materials_ior" ||
+                          name == "KHR_materials_volume" || name == "KHR_materials_emissive_strength" ||
+                          (name == "KHR_materials_specular" && m.kind == MaterialKind::diffuse);
+        if (!read && std::find(ignored_extensions.begin(), ignored_extensions.end(), name) == ignored_extensions.end())
+          ignored_extensions.push_back(name);
+      }
       scene_.materials.push_back(std::move(m));
       note_ignored(gm.normalTexture.index >= 0, "normal");
       note_ignored(gm.occlusionTexture.index >= 0, "occlusion");
@@ -270,6 +280,12 @@ class GltfLoader {
       std::string list;
       for (const std::string& kind : ignored) list += (list.empty() ? "" : ", ") + kind;
       scene_.warnings.push_back(file_ + ": these textures are ignored: " + list);
+    }
+    if (!ignored_extensions.empty()) {
+      std::string list;
+      for (const std::string& name : ignored_extensions)
+        list += (list.empty() ? "" : ", ") + name + (name == "KHR_materials_unlit" ? " (its surfaces are lit)" : "");
+      scene_.warnings.push_back(file_ + ": these material extensions are ignored: " + list);
     }
 
     std::vector<int> roots;

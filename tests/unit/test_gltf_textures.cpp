@@ -494,6 +494,23 @@ TEST_F(GltfTextures, SamplerWrapModes) {
 
 // ---------------------------------------------------------------- what is still ignored
 
+TEST_F(GltfTextures, UnmodelledMaterialExtensionsAreNamed) {
+  QuadModel quad;
+  quad.materials = R"([
+    {"extensions": {"KHR_materials_unlit": {}}},
+    {"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}, "KHR_materials_ior": {"ior": 1.4}}},
+    {"pbrMetallicRoughness": {"metallicFactor": 0}, "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}])";
+  const Scene scene = load_scene_file(write("extensions.gltf", quad.gltf()));
+  ASSERT_EQ(count_warnings(scene, "material extensions are ignored"), 1) << "one line per file";
+  EXPECT_TRUE(has_warning(scene, "KHR_materials_unlit (its surfaces are lit)"));
+  EXPECT_TRUE(has_warning(scene, "KHR_materials_clearcoat"));
+  EXPECT_FALSE(has_warning(scene, "KHR_materials_ior"));       // read: the dielectric part's F0
+  EXPECT_FALSE(has_warning(scene, "KHR_materials_specular"));  // read: factor 0 is Lambertian
+  EXPECT_EQ(scene.materials[2].kind, MaterialKind::diffuse);
+  EXPECT_EQ(scene.materials[1].kind, MaterialKind::metallic_roughness);
+  EXPECT_FLOAT_EQ(scene.materials[1].ior, 1.4f);
+}
+
 TEST_F(GltfTextures, OtherTexturesWarnedInOneLine) {
   write_red_blue_png("red-blue.png");
   QuadModel quad;

@@ -6,8 +6,10 @@
 // 5e-4), so a texel of 1.0 or 0.0 reads back within 1e-3 once filtering weights are summed.
 
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -244,6 +246,37 @@ TEST_F(Textures, ObjMapDIsACutout) {
   EXPECT_FALSE(scene.textures[0].srgb);
   EXPECT_FALSE(scene.occluded(rc::Ray{{0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
   EXPECT_TRUE(scene.occluded(rc::Ray{{0.75f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
+}
+
+TEST_F(Textures, ObjPbrFieldsAndMapKe) {
+  // MTL's PBR extension: Pr and Pm make the metallic-roughness model with base colour Kd;
+  // map_Ke scales Ke as a colour (sRGB) image; a material without them stays as it was.
+  {
+    std::ofstream out(dir_ / "glow.pgm", std::ios::binary);
+    out << "P5\n1 1\n255\n";
+    out.put(char(255));
+  }
+  std::ofstream(dir_ / "pbr.mtl") << "newmtl brass\nKd 0.8 0.6 0.2\nPr 0.4\nPm 1\n"
+                                     "newmtl panel\nKd 0.1 0.1 0.1\nKe 3 2 1\nmap_Ke glow.pgm\n"
+                                     "newmtl plain\nKd 0.5 0.5 0.5\nmap_Ke glow.pgm\n";
+  std::ofstream(dir_ / "pbr.obj") << "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                                     "usemtl brass\nf 1/1 2/2 3/3\nusemtl panel\nf 1/1 2/2 3/3\n"
+                                     "usemtl plain\nf 1/1 2/2 3/3\n";
+  rc::Scene scene = rc::load_scene((dir_ / "pbr.obj").string());
+  ASSERT_EQ(scene.materials.size(), 3u);
+  const rc::Material& brass = scene.materials[0];
+  EXPECT_EQ(brass.kind, rc::MaterialKind::metallic_roughness);
+  EXPECT_FLOAT_EQ(brass.roughness, 0.4f);
+  EXPECT_FLOAT_EQ(brass.metallic, 1.0f);
+  EXPECT_EQ(brass.albedo, rc::Rgb(0.8f, 0.6f, 0.2f));
+  const rc::Material& panel = scene.materials[1];
+  EXPECT_EQ(panel.kind, rc::MaterialKind::diffuse);
+  ASSERT_TRUE(panel.emission_texture.valid());
+  EXPECT_TRUE(scene.textures[size_t(panel.emission_texture.image)].srgb);
+  // A black Ke leaves map_Ke unused, and says so.
+  EXPECT_FALSE(scene.materials[2].emission_texture.valid());
+  EXPECT_TRUE(std::any_of(scene.warnings.begin(), scene.warnings.end(),
+                          [](const std::string& w) { return w.find("Ke is black") != std::string::npos; }));
 }
 
 TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
