@@ -185,7 +185,9 @@ std::optional<BsdfSample> sample_dielectric(const Material& m, const Vec3& wo, f
   const float eta = m.ior;  // inside over outside
   const float cos_o = wo.z;
   if (!(eta > 0.0f) || !std::isfinite(eta) || cos_o == 0.0f) return std::nullopt;
-  const float reflectance = fresnel_dielectric(cos_o, eta);
+  // A thin sheet has the same medium on both sides: either face reflects as the front one does
+  // (no total internal reflection, which would trap rays inside a closed thin shell forever).
+  const float reflectance = fresnel_dielectric(m.thin_walled ? std::fabs(cos_o) : cos_o, eta);
 
   BsdfSample s;
   s.delta = true;

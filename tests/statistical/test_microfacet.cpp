@@ -340,6 +340,20 @@ TEST(Dielectric, ThinWallPassesStraightThroughTinted) {
   }
 }
 
+TEST(Dielectric, ThinWallReflectsAlikeFromBothSides) {
+  // From the back of a sheet of η = 1.5, 60° is past the critical angle of a solid's inside
+  // (41.8°); a sheet has air on both sides, so it must still transmit 1 − F(60°).
+  Material m = Material::make_dielectric("sheet", 1.5f);
+  m.thin_walled = true;
+  const Vec3 wo_back = spherical(kPi - 1.0472f, 0.4f);
+  const float r = fresnel_dielectric(std::cos(1.0472f), 1.5f);
+  ASSERT_LT(r, 0.2f);
+  const auto s = bsdf_sample(m, wo_back, 0.5f * (1.0f + r), {0.3f, 0.3f});
+  ASSERT_TRUE(s);
+  EXPECT_TRUE(s->transmission);
+  EXPECT_NEAR(s->pdf, 1.0f - r, 1e-6f);
+}
+
 TEST(Dielectric, TintScalesRefraction) {
   Material clear = Material::make_dielectric("clear", 1.5f), tinted = clear;
   tinted.transmission_tint = Rgb(0.2f, 0.6f, 1.0f);
