@@ -7,7 +7,15 @@ find_package(TBB CONFIG REQUIRED)
 find_package(nlohmann_json CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(tinyobjloader CONFIG REQUIRED)
-find_package(TinyGLTF CONFIG REQUIRED)
+# tinygltf: the header from libtinygltf-dev, with the implementation compiled by gilt itself
+# (raytrace_core/io/tinygltf_impl.cpp), not Debian's libtinygltf, which is built without Draco.
+# That implementation decodes KHR_draco_mesh_compression primitives with libdraco and keeps
+# tinygltf's default image reader and writer, whose stb_image code comes from libstb (headers in
+# libstb-dev, under stb/).
+find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)
+find_package(draco CONFIG REQUIRED)
+find_path(STB_INCLUDE_DIR stb/stb_image.h REQUIRED)
+find_library(STB_LIBRARY stb REQUIRED)
 
 # OpenImageIO: Debian's exported CMake targets check for files the -dev package does not bring
 # (the command-line tools in openimageio-tools, which pull Qt, and Imath's Python bindings), and

@@ -579,6 +579,12 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
         for (Json& target : primitive["targets"])
           if (target.is_object()) regather(target, true);
       const int tex_coord = add_lightmap_uvs(o, primitive, split);
+      // A Draco-compressed primitive is now written decoded (its attributes and indices were
+      // regathered from tinygltf's decoded accessors): its compressed data no longer applies.
+      if (primitive.contains("extensions") && primitive["extensions"].is_object()) {
+        primitive["extensions"].erase("KHR_draco_mesh_compression");
+        if (primitive["extensions"].empty()) primitive.erase("extensions");
+      }
       const Json extras = lightmap_extras(image_uri, tex_coord, settings);
       primitive["extras"]["gilt_lightmap"] = extras;
       Json& material = material_for(j, primitive);

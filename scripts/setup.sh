@@ -21,7 +21,7 @@ packages=(
   cmake g++ ninja-build pkg-config
   libglm-dev libembree-dev libtbb-dev libopenimageio-dev
   libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev libboost-dev libopenmesh-dev libflann-dev liblz4-dev
-  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev
+  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev libdraco-dev libstb-dev
   libgtest-dev libbenchmark-dev
 )
 # The report test looks at index.html in a real browser; the clients tests open gilt's exports in

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "raytrace_core/error.h"
+#include "raytrace_core/io/gltf_draco.h"
 #include "raytrace_core/io/loaders.h"
 
 namespace gilt::raytrace_core {
@@ -42,20 +43,44 @@ tinygltf::Model read_gltf_file(const std::string& file, std::vector<std::string>
   loader.SetImageLoader(keep_encoded_image, nullptr);
   std::string error, warning;
   bool ok = false;
+  DracoLog draco;  // problems with Draco-compressed primitives, named once the meshes are read
   try {
     ok = lower_extension(file) == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, file)
                                          : loader.LoadASCIIFromFile(&model, &error, &warning, file);
   } catch (const std::exception& e) {
     throw InputError(file + ": " + e.what());
   }
+  // A bad Draco primitive keeps its accessors without data, which tinygltf may then refuse with
+  // a message of its own: the Draco problem is the one to report.
+  if (const std::string problem = draco.first_problem(model); !problem.empty())
+    throw InputError(file + ": " + problem);
   if (warnings) {
     std::istringstream lines(warning);
     for (std::string w; std::getline(lines, w);)
       if (!trim(w).empty() && !is_image_file_note(w))
         warnings->push_back(file + ": " + trim(w));
   }
-  if (!ok) throw InputError(file + ": " + (error.empty() ? std::string("cannot read glTF file") : trim(error)));
+  if (!ok) {
+    // tinygltf reads extensionsRequired before the buffers and accessors: a file that needs an
+    // extension gilt lacks (e.g. compressed accessors without buffer views) fails for that.
+    std::vector<std::string> unsupported;
+    for (const std::string& required : model.extensionsRequired)
+      if (!gltf_extension_supported(required)) unsupported.push_back(required);
+    const std::string why = error.empty() ? std::string("cannot read glTF file") : trim(error);
+    if (!unsupported.empty()) {
+      std::string names = unsupported[0];
+      for (size_t i = 1; i < unsupported.size(); ++i) names += ", " + unsupported[i];
+      throw InputError(file + ": requires " + (unsupported.size() > 1 ? "extensions " : "extension ") +
+                       names + ", which gilt does not support (" + why + ")");
+    }
+    throw InputError(file + ": " + why);
+  }
   return model;
+}
+
+bool gltf_extension_supported(const std::string& name) {
+  return name == "KHR_lights_punctual" || name.rfind("KHR_materials_", 0) == 0 ||
+         name == "KHR_texture_transform" || name == "KHR_draco_mesh_compression";
 }
 
 }  // namespace gilt::raytrace_core

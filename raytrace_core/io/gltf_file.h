@@ -18,8 +18,14 @@ namespace gilt::raytrace_core {
 
 /// The model in `file` (.glb read as binary, anything else as text). tinygltf's warnings, one
 /// per line, are appended to *warnings when given, except its notes on image files it cannot
-/// find (the scene loader resolves image paths itself and names the missing ones). Throws
-/// InputError naming the file when it cannot be read or parsed.
+/// find (the scene loader resolves image paths itself and names the missing ones). Primitives
+/// compressed with KHR_draco_mesh_compression come decoded (see gltf_draco.h). Throws
+/// InputError naming the file when it cannot be read or parsed, naming the mesh and primitive
+/// whose Draco data is bad, and naming the required extensions gilt does not support when
+/// tinygltf fails on a file that has any.
 tinygltf::Model read_gltf_file(const std::string& file, std::vector<std::string>* warnings = nullptr);
+
+/// True for the glTF extensions gilt reads, the ones a file may list in extensionsRequired.
+bool gltf_extension_supported(const std::string& name);
 
 }  // namespace gilt::raytrace_core

@@ -195,10 +195,10 @@ class GltfLoader {
       : model_(model), file_(std::move(file)), scene_(scene), on_path_(model.nodes.size(), false) {}
 
   void load() {
-    // Extensions a file cannot be read without (e.g. Draco compression, quantized attributes).
+    // Extensions a file cannot be read without (e.g. quantized attributes). Draco-compressed
+    // primitives were decoded into ordinary accessors while the file was read (gltf_draco.h).
     for (const std::string& required : model_.extensionsRequired)
-      if (required != "KHR_lights_punctual" && required.rfind("KHR_materials_", 0) != 0 &&
-          required != "KHR_texture_transform")
+      if (!gltf_extension_supported(required))
         fail("requires extension " + required + ", which gilt does not support");
     first_material_ = static_cast<uint32_t>(scene_.materials.size());
     file_index_ = int32_t(scene_.model_files.size());
