@@ -242,7 +242,15 @@ void run_radiosity(RadiosityOptions& o) {
   else
     std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, shooting %.3g)\n", sol.seconds, sol.mesh_seconds,
                 sol.direct_seconds, sol.shoot_seconds);
-  if (check)
+  // The check inverts L = ρ E / π, which holds on Lambertian surfaces only: say so rather than
+  // print errors of nothing.
+  const char* kNothingChecked =
+      "  check:   nothing compared: no %s could be checked; the check reads irradiance only on diffuse "
+      "materials with albedo above zero in every channel (glossy and metallic-roughness surfaces are not "
+      "checked yet)\n";
+  if (check && check->points == 0)
+    std::printf(kNothingChecked, "vertex");
+  else if (check)
     std::printf("  check:   irradiance at %zu vertices against the path tracer (%d samples each): mean relative "
                 "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
@@ -261,7 +269,9 @@ void run_radiosity(RadiosityOptions& o) {
   if (atlas && atlas->stats.uv_set < 0)
     std::printf(", %zu charts at %.4g texels per unit", atlas->stats.charts, atlas->stats.texels_per_metre);
   if (atlas) std::printf("\n            wrote %s\n", radiosity::lightmap_image_path(o.output).c_str());
-  if (surface_check)
+  if (surface_check && surface_check->points == 0 && surface_check->unlit == 0)
+    std::printf(kNothingChecked, "sampled point");
+  else if (surface_check)
     std::printf("  check:   irradiance at %zu random points inside the input's faces against the path tracer (%d "
                 "samples each; %zu points no light reaches left out): relMSE %.4g (of which the reference's own "
                 "noise %.4g), mean relative error %.3g %% (%.2f s)\n",
