@@ -20,6 +20,7 @@
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sampling.h"
+#include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::raytrace_core {
@@ -69,16 +70,8 @@ class LobeTest : public testing::TestWithParam<LobeCase> {};
 TEST_P(LobeTest, SampledDirectionsFollowPdf) {
   const LobeCase& c = GetParam();
   // θ rows resolve the n = 100 lobe (angular width ~0.1 rad) at normal incidence; 48 × 96 cells.
-  const auto r = test::chi2_directions(
-      test::theta_grid(48, 96), kChi2Samples, 0xb5df + std::hash<std::string>{}(c.name) % 1000,
-      [&](Rng& rng) -> std::optional<Vec3> {
-        const float u_lobe = rng.uniform();
-        const auto s = bsdf_sample(c.material, c.wo, u_lobe, rng.uniform2());
-        if (!s) return std::nullopt;
-        return s->wi;
-      },
-      [&](Vec3 wi) { return bsdf_pdf(c.material, c.wo, wi); }, kAlpha);
-  test::expect_chi2_pass(r);
+  test::expect_chi2_pass(
+      test::chi2_bsdf(c.material, c.wo, kChi2Samples, 0xb5df + std::hash<std::string>{}(c.name) % 1000, kAlpha));
 }
 
 TEST_P(LobeTest, SampleMatchesEvalAndPdf) {
