@@ -1,6 +1,8 @@
 // Object-space check. The path tracer looks straight down, along the vertex normal, at points of
-// the input surface around each checked vertex, and its estimate of the radiance leaving a
-// Lambertian surface, L = Le + ρE/π, with next-event estimation and MIS, gives E = π (L − Le) / ρ.
+// the input surface around each checked vertex, with a white, unlit Lambertian standing in for the
+// surface where it lands (PathSettings::first_surface). Its estimate of the radiance leaving that
+// stand-in, with next-event estimation and MIS, is E/π whatever the surface really is: a
+// metallic-roughness surface is checked as a Lambertian one, and a texel's colour does not enter.
 // Sampling the incoming radiance by cosine-distributed directions instead leaves a small light to
 // chance (7.5 % noise at 4,096 samples on the Cornell box, against 2.6 % this way). The points
 // fill a disk around the vertex, half as wide as the distance to its nearest element centroid,
@@ -39,9 +41,19 @@ void CheckSettings::validate() const {
 
 /// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings).
 constexpr float kSameSide = 0.8660254f;
-/// Least albedo (per channel) at which path-traced radiance is turned back into irradiance: a
-/// texel black in some channel carries no information about the light there.
-constexpr float kInvertibleAlbedo = 1e-4f;
+
+namespace {
+
+/// Path settings whose first surface is a white, unlit Lambertian: π times their radiance
+/// estimate is the irradiance where the path starts.
+rc::PathSettings irradiance_probe() {
+  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
+  rc::PathSettings path;
+  path.first_surface = &white;
+  return path;
+}
+
+}  // namespace
 
 CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings) {
   settings.validate();
@@ -61,15 +73,12 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
   }
   std::vector<Rgb> mean(count), standard_error(count);
   std::vector<char> usable(count, 0);
-  const rc::PathSettings path;
+  const rc::PathSettings path = irradiance_probe();
   rc::parallel_for(count, [&](size_t i) {
     const size_t v = i * nv / count;
     const Vec3 n = mesh.normals[v];
     const rc::Frame frame = rc::Frame::from_normal(n);
     const rc::Material& m = scene.materials[mesh.vertex_material[v]];
-    if (m.kind != rc::MaterialKind::diffuse) return;
-    for (int c = 0; c < 3; ++c)
-      if (!(m.albedo[c] > 0.0f)) return;
     const float r = radius[v];
     Rgb sum(0.0f), sum_squares(0.0f);
     int taken = 0;
@@ -82,11 +91,7 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
       // Only the surface on the vertex's side of a crease (vertices are split at 30°) counts.
       const rc::SurfaceInteraction si = scene.surface(ray, *hit);
       if (glm::dot(si.ng, n) < kSameSide) continue;
-      // E = π L / ρ, with ρ the (textured) albedo where the path starts, which scales all it finds.
-      rc::Material textured;
-      const Rgb rho = scene.shading_material(si, textured).albedo;
-      if (!(std::min({rho.r, rho.g, rho.b}) > kInvertibleAlbedo)) continue;
-      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / rho;
+      const Rgb e = rc::path_radiance(scene, ray, ctx, path) * rc::kPi;
       sum += e;
       sum_squares += e * e;
       ++taken;
@@ -136,8 +141,8 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
                                const CheckSettings& settings) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
-  // The faces the colours cover, weighted by area (faces whose material the check cannot invert
-  // weigh nothing).
+  // The faces the colours cover, weighted by area (mirror and glass faces, which carry no
+  // radiosity of their own, weigh nothing).
   struct Face {
     uint32_t mesh, triangle;
   };
@@ -147,8 +152,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     const rc::TriangleMesh& mesh = scene.meshes[m];
     const bool covered = mesh.origin.file == file && covered_mesh(m);
     const rc::Material& mat = scene.materials[mesh.material];
-    if (!covered || mat.kind != rc::MaterialKind::diffuse || !(std::min({mat.albedo.r, mat.albedo.g, mat.albedo.b}) > 0.0f))
-      continue;
+    if (!covered || mat.is_specular()) continue;
     for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
       const Vec3 &a = mesh.positions[mesh.indices[3 * t]], &b = mesh.positions[mesh.indices[3 * t + 1]],
                  &c = mesh.positions[mesh.indices[3 * t + 2]];
@@ -164,7 +168,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
   std::vector<Rgb> baked(count), mean(count), variance(count);
   std::vector<SurfaceCheckPoint> where(count);
   std::vector<char> usable(count, 0);
-  const rc::PathSettings path;
+  const rc::PathSettings path = irradiance_probe();
   rc::parallel_for(count, [&](size_t i) {
     rc::Rng rng = rc::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
     const Face f = faces[pick.sample(rng.uniform())];
@@ -191,10 +195,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
       const std::optional<rc::Hit> hit = scene.intersect(ray);
       // Something lies on the point, or coincides with its face (a duplicate, facing either way).
       if (!hit || hit->geom_id != f.mesh || hit->prim_id != f.triangle) return;
-      rc::Material textured;
-      const Rgb rho = scene.shading_material(scene.surface(ray, *hit), textured).albedo;
-      if (!(std::min({rho.r, rho.g, rho.b}) > kInvertibleAlbedo)) return;  // a texel black in some channel
-      const Rgb e = (rc::path_radiance(scene, ray, ctx, path) - m.emission) * rc::kPi / rho;
+      const Rgb e = rc::path_radiance(scene, ray, ctx, path) * rc::kPi;
       sum += e;
       sum_squares += e * e;
       ++taken;

@@ -36,7 +36,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     }
     const SurfaceInteraction si = scene.surface(ray, *hit);
     Material textured;
-    const Material& m = scene.shading_material(si, textured);
+    const Material& m = depth == 0 && settings.first_surface ? *settings.first_surface : scene.shading_material(si, textured);
 
     // Leaving the inside of a dielectric: attenuate by its absorption over the segment.
     if (m.kind == MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())

@@ -10,6 +10,10 @@ namespace gilt::raytrace_core {
 struct PathSettings {
   int max_depth = 1 << 20;  ///< hang guard only: Russian roulette ends paths long before (ρ^(2^20) ≈ 0)
   int rr_depth = 3;      ///< bounces before Russian roulette starts
+  /// When set, stands in for the material of the first surface hit, emission included: with a
+  /// white, unlit Lambertian stand-in the estimate is E/π, E the irradiance there, whatever the
+  /// surface really is (the radiosity checks). The rest of the path sees the real materials.
+  const Material* first_surface = nullptr;
 };
 
 /// Radiance along `ray` estimated by one path.
