@@ -119,7 +119,7 @@ void run_info(const InfoOptions& o) {
   for (const rc::TriangleMesh& m : scene.meshes) {
     vertices += m.positions.size();
     bytes += m.positions.size() * sizeof(rc::Vec3) + m.normals.size() * sizeof(rc::Vec3) +
-             m.uvs.size() * sizeof(rc::Vec2) + m.indices.size() * sizeof(uint32_t);
+             m.uvs.size() * sizeof(rc::Vec2) + m.tangents.size() * sizeof(glm::vec4) + m.indices.size() * sizeof(uint32_t);
   }
   const size_t bvh = scene.triangle_count() * 96 + scene.spheres.size() * 96;
   bytes += bvh + scene.spheres.size() * sizeof(rc::Sphere);
@@ -151,6 +151,13 @@ void run_info(const InfoOptions& o) {
       else
         p.runs.push_back("albedo textures: read at every hit (MIP-mapped, bilinear)");
     }
+  const size_t normal_mapped = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
+                                                    [](const rc::Material& m) { return m.normal_texture.valid(); }));
+  if (normal_mapped > 0)
+    for (MethodPlan& p : plans)
+      p.runs.push_back(p.method == "radiosity"
+                           ? "normal and height maps: the view shades with them; elements keep their flat normals"
+                           : "normal and height maps: tilt the shading normal at every hit");
 
   if (o.json) {
     nlohmann::json j = {{"command", "info"},
@@ -164,6 +171,7 @@ void run_info(const InfoOptions& o) {
                         {"emissive_materials", emissive},
                         {"bounds", {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}}},
                         {"textures", {{"images", scene.textures.size()}, {"textured_materials", textured},
+                                      {"normal_mapped_materials", normal_mapped},
                                       {"texels", texels}, {"memory_estimate_bytes", texture_bytes}}},
                         {"memory_estimate_bytes", bytes}};
     for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};

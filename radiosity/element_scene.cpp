@@ -10,7 +10,7 @@ rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh) {
   out.materials = scene.materials;
   // Its rays ask only whether something is in the way; textures are read in the input scene.
   for (rc::Material& m : out.materials) {
-    m.albedo_texture = m.alpha_texture = m.metallic_roughness_texture = m.emission_texture = rc::TextureRef{};
+    for (rc::TextureRef* t : m.texture_refs()) *t = rc::TextureRef{};
     m.alpha_mode = rc::AlphaMode::opaque;
   }
   rc::TriangleMesh elements;

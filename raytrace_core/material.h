@@ -2,6 +2,7 @@
 // Surface materials: a closed set, so an enum and a switch rather than virtual classes.
 
 #include <cstdint>
+#include <array>
 #include <string>
 
 #include "raytrace_core/rgb.h"
@@ -55,6 +56,12 @@ struct Material {
   /// Emission is multiplied by this texture's linear RGB where it is set (glTF's emissiveTexture,
   /// MTL's map_Ke).
   TextureRef emission_texture;
+  /// Shading normals read from an image (normal_map.h): a tangent-space normal map, its x and y
+  /// scaled by `normal_scale` (glTF's normalTexture and its scale, MTL's `norm`), or a height map
+  /// whose heights, in texel widths, are multiplied by `normal_scale` (MTL's `bump` and its -bm).
+  TextureRef normal_texture;
+  bool normal_is_height = false;
+  float normal_scale = 1.0f;
 
   /// Coverage: `alpha` times the alpha texture where set (its alpha channel, or its first
   /// channel when it has none), read by `alpha_mode`.
@@ -66,9 +73,18 @@ struct Material {
   /// map_d); else (glTF's base colour) such a texture is fully opaque.
   bool alpha_in_colour = false;
 
+  /// Every image reference the material holds, for code that walks them all.
+  std::array<TextureRef*, 5> texture_refs() {
+    return {&albedo_texture, &metallic_roughness_texture, &emission_texture, &normal_texture, &alpha_texture};
+  }
+  std::array<const TextureRef*, 5> texture_refs() const {
+    return {&albedo_texture, &metallic_roughness_texture, &emission_texture, &normal_texture, &alpha_texture};
+  }
+
   /// True when some parameter varies over the surface and must be looked up at each point.
   bool is_textured() const {
-    return albedo_texture.valid() || metallic_roughness_texture.valid() || emission_texture.valid();
+    return albedo_texture.valid() || metallic_roughness_texture.valid() || emission_texture.valid() ||
+           normal_texture.valid();
   }
   /// True when rays may pass through parts of the surface.
   bool has_coverage() const { return alpha_mode != AlphaMode::opaque && (alpha < 1.0f || alpha_texture.valid()); }

@@ -7,6 +7,8 @@
 
 #include "raytrace_core/scene.h"
 
+#include "raytrace_core/normal_map.h"
+
 #include <embree3/rtcore.h>
 
 #include <cmath>
@@ -16,6 +18,7 @@
 
 #include "raytrace_core/closest_point.h"
 #include "raytrace_core/error.h"
+#include "raytrace_core/normal_map.h"
 
 namespace gilt::raytrace_core {
 namespace {
@@ -211,7 +214,8 @@ void Scene::commit() {
     if (!m.transmission_tint.is_finite() || m.transmission_tint.min_component() < 0.0f ||
         m.transmission_tint.max_component() > 1.0f)
       throw InputError(id + ": transmission tint must lie in [0, 1]");
-    for (const TextureRef* t : {&m.albedo_texture, &m.alpha_texture, &m.metallic_roughness_texture, &m.emission_texture}) {
+    if (!std::isfinite(m.normal_scale)) throw InputError(id + ": normal map scale must be finite");
+    for (const TextureRef* t : m.texture_refs()) {
       if (t->image >= int32_t(textures.size()) || t->image < -1)
         throw InputError(id + ": refers to texture " + std::to_string(t->image) + " but there are " +
                          std::to_string(textures.size()));
@@ -266,6 +270,10 @@ void Scene::commit() {
       kept.insert(kept.end(), {i0, i1, i2});
     }
     mesh.indices = std::move(kept);
+    // Normal maps need a tangent frame at every vertex.
+    const Material& m = materials[mesh.material];
+    mesh.tangents.clear();
+    if (m.normal_texture.valid() && !mesh.uvs.empty()) mesh.tangents = generate_tangents(mesh, m.normal_texture);
   }
   if (dropped > 0) warnings.push_back(where + ": " + std::to_string(dropped) + " degenerate triangle(s) dropped");
 
@@ -489,6 +497,21 @@ SurfaceInteraction Scene::triangle_point(uint32_t geom_id, uint32_t prim_id, Vec
   if (!mesh.uvs.empty()) si.uv = b0 * mesh.uvs[i0] + b.x * mesh.uvs[i1] + b.y * mesh.uvs[i2];
   else si.uv = b;
   si.material = mesh.material;
+  if (!mesh.tangents.empty() && texture_set_) {
+    // The normal before it was turned to ng's side: the tangents were made against it.
+    Vec3 n = si.ns;
+    bool flipped = false;
+    if (!mesh.normals.empty()) {
+      const Vec3 raw = b0 * mesh.normals[i0] + b.x * mesh.normals[i1] + b.y * mesh.normals[i2];
+      flipped = glm::dot(raw, si.ng) < 0.0f;
+      if (flipped) n = -n;
+    }
+    const glm::vec4 tangent = b0 * mesh.tangents[i0] + b.x * mesh.tangents[i1] + b.y * mesh.tangents[i2];
+    Vec3 mapped = tangent_to_world(n, glm::vec4(Vec3(tangent), mesh.tangents[i0].w), mapped_normal(materials[mesh.material], si.uv));
+    if (flipped) mapped = -mapped;
+    // A tilt past the geometric surface would shade the surface from behind: keep the smooth normal.
+    if (glm::dot(mapped, si.ng) > 1e-3f) si.ns = mapped;
+  }
   if (first_light_of_mesh_[geom_id] >= 0) si.light = first_light_of_mesh_[geom_id] + static_cast<int32_t>(prim_id);
   return si;
 }
@@ -546,7 +569,7 @@ const Material& Scene::shading_material(const SurfaceInteraction& si, Material& 
   scratch.transmission_tint = m.transmission_tint;
   scratch.thin_walled = m.thin_walled;
   scratch.two_sided_emission = m.two_sided_emission;
-  scratch.albedo_texture = scratch.metallic_roughness_texture = scratch.emission_texture = TextureRef{};
+  for (TextureRef* t : scratch.texture_refs()) *t = TextureRef{};
   const auto read = [&](const TextureRef& t) {
     return texture_set_->lookup(t.image, t.st(si.uv), t.st_delta(duv_dx), t.st_delta(duv_dy));
   };
@@ -560,6 +583,18 @@ const Material& Scene::shading_material(const SurfaceInteraction& si, Material& 
   }
   scratch.emission = emission_at(m, si.uv);
   return scratch;
+}
+
+Vec3 Scene::mapped_normal(const Material& m, Vec2 uv) const {
+  const TextureRef& t = m.normal_texture;
+  const Vec2 st = t.st(uv);
+  if (!m.normal_is_height) return decode_normal_texel(texture_set_->lookup(t.image, st).rgb, m.normal_scale);
+  // Central differences one texel apart; grey heights are read from the first channel.
+  const Vec2 texel = texture_set_->texel_size(t.image);
+  const auto height = [&](float ds, float dt) { return texture_set_->lookup(t.image, st + Vec2(ds, dt)).rgb.r; };
+  const float dh_ds = 0.5f * (height(texel.x, 0.0f) - height(-texel.x, 0.0f));
+  const float dh_dup = 0.5f * (height(0.0f, -texel.y) - height(0.0f, texel.y));
+  return height_normal(dh_ds, dh_dup, m.normal_scale);
 }
 
 Rgb Scene::emission_at(const Material& m, Vec2 uv) const {

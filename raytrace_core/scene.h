@@ -40,6 +40,9 @@ struct TriangleMesh {
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;     ///< per-vertex shading normals, empty or one per position
   std::vector<Vec2> uvs;         ///< per-vertex texture coordinates, empty or one per position
+  /// Per-vertex tangent (xyz) and handedness (w = ±1) of the material's normal map, made by
+  /// commit() when the material has one (normal_map.h); empty otherwise.
+  std::vector<glm::vec4> tangents;
   std::vector<uint32_t> indices; ///< three per triangle, counter-clockwise seen from the front
   uint32_t material = 0;
 
@@ -151,6 +154,9 @@ class Scene {
   Rgb mean_albedo(const Material& m, Vec2 uv0, Vec2 uv1, Vec2 uv2) const;
   /// Emitted radiance factor of a material at texture coordinates uv (emission × emission texture).
   Rgb emission_at(const Material& m, Vec2 uv) const;
+  /// Tangent-space normal that material m's normal or height map gives at `uv` (m must have one,
+  /// and the scene textures).
+  Vec3 mapped_normal(const Material& m, Vec2 uv) const;
   /// Mean emitted radiance factor over one primitive: what its light's power is built from.
   Rgb mean_emission(uint32_t geom_id, uint32_t prim_id) const;
   /// The scene's opened textures (null when it has none).

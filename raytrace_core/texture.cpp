@@ -112,6 +112,7 @@ struct TextureSet::Impl {
   OIIO::TextureSystem* system = nullptr;
   std::vector<OIIO::TextureSystem::TextureHandle*> handles;
   std::vector<int> channels;
+  std::vector<Vec2> texel_size;
   std::vector<OIIO::TextureOpt> options;
   ~Impl() {
     if (system) OIIO::TextureSystem::destroy(system);
@@ -137,6 +138,7 @@ TextureSet::TextureSet(const std::vector<TextureImage>& images) : impl_(std::mak
     }
     impl_->handles.push_back(handle);
     impl_->channels.push_back(channels);
+    impl_->texel_size.push_back(Vec2(1.0f / float(std::max(resolution[0], 1)), 1.0f / float(std::max(resolution[1], 1))));
     OIIO::TextureOpt opt;
     opt.swrap = oiio_wrap(image.wrap_s);
     opt.twrap = oiio_wrap(image.wrap_t);
@@ -152,6 +154,8 @@ TextureSet::TextureSet(const std::vector<TextureImage>& images) : impl_(std::mak
 TextureSet::~TextureSet() = default;
 
 int TextureSet::channels(int32_t image) const { return impl_->channels[size_t(image)]; }
+
+Vec2 TextureSet::texel_size(int32_t image) const { return impl_->texel_size[size_t(image)]; }
 
 Texel TextureSet::lookup(int32_t image, Vec2 st, Vec2 dx, Vec2 dy) const {
   OIIO::TextureSystem& ts = *impl_->system;

@@ -78,6 +78,8 @@ class TextureSet {
   size_t size() const { return images_.size(); }
   /// Channels of one image (1 grey, 2 grey and alpha, 3 RGB, 4 RGBA).
   int channels(int32_t image) const;
+  /// One texel's width and height in (s, t) at the finest level: 1 / resolution.
+  Vec2 texel_size(int32_t image) const;
 
  private:
   struct Impl;

@@ -1,7 +1,8 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf: the node hierarchy of the default scene with its
 // transforms, triangle primitives, materials with their textures, the first perspective camera
-// and KHR_lights_punctual lights. Normal and occlusion textures, extensions' textures, skins,
-// morph targets and animations are ignored (with a warning naming them).
+// and KHR_lights_punctual lights. Occlusion textures, extensions' textures, skins, morph targets
+// and animations are ignored (with a warning naming them). Normal textures are read; TANGENT
+// attributes are not: tangents are generated (normal_map.h).
 //
 // Material mapping (documented in docs/scene-format.md); base = baseColorFactor.rgb,
 // m = metallicFactor, r = roughnessFactor:
@@ -243,6 +244,15 @@ class GltfLoader {
                    "metallic-roughness of mirror and glass materials");
       if (gm.emissiveTexture.index >= 0 && m.is_emissive())
         m.emission_texture = read(gm.emissiveTexture, "emissiveTexture", true);
+      if (gm.normalTexture.index >= 0) {
+        tinygltf::TextureInfo info;
+        info.index = gm.normalTexture.index;
+        info.texCoord = gm.normalTexture.texCoord;
+        info.extensions = gm.normalTexture.extensions;
+        m.normal_texture = read(info, "normalTexture", false);
+        m.normal_scale = float(gm.normalTexture.scale);
+        if (!std::isfinite(m.normal_scale)) fail(where + ".normalTexture.scale: must be a finite number");
+      }
       uv_set_of_material_.push_back(std::max(uv_set, 0));
       // alphaMode: coverage is baseColorFactor's alpha times the base colour texture's.
       if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
@@ -266,7 +276,6 @@ class GltfLoader {
           ignored_extensions.push_back(name);
       }
       scene_.materials.push_back(std::move(m));
-      note_ignored(gm.normalTexture.index >= 0, "normal");
       note_ignored(gm.occlusionTexture.index >= 0, "occlusion");
       // Extensions' textures, e.g. KHR_materials_transmission's transmissionTexture.
       for (const auto& [name, value] : gm.extensions)

@@ -227,8 +227,8 @@ class JsonSceneReader {
       const auto texture_offset = int32_t(scene_.textures.size());
       for (TextureImage& t : part.textures) scene_.textures.push_back(std::move(t));
       for (Material& m : part.materials) {
-        if (m.albedo_texture.valid()) m.albedo_texture.image += texture_offset;
-        if (m.alpha_texture.valid()) m.alpha_texture.image += texture_offset;
+        for (TextureRef* t : m.texture_refs())
+          if (t->valid()) t->image += texture_offset;
         scene_.materials.push_back(std::move(m));
       }
     }

@@ -383,8 +383,6 @@ void unused_maps(const tinyobj::material_t& mtl, std::vector<std::string>& kinds
   const std::pair<const std::string*, const char*> maps[] = {
       {&mtl.specular_texname, "specular maps (map_Ks)"},
       {&mtl.specular_highlight_texname, "exponent maps (map_Ns)"},
-      {&mtl.bump_texname, "bump maps"},
-      {&mtl.normal_texname, "normal maps (norm)"},
       {&mtl.displacement_texname, "displacement maps (disp)"},
       {&mtl.reflection_texname, "reflection maps (refl)"},
       {&mtl.roughness_texname, "roughness maps (map_Pr)"},
@@ -562,6 +560,18 @@ void load_obj(const fs::path& path, Scene& scene) {
                                mtl.emissive_texname + " would not show; ignored");
     } else if (!mtl.emissive_texname.empty()) {
       m.emission_texture = read_map(mtl.emissive_texname, mtl.emissive_texopt, true, "map_Ke", "emission untextured");
+    }
+    // norm: a tangent-space normal map; bump (map_Bump): a height map, its heights times -bm.
+    // Both are data, read linear.
+    if (!mtl.normal_texname.empty()) {
+      m.normal_texture = read_map(mtl.normal_texname, mtl.normal_texopt, false, "norm", "normals left smooth");
+      const char* kind = "bump maps beside a normal map (norm)";
+      if (!mtl.bump_texname.empty() && std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end())
+        ignored_maps.push_back(kind);
+    } else if (!mtl.bump_texname.empty()) {
+      m.normal_texture = read_map(mtl.bump_texname, mtl.bump_texopt, false, "bump", "normals left smooth");
+      m.normal_is_height = true;
+      m.normal_scale = float(mtl.bump_texopt.bump_multiplier);
     }
     scene.materials.push_back(std::move(m));
   }

@@ -518,7 +518,7 @@ TEST_F(GltfTextures, OtherTexturesWarnedInOneLine) {
   quad.materials = R"([
     {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 0},
      "emissiveTexture": {"index": 0}, "emissiveFactor": [1, 1, 1], "occlusionTexture": {"index": 0}},
-    {"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}}, "normalTexture": {"index": 0}},
+    {"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}}, "normalTexture": {"index": 0, "scale": 0.5}},
     {"name": "chrome", "pbrMetallicRoughness": {"metallicFactor": 1, "roughnessFactor": 0,
                                                 "baseColorTexture": {"index": 0}}}])";
   const Scene scene = load_scene_file(write("others.gltf", quad.gltf()));
@@ -529,15 +529,48 @@ TEST_F(GltfTextures, OtherTexturesWarnedInOneLine) {
   // A mirror's base colour tints its reflection, which an albedo texture cannot: left out.
   EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
   EXPECT_FALSE(scene.materials[2].is_textured());
-  // One image, read as colour (base, emission) and as data (metallic-roughness).
+  // Normal textures are read (as data), with their scale.
+  for (size_t i : {0, 1}) {
+    ASSERT_TRUE(scene.materials[i].normal_texture.valid());
+    EXPECT_FALSE(scene.materials[i].normal_is_height);
+    EXPECT_FALSE(scene.textures[size_t(scene.materials[i].normal_texture.image)].srgb);
+  }
+  EXPECT_EQ(scene.materials[0].normal_scale, 1.0f);
+  EXPECT_EQ(scene.materials[1].normal_scale, 0.5f);
+  // One image, read as colour (base, emission) and as data (metallic-roughness, normal).
   EXPECT_EQ(scene.textures.size(), 2u);
   ASSERT_EQ(count_warnings(scene, "ignored"), 1) << "one line per file";
-  for (const char* kind : {"normal", "occlusion", "mirror"}) EXPECT_TRUE(has_warning(scene, kind)) << kind;
-  for (const char* kind : {"emissive", "metallic-roughness"}) EXPECT_FALSE(has_warning(scene, kind)) << kind;
+  for (const char* kind : {"occlusion", "mirror"}) EXPECT_TRUE(has_warning(scene, kind)) << kind;
+  for (const char* kind : {"normal", "emissive", "metallic-roughness"}) EXPECT_FALSE(has_warning(scene, kind)) << kind;
 
   // Nothing is said when the base colour is all there is.
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])";
   EXPECT_FALSE(has_warning(load_scene_file(write("base_only.gltf", quad.gltf())), "ignored"));
+}
+
+TEST_F(GltfTextures, NormalTextureTiltsTheShadingNormalUpTheImage) {
+  // One texel holding the tangent-space normal (0, sin 30°, cos 30°): tilted up the image. The
+  // quad's UVs are (x, y) and glTF's t runs down the image, so up the image is −y in the world:
+  // the shading normal is the texel's normal (decoded from its own 8-bit codes, read as data,
+  // exactly code/255) with its y negated. A scale of 0.5 halves x and y before normalising.
+  {
+    std::ofstream out(dir_ / "tilt.ppm", std::ios::binary);
+    out << "P6\n1 1\n255\n";
+    out.put(char(128)).put(char(191)).put(char(238));
+  }
+  QuadModel quad;
+  quad.images = R"([{"uri": "tilt.ppm"}])";
+  for (const float scale : {1.0f, 0.5f}) {
+    quad.materials = R"([{"pbrMetallicRoughness": {"metallicFactor": 0}, "normalTexture": {"index": 0, "scale": )" +
+                     std::to_string(scale) + "}}]";
+    const Scene scene = load_scene(write("tilt.gltf", quad.gltf()));
+    const SurfaceInteraction si = left_point(scene);
+    const Vec3 expected = glm::normalize(Vec3(scale * (2 * 128 / 255.0f - 1), -scale * (2 * 191 / 255.0f - 1),
+                                              2 * 238 / 255.0f - 1));
+    EXPECT_NEAR(si.ns.x, expected.x, 1e-5f) << scale;
+    EXPECT_NEAR(si.ns.y, expected.y, 1e-5f) << scale;
+    EXPECT_NEAR(si.ns.z, expected.z, 1e-5f) << scale;
+  }
 }
 
 TEST_F(GltfTextures, AlphaModeMaskAndBlendComeFromTheBaseColour) {

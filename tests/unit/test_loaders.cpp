@@ -307,15 +307,21 @@ TEST_F(Loaders, ObjMaterialsSharingATextureShareOneImage) {
                                 "mtllib shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                                 "usemtl wall\nf 1/1 2/2 3/3\nusemtl pillar\nf 1/1 3/3 2/2\n");
   const Scene scene = load_scene_file(obj);
-  ASSERT_EQ(scene.textures.size(), 1u);
-  EXPECT_EQ(scene.materials[mesh_named(scene, "shared:wall").material].albedo_texture.image, 0);
-  EXPECT_EQ(scene.materials[mesh_named(scene, "shared:pillar").material].albedo_texture.image, 0);
-  EXPECT_EQ(scene.materials[mesh_named(scene, "shared:pillar").material].albedo, Rgb(0.6f));
+  // Two images: the stone (colour) and its bump map (data), each shared by both materials.
+  ASSERT_EQ(scene.textures.size(), 2u);
+  const Material& wall = scene.materials[mesh_named(scene, "shared:wall").material];
+  const Material& pillar = scene.materials[mesh_named(scene, "shared:pillar").material];
+  EXPECT_EQ(wall.albedo_texture.image, 0);
+  EXPECT_EQ(pillar.albedo_texture.image, 0);
+  EXPECT_EQ(wall.normal_texture.image, 1);
+  EXPECT_EQ(pillar.normal_texture.image, 1);
+  EXPECT_TRUE(pillar.normal_is_height);
+  EXPECT_EQ(pillar.albedo, Rgb(0.6f));
   int ignored = 0;
   for (const std::string& w : scene.warnings)
     if (w.find("are ignored") != std::string::npos) {
       ++ignored;
-      EXPECT_CONTAINS(w, "bump maps");
+      EXPECT_EQ(w.find("bump"), std::string::npos) << w;
       EXPECT_CONTAINS(w, "specular maps (map_Ks)");
       EXPECT_EQ(w.find("map_Kd"), std::string::npos) << w;
     }

@@ -21,6 +21,7 @@
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/light.h"
+#include "raytrace_core/normal_map.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/scene.h"
 #include "raytrace_core/texture.h"
@@ -279,6 +280,31 @@ TEST_F(Textures, ObjPbrFieldsAndMapKe) {
                           [](const std::string& w) { return w.find("Ke is black") != std::string::npos; }));
 }
 
+TEST_F(Textures, JsonSceneKeepsEachFilesImages) {
+  // Two OBJ files in one JSON scene, the second's material reading its own emission, normal and
+  // albedo images: every one of its references moves past the first file's images.
+  for (const char* name : {"red.pgm", "glow.pgm", "bumps.pgm"}) {
+    std::ofstream out(dir_ / name, std::ios::binary);
+    out << "P5\n1 1\n255\n";
+    out.put(char(200));
+  }
+  const char* quad_obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n";
+  std::ofstream(dir_ / "a.mtl") << "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd red.pgm\n";
+  std::ofstream(dir_ / "a.obj") << "mtllib a.mtl\n" << quad_obj << "usemtl a\nf 1/1 2/2 3/3\n";
+  std::ofstream(dir_ / "b.mtl") << "newmtl b\nKd 0.5 0.5 0.5\nKe 1 1 1\nmap_Ke glow.pgm\nbump bumps.pgm\nmap_Kd red.pgm\n";
+  std::ofstream(dir_ / "b.obj") << "mtllib b.mtl\n" << quad_obj << "usemtl b\nf 1/1 2/2 3/3\n";
+  std::ofstream(dir_ / "ab.json") << R"({"meshes": [{"file": "a.obj"}, {"file": "b.obj"}]})";
+  const rc::Scene scene = rc::load_scene((dir_ / "ab.json").string());
+  ASSERT_EQ(scene.materials.size(), 2u);
+  const auto file_of = [&](const rc::TextureRef& t) {
+    return t.valid() ? fs::path(scene.textures[size_t(t.image)].file).filename().string() : std::string("none");
+  };
+  EXPECT_EQ(file_of(scene.materials[0].albedo_texture), "red.pgm");
+  EXPECT_EQ(file_of(scene.materials[1].albedo_texture), "red.pgm");
+  EXPECT_EQ(file_of(scene.materials[1].emission_texture), "glow.pgm");
+  EXPECT_EQ(file_of(scene.materials[1].normal_texture), "bumps.pgm");
+}
+
 TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
   // Constant alpha 0.3, BLEND: each ray stops with probability 0.3, fixed by the ray itself. Over
   // n = 20,000 rays the fraction's standard deviation is √(0.3 · 0.7 / n) = 0.0032; 4 of them.
@@ -382,6 +408,91 @@ TEST_F(Textures, ElementsReflectTheTexturesMeanOverThem) {
   EXPECT_NEAR(mean.r, 0.45f, 0.02f * 0.45f);
   EXPECT_NEAR(mean.b, 0.45f, 0.02f * 0.45f);
   EXPECT_NEAR(mean.g, 0.0f, kHalfTolerance);
+}
+
+TEST(NormalMaps, TangentsFollowTheImageAxes) {
+  // A quad facing +z whose image has its top at y = 1: the tangent runs along +s and the
+  // bitangent w·(n × t) up the image, +y. Mirrored (s = 1 − x), the tangent turns to −x and w to
+  // −1, so the bitangent still runs up the image. Exact up to rounding.
+  rc::TriangleMesh m = quad(0);
+  m.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+  const rc::TextureRef identity;
+  for (const bool mirrored : {false, true}) {
+    if (mirrored)
+      for (rc::Vec2& uv : m.uvs) uv.x = 1.0f - uv.x;
+    const std::vector<glm::vec4> t = rc::generate_tangents(m, identity);
+    ASSERT_EQ(t.size(), 4u);
+    for (const glm::vec4& v : t) {
+      EXPECT_NEAR(v.x, mirrored ? -1.0f : 1.0f, 1e-6f);
+      EXPECT_NEAR(v.y, 0.0f, 1e-6f);
+      EXPECT_NEAR(v.z, 0.0f, 1e-6f);
+      EXPECT_EQ(v.w, mirrored ? -1.0f : 1.0f);
+      const rc::Vec3 up = rc::tangent_to_world(rc::Vec3(0, 0, 1), v, rc::Vec3(0, 1, 0));
+      EXPECT_NEAR(up.y, 1.0f, 1e-6f) << "mirrored " << mirrored;
+    }
+  }
+  // A face without a usable (s, t) frame still gets a unit tangent orthogonal to the normal.
+  rc::TriangleMesh flat = quad(0);
+  flat.uvs.assign(4, rc::Vec2(0.5f));
+  for (const glm::vec4& v : rc::generate_tangents(flat, identity)) {
+    EXPECT_NEAR(glm::length(rc::Vec3(v)), 1.0f, 1e-6f);
+    EXPECT_NEAR(v.z, 0.0f, 1e-6f);
+  }
+}
+
+TEST_F(Textures, ObjNormalMapTiltsTheShadingNormal) {
+  // One texel holding the tangent-space normal (sin 30°, 0, cos 30°) as 8-bit codes, read as data
+  // (exactly code/255): the shading normal on an OBJ quad (v up the image, so +s is +x and the
+  // image's up is +y) is that normal, decoded from the same codes, in world axes.
+  {
+    std::ofstream out(dir_ / "tilt.ppm", std::ios::binary);
+    out << "P6\n1 1\n255\n";
+    out.put(char(191)).put(char(128)).put(char(238));
+  }
+  std::ofstream(dir_ / "n.mtl") << "newmtl stone\nKd 0.5 0.5 0.5\nnorm tilt.ppm\n";
+  std::ofstream(dir_ / "n.obj") << "mtllib n.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl stone\nf 1/1 2/2 3/3 4/4\n";
+  rc::Scene scene = rc::load_scene((dir_ / "n.obj").string());
+  ASSERT_TRUE(scene.materials[0].normal_texture.valid());
+  EXPECT_FALSE(scene.materials[0].normal_is_height);
+  EXPECT_FALSE(scene.textures[0].srgb);
+  const rc::Vec3 expected = glm::normalize(rc::Vec3(2 * 191 / 255.0f - 1, 2 * 128 / 255.0f - 1, 2 * 238 / 255.0f - 1));
+  const rc::Ray ray{{0.3f, 0.6f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+  const std::optional<rc::Hit> hit = scene.intersect(ray);
+  ASSERT_TRUE(hit.has_value());
+  const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+  EXPECT_NEAR(si.ns.x, expected.x, 1e-5f);
+  EXPECT_NEAR(si.ns.y, expected.y, 1e-5f);
+  EXPECT_NEAR(si.ns.z, expected.z, 1e-5f);
+  EXPECT_EQ(si.ng, rc::Vec3(0, 0, 1));
+}
+
+TEST_F(Textures, ObjBumpMapSlopesByItsHeights) {
+  // An 8 × 1 height ramp rising 16 codes per texel along +s, with -bm 4: between texel centres
+  // away from the wrap, bilinear reads are exact and the central difference is 16/255 per texel,
+  // so the tangent-space normal is (−4 · 16/255, 0, 1), normalised.
+  {
+    std::ofstream out(dir_ / "ramp.pgm", std::ios::binary);
+    out << "P5\n8 1\n255\n";
+    for (int i = 0; i < 8; ++i) out.put(char(16 * i));
+  }
+  std::ofstream(dir_ / "b.mtl") << "newmtl stone\nKd 0.5 0.5 0.5\nbump -bm 4 ramp.pgm\n";
+  std::ofstream(dir_ / "b.obj") << "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl stone\nf 1/1 2/2 3/3 4/4\n";
+  rc::Scene scene = rc::load_scene((dir_ / "b.obj").string());
+  ASSERT_TRUE(scene.materials[0].normal_texture.valid());
+  EXPECT_TRUE(scene.materials[0].normal_is_height);
+  EXPECT_FLOAT_EQ(scene.materials[0].normal_scale, 4.0f);
+  const rc::Vec3 expected = glm::normalize(rc::Vec3(-4.0f * 16.0f / 255.0f, 0.0f, 1.0f));
+  for (const float x : {3.5f / 8.0f, 4.0f / 8.0f}) {
+    const rc::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    ASSERT_TRUE(hit.has_value());
+    const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+    EXPECT_NEAR(si.ns.x, expected.x, 1e-5f) << x;
+    EXPECT_NEAR(si.ns.y, expected.y, 1e-5f) << x;
+    EXPECT_NEAR(si.ns.z, expected.z, 1e-5f) << x;
+  }
 }
 
 }  // namespace
