@@ -41,6 +41,10 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float aspect) const {
   return {origin, glm::normalize(target - origin), kInfinity};
 }
 
+float Camera::pixel_spread(int height) const {
+  return 2.0f * std::tan(0.5f * vfov_degrees * kPi / 180.0f) / float(std::max(height, 1));
+}
+
 Camera default_camera(const Bounds3& bounds) {
   Camera c;
   if (bounds.empty()) return c;

@@ -19,6 +19,8 @@ struct Camera {
   /// Primary ray through film position `film` ∈ [0,1]² (x right, y down) for an image of the
   /// given aspect ratio (width / height); `lens` ∈ [0,1)² picks the point on the lens.
   Ray generate_ray(Vec2 film, Vec2 lens, float aspect) const;
+  /// Angle one pixel of an image `height` pixels high subtends at the image centre (Ray::spread).
+  float pixel_spread(int height) const;
 
   /// Throws InputError when the camera cannot form an image (coincident points, up parallel to
   /// the view direction, field of view outside (0, 180), negative aperture).

@@ -17,6 +17,10 @@ struct Ray {
   Vec3 origin{0.0f};
   Vec3 direction{0.0f, 0.0f, 1.0f};
   float tmax = kInfinity;
+  /// Angle by which a cone around the ray widens per unit distance: a camera ray carries its
+  /// pixel's, so that a hit knows the pixel's footprint there (ray cones, Akenine-Möller et al.
+  /// 2019, "Texture Level of Detail Strategies for Real-Time Ray Tracing"). 0 for other rays.
+  float spread = 0.0f;
 };
 
 /// A point on a surface with the bound on its rounding error and its geometric normal.

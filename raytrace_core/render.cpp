@@ -39,6 +39,7 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
   Film film(settings.width, settings.height);
   const std::vector<Tile> tiles = make_tiles(settings.width, settings.height, settings.tile_size);
   const float aspect = float(settings.width) / float(settings.height);
+  const float spread = camera.pixel_spread(settings.height);
   const uint64_t pixels = uint64_t(settings.width) * settings.height;
   std::atomic<uint64_t> rays{0}, non_finite{0};
 
@@ -59,7 +60,9 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
             const Vec2 offset = settings.filter.sample(ctx.rng.uniform2());
             const Vec2 film_pos((x + 0.5f + offset.x) / settings.width, (y + 0.5f + offset.y) / settings.height);
             const Vec2 lens = ctx.rng.uniform2();
-            const Rgb value = radiance(camera.generate_ray(film_pos, lens, aspect), ctx);
+            Ray ray = camera.generate_ray(film_pos, lens, aspect);
+            ray.spread = spread;
+            const Rgb value = radiance(ray, ctx);
             tile_rays += ctx.rays;
             if (value.is_finite()) film.add_sample(x, y, value);
             else ++tile_bad;

@@ -538,9 +538,47 @@ SurfaceInteraction Scene::surface(const Ray& ray, const Hit& hit) const {
     si = sphere_point(hit.prim_id, Vec3(p - DVec3(spheres[hit.prim_id].center)));
   } else {
     si = triangle_point(hit.geom_id, hit.prim_id, Vec2(hit.u, hit.v));
+    if (ray.spread > 0.0f) pixel_footprint(ray, hit, si);
   }
   si.front_face = glm::dot(ray.direction, si.ng) < 0.0f;
   return si;
+}
+
+void Scene::pixel_footprint(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const {
+  const TriangleMesh& mesh = meshes[hit.geom_id];
+  if (mesh.uvs.empty()) return;
+  const uint32_t* c = &mesh.indices[3 * size_t(hit.prim_id)];
+  // The cone's circle, `width` across, laid on the triangle's plane: an ellipse whose short axis
+  // is `width` long, across the ray, and whose long axis, along the ray's trace on the plane, is
+  // width / |cos θ| (θ bounded off grazing, where the footprint would cover the whole plane).
+  const float length = glm::length(ray.direction);
+  const Vec3 d = ray.direction / length;
+  const float width = ray.spread * hit.t * length;
+  const float cos_theta = std::max(std::fabs(glm::dot(d, si.ng)), 0.05f);
+  const Vec3 across = glm::cross(si.ng, d);
+  const float across_length = glm::length(across);
+  if (!(width > 0.0f) || !std::isfinite(width) || !(across_length > 1e-6f)) {
+    // Head-on: a circle; any two perpendicular axes in the plane.
+    const Frame f = Frame::from_normal(si.ng);
+    si.duv_dx = uv_offset(mesh, c, f.to_world(Vec3(width, 0.0f, 0.0f)));
+    si.duv_dy = uv_offset(mesh, c, f.to_world(Vec3(0.0f, width, 0.0f)));
+  } else {
+    const Vec3 a = across / across_length, along = glm::cross(a, si.ng);
+    si.duv_dx = uv_offset(mesh, c, width * a);
+    si.duv_dy = uv_offset(mesh, c, (width / cos_theta) * along);
+  }
+  if (!std::isfinite(si.duv_dx.x + si.duv_dx.y + si.duv_dy.x + si.duv_dy.y)) si.duv_dx = si.duv_dy = Vec2(0.0f);
+}
+
+Vec2 Scene::uv_offset(const TriangleMesh& mesh, const uint32_t* c, const Vec3& v) {
+  // v = b1 e1 + b2 e2 in the triangle's plane, solved through the Gram matrix of e1, e2.
+  const Vec3 e1 = mesh.positions[c[1]] - mesh.positions[c[0]], e2 = mesh.positions[c[2]] - mesh.positions[c[0]];
+  const float g11 = glm::dot(e1, e1), g12 = glm::dot(e1, e2), g22 = glm::dot(e2, e2);
+  const float det = g11 * g22 - g12 * g12;
+  if (!(det > 0.0f)) return Vec2(0.0f);
+  const float r1 = glm::dot(v, e1), r2 = glm::dot(v, e2);
+  const float b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
+  return b1 * (mesh.uvs[c[1]] - mesh.uvs[c[0]]) + b2 * (mesh.uvs[c[2]] - mesh.uvs[c[0]]);
 }
 
 float Scene::primitive_area(uint32_t geom_id, uint32_t prim_id) const {
@@ -557,7 +595,7 @@ const Material& Scene::primitive_material(uint32_t geom_id, uint32_t prim_id) co
   return materials[meshes[geom_id].material];
 }
 
-const Material& Scene::shading_material(const SurfaceInteraction& si, Material& scratch, Vec2 duv_dx, Vec2 duv_dy) const {
+const Material& Scene::shading_material(const SurfaceInteraction& si, Material& scratch) const {
   const Material& m = materials[si.material];
   if (!m.is_textured() || !texture_set_) return m;
   // Field by field rather than `scratch = m`, so a long name is not copied at every hit.
@@ -571,7 +609,7 @@ const Material& Scene::shading_material(const SurfaceInteraction& si, Material& 
   scratch.two_sided_emission = m.two_sided_emission;
   for (TextureRef* t : scratch.texture_refs()) *t = TextureRef{};
   const auto read = [&](const TextureRef& t) {
-    return texture_set_->lookup(t.image, t.st(si.uv), t.st_delta(duv_dx), t.st_delta(duv_dy));
+    return texture_set_->lookup(t.image, t.st(si.uv), t.st_delta(si.duv_dx), t.st_delta(si.duv_dy));
   };
   scratch.albedo = m.albedo_texture.valid() ? m.albedo * read(m.albedo_texture).rgb : m.albedo;
   scratch.metallic = m.metallic;

@@ -81,6 +81,9 @@ struct Hit {
 struct SurfaceInteraction : SurfacePoint {
   Vec3 ns{0.0f, 0.0f, 1.0f};  ///< unit shading normal, on the same side as ng
   Vec2 uv{0.0f};
+  /// Change of uv across the footprint of the camera pixel whose ray made the hit (Ray::spread),
+  /// along its two axes; zero for other rays, whose lookups read the finest level.
+  Vec2 duv_dx{0.0f}, duv_dy{0.0f};
   uint32_t material = 0;
   int32_t light = -1;          ///< index into Scene::lights() when the surface emits, else −1
   bool front_face = true;      ///< the ray arrived on the ng side
@@ -146,10 +149,9 @@ class Scene {
   /// Material of one primitive.
   const Material& primitive_material(uint32_t geom_id, uint32_t prim_id) const;
   /// The material as it is at one surface point: the scene's own when it is not textured,
-  /// else `scratch` filled with its parameters looked up at si.uv (footprint: the (u, v)
-  /// derivatives duv_dx, duv_dy; zero for the finest level).
-  const Material& shading_material(const SurfaceInteraction& si, Material& scratch, Vec2 duv_dx = Vec2(0.0f),
-                                   Vec2 duv_dy = Vec2(0.0f)) const;
+  /// else `scratch` filled with its parameters looked up at si.uv, filtered over the footprint
+  /// si.duv_dx, si.duv_dy.
+  const Material& shading_material(const SurfaceInteraction& si, Material& scratch) const;
   /// Mean albedo of a material over a triangle with texture coordinates uv0, uv1, uv2.
   Rgb mean_albedo(const Material& m, Vec2 uv0, Vec2 uv1, Vec2 uv2) const;
   /// Emitted radiance factor of a material at texture coordinates uv (emission × emission texture).
@@ -170,6 +172,11 @@ class Scene {
   void* embree_scene() const;
 
  private:
+  /// Fills si.duv_dx, si.duv_dy with the footprint of `ray`'s cone (Ray::spread) at its hit on a
+  /// triangle with texture coordinates.
+  void pixel_footprint(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
+  /// The uv change along world-space offset v in the plane of the triangle with corners c.
+  static Vec2 uv_offset(const TriangleMesh& mesh, const uint32_t* c, const Vec3& v);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<Light> lights_;

@@ -305,6 +305,42 @@ TEST_F(Textures, JsonSceneKeepsEachFilesImages) {
   EXPECT_EQ(file_of(scene.materials[1].normal_texture), "bumps.pgm");
 }
 
+TEST_F(Textures, CameraRaysFilterOverTheirPixelsFootprint) {
+  // A 64 × 64 black-and-white checker (data, one texel per square) on the unit quad, seen
+  // head-on from distance 2 by a ray whose pixel spans 1/8 of the quad there (16 texels): the
+  // lookup reads MIP levels where every texel averages whole periods of the checker, which is
+  // 0.5, stored (an 8-bit image's levels are 8-bit too) as the code 128, within 1/255 of it. A
+  // ray without a cone (spread 0) reads the finest level: at a texel's centre, exactly 0 or 1.
+  // Tilted to 60°, the footprint stretches along the tilt, and the reading is the same.
+  std::vector<unsigned char> texels;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) texels.insert(texels.end(), 3, (x + y) % 2 ? (unsigned char)255 : (unsigned char)0);
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("checker", rc::Rgb(1.0f));
+  scene.textures.push_back(rc::TextureImage{ppm("checker.ppm", 64, 64, texels), false, rc::TextureWrap::repeat, rc::TextureWrap::repeat});
+  m.albedo_texture.image = 0;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(quad(0));
+  scene.commit();
+  const auto albedo = [&](const rc::Ray& ray) {
+    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    EXPECT_TRUE(hit.has_value());
+    rc::Material scratch;
+    return hit ? scene.shading_material(scene.surface(ray, *hit), scratch).albedo.r : -1.0f;
+  };
+  constexpr float kMipCode = 1.0f / 255.0f;
+  const rc::Vec3 texel_centre((20 + 0.5f) / 64.0f, (31 + 0.5f) / 64.0f, 0.0f);
+  rc::Ray ray{texel_centre + rc::Vec3(0, 0, 2), {0.0f, 0.0f, -1.0f}, 4.0f};
+  const float sharp = albedo(ray);
+  EXPECT_TRUE(std::fabs(sharp) < 1e-4f || std::fabs(sharp - 1.0f) < 1e-4f) << sharp;
+  ray.spread = 0.125f / 2.0f;
+  EXPECT_NEAR(albedo(ray), 0.5f, kMipCode);
+  const rc::Vec3 tilted = glm::normalize(rc::Vec3(0.0f, std::sin(1.047f), -std::cos(1.047f)));
+  ray = rc::Ray{texel_centre - 2.0f * tilted, tilted, 4.0f};
+  ray.spread = 0.125f / 2.0f;
+  EXPECT_NEAR(albedo(ray), 0.5f, kMipCode);
+}
+
 TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
   // Constant alpha 0.3, BLEND: each ray stops with probability 0.3, fixed by the ray itself. Over
   // n = 20,000 rays the fraction's standard deviation is √(0.3 · 0.7 / n) = 0.0032; 4 of them.
