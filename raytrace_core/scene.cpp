@@ -270,10 +270,18 @@ void Scene::commit() {
       kept.insert(kept.end(), {i0, i1, i2});
     }
     mesh.indices = std::move(kept);
-    // Normal maps need a tangent frame at every vertex.
+    // Normal maps need a tangent frame at every vertex: the file's (glTF's TANGENT), when it
+    // gives a usable one for each, else made here.
     const Material& m = materials[mesh.material];
-    mesh.tangents.clear();
-    if (m.normal_texture.valid() && !mesh.uvs.empty()) mesh.tangents = generate_tangents(mesh, m.normal_texture);
+    if (!m.normal_texture.valid() || mesh.uvs.empty()) {
+      mesh.tangents.clear();
+    } else {
+      const bool usable = mesh.tangents.size() == mesh.positions.size() &&
+                          std::all_of(mesh.tangents.begin(), mesh.tangents.end(), [](const glm::vec4& t) {
+                            return std::isfinite(t.x + t.y + t.z + t.w) && glm::dot(Vec3(t), Vec3(t)) > 0.0f;
+                          });
+      if (!usable) mesh.tangents = generate_tangents(mesh, m.normal_texture);
+    }
   }
   if (dropped > 0) warnings.push_back(where + ": " + std::to_string(dropped) + " degenerate triangle(s) dropped");
 

@@ -40,8 +40,9 @@ struct TriangleMesh {
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;     ///< per-vertex shading normals, empty or one per position
   std::vector<Vec2> uvs;         ///< per-vertex texture coordinates, empty or one per position
-  /// Per-vertex tangent (xyz) and handedness (w = ±1) of the material's normal map, made by
-  /// commit() when the material has one (normal_map.h); empty otherwise.
+  /// Per-vertex tangent (xyz) and handedness (w = ±1, the bitangent being w · n × t) of the
+  /// material's normal map: a loader's (glTF's TANGENT), else made by commit() when the material
+  /// has one (normal_map.h). commit() empties it for materials without one.
   std::vector<glm::vec4> tangents;
   std::vector<uint32_t> indices; ///< three per triangle, counter-clockwise seen from the front
   uint32_t material = 0;

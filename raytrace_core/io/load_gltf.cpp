@@ -1,8 +1,8 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf: the node hierarchy of the default scene with its
 // transforms, triangle primitives, materials with their textures, the first perspective camera
 // and KHR_lights_punctual lights. Occlusion textures, extensions' textures, skins, morph targets
-// and animations are ignored (with a warning naming them). Normal textures are read; TANGENT
-// attributes are not: tangents are generated (normal_map.h).
+// and animations are ignored (with a warning naming them). Normal textures are read, with the
+// primitive's TANGENT when it has one (else tangents are generated: normal_map.h).
 //
 // Material mapping (documented in docs/scene-format.md); base = baseColorFactor.rgb,
 // m = metallicFactor, r = roughnessFactor:
@@ -580,7 +580,7 @@ class GltfLoader {
     const unsigned char* data = elements(index, what, stride);
     const tinygltf::Accessor& a = model_.accessors[size_t(index)];
     if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT ||
-        a.type != (N == 2 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3))
+        a.type != (N == 2 ? TINYGLTF_TYPE_VEC2 : N == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4))
       fail(what + ": expected float VEC" + std::to_string(N) + ", not component type " +
            std::to_string(a.componentType) + " of type " + std::to_string(a.type));
     std::vector<glm::vec<N, float>> out(a.count);
@@ -713,6 +713,15 @@ class GltfLoader {
       }
     }
     mesh.material = material_for(prim.material, what);
+    // The file's tangents serve the normal texture when it reads the UVs as they are (a
+    // KHR_texture_transform would turn the frame they were made in); else commit() makes them.
+    if (const auto it = prim.attributes.find("TANGENT"); it != prim.attributes.end() && !mesh.uvs.empty()) {
+      const TextureRef& normal = scene_.materials[mesh.material].normal_texture;
+      if (normal.valid() && normal.map == TextureRef{}.map) {
+        mesh.tangents = read_floats<4>(it->second, what + " TANGENT");
+        if (mesh.tangents.size() != n) fail(what + ": TANGENT and POSITION counts differ");
+      }
+    }
     transform_mesh(mesh, world);
     scene_.meshes.push_back(std::move(mesh));
   }

@@ -34,6 +34,14 @@ void transform_mesh(TriangleMesh& mesh, const glm::mat4& transform) {
     const float length = glm::length(m);
     n = length > 0.0f ? m / length : Vec3(0.0f);  // commit() falls back to ng for zero normals
   }
+  // Tangents turn with the surface; a mirroring transform also mirrors the bitangent n × t
+  // relative to the surface, so its sign w flips.
+  const float handedness = glm::determinant(linear) < 0.0f ? -1.0f : 1.0f;
+  for (glm::vec4& t : mesh.tangents) {
+    const Vec3 m = linear * Vec3(t);
+    const float length = glm::length(m);
+    t = glm::vec4(length > 0.0f ? m / length : Vec3(0.0f), t.w < 0.0f ? -handedness : handedness);
+  }
   // A mirroring transform turns counter-clockwise into clockwise: swap two corners so the same
   // physical side stays the front (glTF 2.0 §3.7.4 asks the same of mirrored nodes).
   if (glm::determinant(linear) < 0.0f)

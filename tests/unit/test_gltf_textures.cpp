@@ -72,6 +72,9 @@ struct QuadModel {
   std::string samplers;  ///< JSON array, or empty for none
   std::string extensions_used;
   std::vector<unsigned char> image_bytes;
+  std::vector<float> tangents;  ///< TANGENT (4 floats per corner) after the image, when set
+
+  size_t tangent_offset() const { return (124 + image_bytes.size() + 3) / 4 * 4; }
 
   std::vector<unsigned char> buffer() const {
     std::vector<unsigned char> bin;
@@ -82,6 +85,7 @@ struct QuadModel {
     append(bin, std::vector<uint8_t>{255, 0, 0, 0, 0, 0, 0, 0, 0, 255, 0, 0, 255, 255, 0, 0});  // 108: 16
     append(bin, image_bytes);                                                                   // 124
     while (bin.size() % 4 != 0) bin.push_back(0);
+    append(bin, tangents);
     return bin;
   }
 
@@ -95,12 +99,17 @@ struct QuadModel {
     if (!image_bytes.empty())
       views +=
           R"(, {"buffer": 0, "byteOffset": 124, "byteLength": )" + std::to_string(image_bytes.size()) + "}";
+    if (!tangents.empty())
+      views += R"(, {"buffer": 0, "byteOffset": )" + std::to_string(tangent_offset()) + R"(, "byteLength": )" +
+               std::to_string(4 * tangents.size()) + "}";
     views += "]";
+    const std::string tangent_view = std::to_string(image_bytes.empty() ? 5 : 6);
     return R"({"asset": {"version": "2.0"}, "scene": 0, )" +
            (extensions_used.empty() ? std::string() : R"("extensionsUsed": )" + extensions_used + ", ") +
            R"("scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
   "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 2, "TEXCOORD_1": 3,
-                                                             "TEXCOORD_2": 4}, "indices": 1, "material": 0}]}],
+                                                             "TEXCOORD_2": 4)" +
+           (tangents.empty() ? std::string() : R"(, "TANGENT": 5)") + R"(}, "indices": 1, "material": 0}]}],
   "materials": )" +
            materials + R"(, "textures": )" + textures + R"(, "images": )" + (images.empty() ? "[]" : images) +
            (samplers.empty() ? std::string() : R"(, "samplers": )" + samplers) + R"(,
@@ -110,7 +119,10 @@ struct QuadModel {
                 {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
                 {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
                 {"bufferView": 3, "componentType": 5123, "normalized": true, "count": 4, "type": "VEC2"},
-                {"bufferView": 4, "componentType": 5121, "normalized": true, "count": 4, "type": "VEC2"}]})";
+                {"bufferView": 4, "componentType": 5121, "normalized": true, "count": 4, "type": "VEC2"})" +
+           (tangents.empty() ? std::string()
+                             : R"(, {"bufferView": )" + tangent_view + R"(, "componentType": 5126, "count": 4, "type": "VEC4"})") +
+           "]}";
   }
 
   /// A .gltf with its buffer in a data: URI.
@@ -571,6 +583,17 @@ TEST_F(GltfTextures, NormalTextureTiltsTheShadingNormalUpTheImage) {
     EXPECT_NEAR(si.ns.y, expected.y, 1e-5f) << scale;
     EXPECT_NEAR(si.ns.z, expected.z, 1e-5f) << scale;
   }
+  // The file's own TANGENT wins over the generated frame: tangent +y with w = +1 puts the
+  // bitangent n × t along −x, so "up the image" now tilts the normal towards −x.
+  quad.tangents = {0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
+  quad.materials = R"([{"pbrMetallicRoughness": {"metallicFactor": 0}, "normalTexture": {"index": 0}}])";
+  const Scene scene = load_scene(write("tangents.gltf", quad.gltf()));
+  ASSERT_EQ(scene.meshes[0].tangents.size(), 4u);
+  const SurfaceInteraction si = left_point(scene);
+  const Vec3 expected = glm::normalize(Vec3(-(2 * 191 / 255.0f - 1), 2 * 128 / 255.0f - 1, 2 * 238 / 255.0f - 1));
+  EXPECT_NEAR(si.ns.x, expected.x, 1e-5f);
+  EXPECT_NEAR(si.ns.y, expected.y, 1e-5f);
+  EXPECT_NEAR(si.ns.z, expected.z, 1e-5f);
 }
 
 TEST_F(GltfTextures, AlphaModeMaskAndBlendComeFromTheBaseColour) {
