@@ -68,6 +68,18 @@ rc::TriangleMesh quad(uint32_t material) {
   return m;
 }
 
+/// The unit quad of quad() with one diffuse material of albedo `albedo` × `image`, committed.
+rc::Scene textured_quad(const rc::TextureImage& image, rc::Rgb albedo) {
+  rc::Scene scene;
+  rc::Material m = rc::Material::make_diffuse("textured", albedo);
+  scene.textures.push_back(image);
+  m.albedo_texture.image = 0;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(quad(0));
+  scene.commit();
+  return scene;
+}
+
 TEST_F(Textures, DecodesSrgbBeforeReading) {
   // Texels red, blue and the sRGB code 188, read at their centres (bilinear is exact there).
   const std::string file = ppm("rb.ppm", 3, 1, {255, 0, 0, 0, 0, 255, 188, 188, 188});
@@ -315,13 +327,9 @@ TEST_F(Textures, CameraRaysFilterOverTheirPixelsFootprint) {
   std::vector<unsigned char> texels;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) texels.insert(texels.end(), 3, (x + y) % 2 ? (unsigned char)255 : (unsigned char)0);
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("checker", rc::Rgb(1.0f));
-  scene.textures.push_back(rc::TextureImage{ppm("checker.ppm", 64, 64, texels), false, rc::TextureWrap::repeat, rc::TextureWrap::repeat});
-  m.albedo_texture.image = 0;
-  scene.materials.push_back(m);
-  scene.meshes.push_back(quad(0));
-  scene.commit();
+  const rc::Scene scene = textured_quad(
+      rc::TextureImage{ppm("checker.ppm", 64, 64, texels), false, rc::TextureWrap::repeat, rc::TextureWrap::repeat},
+      rc::Rgb(1.0f));
   const auto albedo = [&](const rc::Ray& ray) {
     const std::optional<rc::Hit> hit = scene.intersect(ray);
     EXPECT_TRUE(hit.has_value());
@@ -406,14 +414,10 @@ TEST_F(Textures, ElementsReflectTheTexturesMeanOverThem) {
   // signs; the total is checked to 2 %.
   std::vector<unsigned char> texels;
   for (int x = 0; x < 64; ++x) texels.insert(texels.end(), {x < 32 ? (unsigned char)255 : (unsigned char)0, 0, x < 32 ? (unsigned char)0 : (unsigned char)255});
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("textured", rc::Rgb(0.9f));
   // Clamped: repeating would blend the blue right edge into the red left one.
-  scene.textures.push_back(rc::TextureImage{ppm("rb.ppm", 64, 1, texels), true, rc::TextureWrap::clamp, rc::TextureWrap::clamp});
-  m.albedo_texture.image = 0;
-  scene.materials.push_back(m);
-  scene.meshes.push_back(quad(0));
-  scene.commit();
+  const rc::Scene scene = textured_quad(
+      rc::TextureImage{ppm("rb.ppm", 64, 1, texels), true, rc::TextureWrap::clamp, rc::TextureWrap::clamp},
+      rc::Rgb(0.9f));
   const radiosity::RadiosityMesh mesh = radiosity::build_mesh(scene, radiosity::MeshSettings{.max_edge = 0.1f});
   const std::vector<rc::Rgb> rho = radiosity::element_reflectance(scene, mesh);
   ASSERT_EQ(rho.size(), mesh.element_count());
