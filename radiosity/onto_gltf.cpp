@@ -594,6 +594,24 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
   }
   if (!baked_any)
     throw InputError(input + ": no surface of the model holds a solution (mirrors and glass are not baked)");
+  // Once no primitive is compressed any more, the file no longer needs a Draco decoder.
+  bool draco_left = false;
+  if (j.contains("meshes") && j["meshes"].is_array())
+    for (const Json& mesh : j["meshes"])
+      if (mesh.is_object() && mesh.contains("primitives") && mesh["primitives"].is_array())
+        for (const Json& primitive : mesh["primitives"])
+          draco_left = draco_left || (primitive.is_object() && primitive.contains("extensions") &&
+                                      primitive["extensions"].is_object() &&
+                                      primitive["extensions"].contains("KHR_draco_mesh_compression"));
+  if (!draco_left)
+    for (const char* list : {"extensionsUsed", "extensionsRequired"})
+      if (j.contains(list) && j[list].is_array()) {
+        Json kept = Json::array();
+        for (const Json& name : j[list])
+          if (name != "KHR_draco_mesh_compression") kept.push_back(name);
+        if (kept.empty()) j.erase(list);
+        else j[list] = std::move(kept);
+      }
   finish_output(o, output);
 }
 

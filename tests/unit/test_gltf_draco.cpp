@@ -523,6 +523,7 @@ TEST_F(GltfDraco, LightmapWritesTheDecodedPrimitiveWhenItMakesItsOwnUvs) {
   tinygltf::Model out = bake();
   ASSERT_EQ(out.meshes.size(), 1u);
   EXPECT_EQ(out.meshes[0].primitives.at(0).extensions.count("KHR_draco_mesh_compression"), 1u);
+  EXPECT_EQ(std::count(out.extensionsRequired.begin(), out.extensionsRequired.end(), "KHR_draco_mesh_compression"), 1);
   // Without them gilt makes an atlas and rewrites the primitive's attributes and indices from the
   // decoded data (its vertices split along the atlas's seams): it is no longer compressed.
   write("box.glb", cube_glb([](Json& j) {
@@ -534,6 +535,9 @@ TEST_F(GltfDraco, LightmapWritesTheDecodedPrimitiveWhenItMakesItsOwnUvs) {
   ASSERT_EQ(out.meshes.size(), 1u);
   const tinygltf::Primitive& p = out.meshes[0].primitives.at(0);
   EXPECT_EQ(p.extensions.count("KHR_draco_mesh_compression"), 0u);
+  // No compressed primitive is left, so the file no longer asks for a Draco decoder.
+  for (const auto* list : {&out.extensionsUsed, &out.extensionsRequired})
+    EXPECT_EQ(std::count(list->begin(), list->end(), "KHR_draco_mesh_compression"), 0);
   for (const auto& [name, index] : p.attributes)
     EXPECT_GE(out.accessors.at(size_t(index)).bufferView, 0) << name;
   const Scene again = load_scene((dir_ / "out.glb").string());
