@@ -35,9 +35,9 @@ struct CheckResult {
 
 /// Compares the solution's vertex irradiance with path-traced irradiance averaged over the input
 /// surface around each vertex (a disk half as wide as the distance to its nearest element
-/// centroid, seen along the vertex normal; see check.cpp). A vertex is left out when it is not
-/// diffuse, its albedo has a zero channel, or fewer than two of the path tracer's views land on
-/// its material. Each
+/// centroid, seen along the vertex normal, with a white Lambertian standing in for the surface
+/// where each path starts; see check.cpp). A vertex is left out when fewer than two of the path
+/// tracer's views land on its material. Each
 /// vertex's estimate draws from its own random stream, so the result is the same for any thread
 /// count.
 CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings);
@@ -78,9 +78,9 @@ void write_check_points(const std::string& path, const rc::Scene& scene, const S
 /// Draws `settings.points` points uniformly by area over the faces that `irradiance` (an
 /// InputColours fitted with Quantity::irradiance) covers, from `settings.seed`, and compares
 /// the interpolated colours with path-traced irradiance there: the path tracer looks straight
-/// down the face normal at the point, E = π (L − Le) / ρ, `settings.samples` samples per point.
-/// Surfaces that are not diffuse or have an albedo with a zero channel are not drawn from, and
-/// a point with something lying on it (the path tracer's ray hits another surface) is left out,
+/// down the face normal at the point, at a white, unlit Lambertian standing in for the surface
+/// there, E = π L, `settings.samples` samples per point. Mirrors and glass are not drawn from,
+/// and a point with something lying on it (the path tracer's ray hits another surface) is left out,
 /// and so is a buried point (input_triangle_buried for its face, which the fit leaves out, or
 /// input_point_buried for the point: inside a closed solid or under an object) or one no
 /// path-traced sample brings any light to: no one sees their colour.
