@@ -114,7 +114,16 @@ void run_render(const RenderOptions& o) {
   mo.photon.gather_rays = o.gather_rays;
   mo.sppm.alpha = o.alpha;
   mo.max_depth = o.max_depth;
-  const MethodResult result = run_method(scene, camera, o.method, settings, mo);
+  // A scene that emits nothing is black whatever the method: the image is written at once rather
+  // than after the samples or the --time budget have been spent tracing it.
+  MethodResult result;
+  if (scene.lights().empty()) {
+    if (settings.width <= 0 || settings.height <= 0) throw rc::InputError("image size must be positive");
+    result.film = rc::Film(settings.width, settings.height);
+    result.notes.push_back("nothing traced: without lights the image is black in every method");
+  } else {
+    result = run_method(scene, camera, o.method, settings, mo);
+  }
   const rc::Film& film = result.film;
   const rc::RenderStats& stats = result.stats;
   const std::optional<radiosity::Solution>& solution = result.solution;

@@ -19,9 +19,11 @@
 #include <string>
 #include <vector>
 
+#include "raytrace_core/io/image_io.h"
 #include "tests/stress/bad_files.h"
 
 namespace fs = std::filesystem;
+namespace rc = gilt::raytrace_core;
 using gilt::stress::BadFile;
 using gilt::stress::corpus_file;
 using gilt::stress::kTriangle;
@@ -301,8 +303,8 @@ TEST_F(CliBadInput, TruncatedFilesExitZeroOrTwo) {
   }
 }
 
-// A scene without lights is not an error: a warning, exit 0, a black image (render) or black
-// vertex colours (radiosity).
+// A scene without lights is not an error: a warning, exit 0, a black image (render, at once:
+// nothing is traced) or black vertex colours (radiosity).
 TEST_F(CliBadInput, SceneWithoutLightsWarnsAndExitsZero) {
   write("grey.mtl", "newmtl grey\nKd 0.5 0.5 0.5\n");
   const fs::path obj =
@@ -315,6 +317,9 @@ TEST_F(CliBadInput, SceneWithoutLightsWarnsAndExitsZero) {
     EXPECT_NE(r.err.find("no lights"), std::string::npos) << method << ": " << r.err;
     EXPECT_TRUE(fs::exists(out)) << method;
     EXPECT_NE(r.out.find("\"non_finite_samples\":0"), std::string::npos) << method << ": " << r.out;
+    EXPECT_NE(r.out.find("\"rays\":0,"), std::string::npos) << method << ": " << r.out;
+    const rc::Image image = rc::read_image(out.string());
+    for (const rc::Rgb& p : image.pixels) EXPECT_TRUE(p.is_black()) << method;
   }
   const fs::path mesh = dir_ / "dark.ply";
   const Outcome r = run("radiosity '" + obj.string() + "' --elements 20 -q -o '" + mesh.string() + "'");
