@@ -38,6 +38,7 @@ class JsonSceneReader {
 
   void read(const Json& root) {
     object(root, "", {"materials", "meshes", "shapes", "lights", "camera", "render"});
+    own_camera_ = root.contains("camera");
     if (const Json* j = field(root, "materials")) read_materials(*j);
     if (const Json* j = field(root, "meshes"))
       for_each(*j, "/meshes", [&](const Json& e, const std::string& p) { read_mesh(e, p); });
@@ -246,8 +247,20 @@ class JsonSceneReader {
       if (glm::length(direction) > 0.0f) light.direction = glm::normalize(direction);
       scene_.punctual_lights.push_back(light);
     }
-    if (part.camera)
-      scene_.warnings.push_back(file_ + ": " + p + ": the camera of '" + relative.string() + "' is ignored");
+    // The first included file's camera frames the scene, moved with the file, unless the JSON has
+    // its own; its image size (a glTF camera's aspect ratio) comes with it.
+    if (part.camera && !own_camera_ && !scene_.camera) {
+      Camera camera = *part.camera;
+      camera.look_from = Vec3(transform * glm::vec4(camera.look_from, 1.0f));
+      camera.look_at = Vec3(transform * glm::vec4(camera.look_at, 1.0f));
+      const Vec3 up = glm::mat3(transform) * camera.up;
+      if (glm::length(up) > 0.0f) camera.up = glm::normalize(up);
+      scene_.camera = camera;
+      scene_.render = part.render;
+    } else if (part.camera) {
+      scene_.warnings.push_back(file_ + ": " + p + ": the camera of '" + relative.string() + "' is ignored (" +
+                                (own_camera_ ? "the scene's own" : "an earlier file's") + " is used)");
+    }
     for (std::string& w : part.warnings) scene_.warnings.push_back(std::move(w));
   }
 
@@ -360,6 +373,7 @@ class JsonSceneReader {
 
   fs::path path_;
   std::string file_;
+  bool own_camera_ = false;  // the JSON names its own camera, which wins over its files'
   Scene& scene_;
   std::map<std::string, uint32_t> material_index_;
   std::map<uint32_t, size_t> shape_mesh_of_material_;

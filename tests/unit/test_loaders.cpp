@@ -528,6 +528,29 @@ TEST_F(Loaders, GltfEmbeddedBuffer) {
   EXPECT_EQ(load_scene(path).lights().size(), 2u + 3u);  // two lamp triangles, three punctual lights
 }
 
+TEST_F(Loaders, JsonSceneKeepsItsGltfsCameraUnlessItHasOne) {
+  // The glTF's camera (at (0, 0, 5), looking down −z, aspect 1.5) moved by the file's transform;
+  // a second file's camera is ignored with a warning; a JSON camera wins over both.
+  write("scene.gltf", gltf_json(embedded_buffer(quad_buffer())));
+  const std::string wrapped =
+      write("wrapped.json", R"({"meshes": [{"file": "scene.gltf", "transform": {"translate": [1, 2, 3]}},
+                                          {"file": "scene.gltf"}]})");
+  const Scene scene = load_scene_file(wrapped);
+  ASSERT_TRUE(scene.camera.has_value());
+  EXPECT_EQ(scene.camera->look_from, Vec3(1, 2, 8));
+  EXPECT_EQ(scene.camera->look_at, Vec3(1, 2, 7));
+  EXPECT_EQ(scene.camera->up, Vec3(0, 1, 0));
+  EXPECT_NEAR(scene.camera->vfov_degrees, 0.8f * 180.0f / kPi, 1e-4f);
+  EXPECT_EQ(scene.render.width, 768);
+  EXPECT_TRUE(has_warning(scene, "an earlier file's is used"));
+  const std::string own = write("own.json", R"({"meshes": [{"file": "scene.gltf"}],
+      "camera": {"look_from": [0, 0, -3], "look_at": [0, 0, 0]}})");
+  const Scene with_own = load_scene_file(own);
+  ASSERT_TRUE(with_own.camera.has_value());
+  EXPECT_EQ(with_own.camera->look_from, Vec3(0, 0, -3));
+  EXPECT_TRUE(has_warning(with_own, "the scene's own is used"));
+}
+
 TEST_F(Loaders, GlbBinaryContainer) {
   std::string json = gltf_json(R"({"byteLength": 60})");
   while (json.size() % 4 != 0) json += ' ';
