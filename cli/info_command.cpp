@@ -142,6 +142,19 @@ void run_info(const InfoOptions& o) {
       else
         p.runs.push_back("metallic-roughness: GGX specular over a Lambertian base, sampled by visible normals");
     }
+  // And with rough glass.
+  if (std::any_of(scene.materials.begin(), scene.materials.end(),
+                  [](const rc::Material& m) { return m.is_rough_dielectric(); }))
+    for (MethodPlan& p : plans) {
+      if (p.method == "radiosity")
+        p.runs.push_back("rough glass: not meshed; the view traces through it by sampling its GGX lobes");
+      else if (p.method == "photon" || p.method == "sppm")
+        p.runs.push_back("rough glass: camera paths and photons pass through by sampling its GGX lobes (caustics)");
+      else if (p.method == "whitted")
+        p.runs.push_back("rough glass: rendered as smooth glass (delta directions only)");
+      else
+        p.runs.push_back("rough glass: GGX reflection and refraction, lights sampled through it");
+    }
   if (textured > 0)
     for (MethodPlan& p : plans) {
       if (p.method == "radiosity")

@@ -89,7 +89,7 @@ MapNeeds map_needs(const rc::Scene& scene) {
   bool specular = false, reflective = false;
   auto visit = [&](uint32_t material) {
     const rc::Material& m = scene.materials[material];
-    if (m.is_specular()) specular = true;
+    if (m.is_traced_through()) specular = true;
     else if (rc::diffuse_reflectance(m).max_component() > 1e-4f || m.kind == rc::MaterialKind::glossy ||
              m.kind == rc::MaterialKind::metallic_roughness)
       reflective = true;

@@ -23,7 +23,7 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
     if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
       power *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
     const rc::Vec3 wo_world = -glm::normalize(ray.direction);
-    if (!m.is_specular()) {
+    if (!m.is_traced_through()) {
       Photon p;
       p.position = si.p;
       p.power = power;
@@ -48,7 +48,7 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
       correction = denom > 0.0f ? std::fabs(wo.z) * std::fabs(glm::dot(wi_world, si.ng)) / denom : 0.0f;
     }
     const rc::Rgb scaled = power * bs->f * (std::fabs(bs->wi.z) / bs->pdf * correction);
-    if (!m.is_specular()) specular_only = false;
+    if (!m.is_traced_through()) specular_only = false;
     // Russian roulette: survive with the ratio of new to old power (the bounce's albedo), so the
     // survivors carry about the same power as before.
     const float survive = std::min(1.0f, scaled.max_component() / std::max(power.max_component(), 1e-30f));

@@ -134,7 +134,7 @@ rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx
     const rc::Vec3 wo_world = -glm::normalize(ray.direction);
     // Seen from the camera or through mirrors and glass: emission counts in full.
     if (m.is_emissive()) radiance += beta * rc::emitted_radiance(m, si.ng, wo_world);
-    if (!m.is_specular()) {
+    if (!m.is_traced_through()) {
       radiance += beta * shade(si, wo_world, ctx);
       break;
     }
@@ -225,7 +225,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
           gathered += g * le * w;
         }
       }
-      if (mj.is_specular()) {
+      if (mj.is_traced_through()) {
         const rc::Frame fj = rc::Frame::from_normal(sj.ns);
         const rc::Vec3 woj = fj.to_local(-dir);
         const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, ctx.rng.uniform(), ctx.rng.uniform2());

@@ -107,7 +107,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           const rc::Frame frame = rc::Frame::from_normal(si.ns);
           const rc::Vec3 wo = frame.to_local(wo_world);
           const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
-          if (!m.is_specular()) {
+          if (!m.is_traced_through()) {
             direct += beta * rc::sample_direct(scene, si, m, frame, wo, wo_above, rng, local_rays).value;
             ps.visible = true;
             ps.position = si.p;

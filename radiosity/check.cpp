@@ -152,7 +152,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     const rc::TriangleMesh& mesh = scene.meshes[m];
     const bool covered = mesh.origin.file == file && covered_mesh(m);
     const rc::Material& mat = scene.materials[mesh.material];
-    if (!covered || mat.is_specular()) continue;
+    if (!covered || mat.is_traced_through()) continue;
     for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
       const Vec3 &a = mesh.positions[mesh.indices[3 * t]], &b = mesh.positions[mesh.indices[3 * t + 1]],
                  &c = mesh.positions[mesh.indices[3 * t + 2]];

@@ -22,9 +22,9 @@ rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh) {
   out.materials.push_back(rc::Material::make_diffuse("radiosity elements", rc::Rgb(0.0f)));
   out.meshes.push_back(std::move(elements));
   for (const rc::TriangleMesh& m : scene.meshes)
-    if (scene.materials[m.material].is_specular()) out.meshes.push_back(m);
+    if (scene.materials[m.material].is_traced_through()) out.meshes.push_back(m);
   for (const rc::Sphere& s : scene.spheres)
-    if (scene.materials[s.material].is_specular()) out.spheres.push_back(s);
+    if (scene.materials[s.material].is_traced_through()) out.spheres.push_back(s);
   out.commit();
   return out;
 }

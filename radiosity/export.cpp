@@ -9,8 +9,8 @@
 // Materials are written so that gilt's own loaders read them back as the same kind:
 //   MTL   Kd albedo, Ks specular, Ns exponent (1000, the sharpest, for a mirror), Ni ior, d 1,
 //         Tf = exp(−σa) for a dielectric, Ke emission; illum 1 diffuse, 2 glossy, 3 mirror,
-//         7 dielectric; metallic-roughness as illum 2 with the PBR extension's Pr and Pm. Two-sided
-//         emission has no MTL equivalent.
+//         7 dielectric (a rough one with the PBR extension's Pr); metallic-roughness as illum 2
+//         with Pr and Pm. Two-sided emission has no MTL equivalent.
 //   glTF  baseColorFactor albedo; metallic-roughness materials their metallicFactor and
 //         roughnessFactor; others metallicFactor 0, roughnessFactor 1 and
 //         KHR_materials_specular's specularFactor 0, which makes the specification's BRDF exactly
@@ -275,6 +275,10 @@ std::string encode_mtl(const std::vector<Material>& materials, const std::vector
       append_float(out, mat.roughness);
       out += "\nPm";
       append_float(out, mat.metallic);
+      out += "\n";
+    } else if (mat.is_rough_dielectric()) {  // frosted glass: its roughness as the PBR extension's Pr
+      out += "Pr";
+      append_float(out, mat.roughness);
       out += "\n";
     }
     out += "illum " + std::to_string(illum) + "\n";

@@ -477,7 +477,7 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
   std::vector<std::vector<char>> buried(scene.meshes.size());
   for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
     const rc::TriangleMesh& mesh = scene.meshes[m];
-    if (mesh.origin.file != out.file || scene.materials[mesh.material].is_specular()) continue;
+    if (mesh.origin.file != out.file || scene.materials[mesh.material].is_traced_through()) continue;
     baked_meshes.push_back(m);
     out.stats.faces += mesh.triangle_count();
     buried[m] = input_faces_buried(scene, mesh.positions, mesh.indices);

@@ -196,7 +196,7 @@ SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_d
 namespace {
 
 bool is_meshed(const rc::Material& material) {
-  return !material.is_specular();  // diffuse, glossy and metallic-roughness: their diffuse part
+  return !material.is_traced_through();  // diffuse, glossy and metallic-roughness: their diffuse part
 }
 
 const rc::Material& material_of(const rc::Scene& scene, uint32_t material, const std::string& what) {

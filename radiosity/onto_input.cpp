@@ -87,7 +87,7 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
   const SolutionAtInput at_input(scene, solution, quantity);
   const auto value = [&](const rc::Material& m, const Vec3& p, const Vec3& n) { return at_input(m, p, n); };
   const auto baked = [&](const rc::TriangleMesh& mesh) {
-    return mesh.origin.file == out.file && !scene.materials[mesh.material].is_specular();
+    return mesh.origin.file == out.file && !scene.materials[mesh.material].is_traced_through();
   };
 
   const auto buried_faces = [&](std::span<const Vec3> positions, std::span<const uint32_t> indices) {

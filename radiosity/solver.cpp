@@ -196,13 +196,13 @@ std::vector<rc::Bounds3> occluder_boxes(const rc::Scene& scene, const RadiosityM
   std::vector<rc::Bounds3> boxes;
   for (auto& [surface, b] : by_surface) boxes.push_back(b);
   for (const rc::TriangleMesh& m : scene.meshes) {
-    if (!scene.materials[m.material].is_specular()) continue;
+    if (!scene.materials[m.material].is_traced_through()) continue;
     rc::Bounds3 b;
     for (uint32_t i : m.indices) b.extend(m.positions[i]);
     if (!b.empty()) boxes.push_back(b);
   }
   for (const rc::Sphere& sp : scene.spheres)
-    if (scene.materials[sp.material].is_specular()) boxes.push_back({sp.center - Vec3(sp.radius), sp.center + Vec3(sp.radius)});
+    if (scene.materials[sp.material].is_traced_through()) boxes.push_back({sp.center - Vec3(sp.radius), sp.center + Vec3(sp.radius)});
   // Grow each box by the rounding slack so the test stays conservative.
   for (rc::Bounds3& b : boxes) {
     b.lo -= Vec3(eps);
@@ -603,8 +603,8 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.convex_enclosure = plan.occluder_boxes == 0;
   plan.punctual_lights = scene.punctual_lights.size();
   plan.solver = choose_solver(settings, plan.elements, &plan.solver_reason);
-  for (const rc::TriangleMesh& m : scene.meshes) plan.specular_surfaces += scene.materials[m.material].is_specular();
-  for (const rc::Sphere& s : scene.spheres) plan.specular_surfaces += scene.materials[s.material].is_specular();
+  for (const rc::TriangleMesh& m : scene.meshes) plan.specular_surfaces += scene.materials[m.material].is_traced_through();
+  for (const rc::Sphere& s : scene.spheres) plan.specular_surfaces += scene.materials[s.material].is_traced_through();
   return plan;
 }
 

@@ -82,7 +82,7 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   element_normal_ = mesh.element_normal;
   element_direct_ = solution.element_direct;
   has_specular_ = std::any_of(scene.materials.begin(), scene.materials.end(),
-                              [](const rc::Material& m) { return m.is_specular(); });
+                              [](const rc::Material& m) { return m.is_traced_through(); });
   // An input point lies within about an element's size of the element that stands for it
   // (elements are chords of a curved input); twice the target edge leaves room for bisection
   // and for input faces kept as they were.
@@ -157,8 +157,8 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
     if (via_specular && mj.is_emissive()) out += beta * rc::emitted_radiance(mj, sj.ng, wo_world);
     const rc::Frame fj = rc::Frame::from_normal(sj.ns);
     const Vec3 wo = fj.to_local(wo_world);
-    if (depth == 0 && via_specular_only && !mj.is_specular()) return Rgb(0.0f);
-    if (!mj.is_specular()) {
+    if (depth == 0 && via_specular_only && !mj.is_traced_through()) return Rgb(0.0f);
+    if (!mj.is_traced_through()) {
       // Direct light: the element's own mean where the solution has it (hierarchical), else by a
       // shadow ray, as at the camera's point. Not the vertices' direct light interpolated:
       // across an element that a shadow edge crosses their mean may be anything from none of it
@@ -231,7 +231,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     const Vec3 wo = frame.to_local(wo_world);
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
-    if (!m.is_specular()) {
+    if (!m.is_traced_through()) {
       // Direct light by one shadow ray (the whole BSDF, glossy lobe included), then the light
       // the other surfaces reflect onto its Lambertian part: the solution's, interpolated over
       // the element found here. Where no element stands for this side, a gather ray reads the

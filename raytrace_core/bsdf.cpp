@@ -2,6 +2,7 @@
 //   Lambertian diffuse, sampled with Malley's cosine-weighted hemisphere.
 //   Glossy: Lambertian + energy-normalised modified Phong, Lafortune & Willems 1994, "Using the
 //     Modified Phong Reflectance Model for Physically Based Rendering" (CW report 197).
+//   Rough dielectric: GGX reflection and refraction, Walter et al. 2007 (rough_dielectric.h).
 //   Mirror and smooth dielectric: delta lobes with the exact unpolarised Fresnel equations
 //     (Born & Wolf, "Principles of Optics", §1.5), 1/η² radiance scaling across a refractive
 //     interface as in Veach 1997, "Robust Monte Carlo Methods for Light Transport Simulation", §5.2.
@@ -17,6 +18,7 @@
 #include <algorithm>
 
 #include "raytrace_core/microfacet.h"
+#include "raytrace_core/rough_dielectric.h"
 #include "raytrace_core/sampling.h"
 
 namespace gilt::raytrace_core {
@@ -231,7 +233,8 @@ std::optional<BsdfSample> sample_dielectric(const Material& m, const Vec3& wo, f
 
 }  // namespace
 
-Rgb bsdf_eval(const Material& m, const Vec3& wo, const Vec3& wi) {
+Rgb bsdf_eval(const Material& m, const Vec3& wo, const Vec3& wi, TransportMode mode) {
+  if (m.is_rough_dielectric()) return rough_dielectric_eval(m, wo, wi, mode);
   if (!(wo.z * wi.z > 0.0f)) return Rgb(0.0f);  // opposite sides, or grazing
   switch (m.kind) {
     case MaterialKind::diffuse:
@@ -249,6 +252,7 @@ Rgb bsdf_eval(const Material& m, const Vec3& wo, const Vec3& wi) {
 }
 
 float bsdf_pdf(const Material& m, const Vec3& wo, const Vec3& wi) {
+  if (m.is_rough_dielectric()) return rough_dielectric_pdf(m, wo, wi);
   if (!(wo.z * wi.z > 0.0f)) return 0.0f;
   switch (m.kind) {
     case MaterialKind::diffuse:
@@ -275,7 +279,8 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, const Vec3& wo, float u
     case MaterialKind::mirror:
       return sample_mirror(m, wo);
     case MaterialKind::dielectric:
-      return sample_dielectric(m, wo, u_lobe, mode);
+      return m.is_rough_dielectric() ? rough_dielectric_sample(m, wo, u_lobe, u, mode)
+                                     : sample_dielectric(m, wo, u_lobe, mode);
   }
   return std::nullopt;
 }

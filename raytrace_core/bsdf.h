@@ -4,7 +4,8 @@
 // All directions are unit vectors in the local shading frame (Frame::to_local) whose +z is the
 // surface's front normal; wo and wi point away from the surface. Reflective lobes of diffuse,
 // glossy and mirror materials work on both sides (wo.z < 0 is mirrored to the front); the
-// dielectric distinguishes inside (z < 0) from outside (z > 0).
+// dielectric distinguishes inside (z < 0) from outside (z > 0); a rough one (rough_dielectric.h)
+// has non-delta reflection and refraction, so f and pdf are non-zero across the surface too.
 //
 // Conventions follow pbrt: f excludes the cosine factor; for a delta lobe f = (weight) / |cos θi|
 // and pdf is the discrete probability of choosing that lobe, flagged by `delta`.
@@ -29,10 +30,12 @@ struct BsdfSample {
   bool transmission = false;  ///< wi lies on the other side of the surface from wo
 };
 
-/// Non-delta BSDF value f(wo, wi) (zero for mirror and dielectric).
-Rgb bsdf_eval(const Material& m, const Vec3& wo, const Vec3& wi);
+/// Non-delta BSDF value f(wo, wi) (zero for mirror and smooth dielectric). Only a rough
+/// dielectric's refraction depends on `mode`.
+Rgb bsdf_eval(const Material& m, const Vec3& wo, const Vec3& wi, TransportMode mode = TransportMode::radiance);
 
 /// Solid-angle density with which bsdf_sample draws wi given wo (zero for delta-only materials).
+/// A rough dielectric's pdf is the same for radiance and importance.
 float bsdf_pdf(const Material& m, const Vec3& wo, const Vec3& wi);
 
 /// Draws wi given wo. `u_lobe` picks among lobes, `u` the direction within it. Empty when the
@@ -43,7 +46,8 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, const Vec3& wo, float u
 /// Reflectance of the material's Lambertian part: what radiosity and the photon map's irradiance
 /// gather treat as diffuse. The albedo for diffuse and glossy materials; (1 − metallic)(1 − F0)
 /// times the base colour for metallic-roughness (F0 the dielectric's normal reflectance, 0.04
-/// for η = 1.5: the light the specular layer takes at normal incidence); zero for mirror and glass.
+/// for η = 1.5: the light the specular layer takes at normal incidence); zero for mirror and
+/// glass, smooth or rough.
 Rgb diffuse_reflectance(const Material& m);
 
 /// Fresnel reflectance of an unpolarised dielectric interface. cos_i > 0 means arriving from the

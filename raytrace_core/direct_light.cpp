@@ -13,8 +13,10 @@ DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const Surfac
                         const Frame& frame, const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
   DirectSample out;
   const LightSample ls = sample_light(scene, scene.lights()[li], si, rng.uniform2());
-  // Reflection only: the light must be on wo's side of the geometric surface (no leaks).
-  if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) return out;
+  // The light must be on wo's side of the geometric surface (no leaks), unless the surface
+  // transmits into a lobe (a rough dielectric): then light from behind it counts too.
+  if (!(ls.pdf > 0.0f) || ls.radiance.is_black()) return out;
+  if ((glm::dot(ls.wi, si.ng) > 0.0f) != wo_above && !m.is_rough_dielectric()) return out;
   out.wi = frame.to_local(ls.wi);
   out.pdf = ls.pdf * pmf;
   out.delta = ls.delta;

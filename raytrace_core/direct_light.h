@@ -26,7 +26,8 @@ struct DirectSample {
 /// Samples the scene's lights once from `si` (material m, shading frame `frame`, outgoing
 /// direction wo in that frame, wo_above: wo lies on the ng side). Draws one uniform for the light
 /// and two for the point on it, nothing when the scene has no lights; adds the shadow ray to `rays`.
-/// Only reflection is estimated: a light on the other side of the geometric surface adds nothing.
+/// A light on the other side of the geometric surface adds nothing, except through a surface
+/// that transmits into a lobe (a rough dielectric), whose BSDF then gives the transmitted part.
 DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
                            const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays);
 

@@ -5,6 +5,8 @@
 
 #include <utility>
 
+#include "raytrace_core/microfacet.h"
+
 namespace gilt::raytrace_core {
 
 Material Material::make_diffuse(std::string name, Rgb albedo) {
@@ -37,8 +39,11 @@ Material Material::make_dielectric(std::string name, float ior, Rgb absorption) 
   m.albedo = Rgb(0.0f);
   m.ior = ior;
   m.absorption = absorption;
+  m.roughness = 0.0f;
   return m;
 }
+
+bool Material::is_rough_dielectric() const { return kind == MaterialKind::dielectric && sqr(roughness) > kMinGgxAlpha; }
 
 Material Material::make_glossy(std::string name, Rgb albedo, Rgb specular, float exponent) {
   Material m;

@@ -15,7 +15,9 @@ enum class MaterialKind : uint8_t {
   diffuse,     ///< Lambertian: f = albedo / π, reflects on both sides
   glossy,      ///< Lambertian `albedo` plus energy-normalised Phong lobe `specular`, `exponent`
   mirror,      ///< perfect specular reflection tinted by `specular`
-  dielectric,  ///< smooth glass: Fresnel reflection and refraction with `ior`, Beer–Lambert `absorption`
+  /// Glass: Fresnel reflection and refraction with `ior`, Beer–Lambert `absorption`; a perfect
+  /// interface, or GGX microfacets (Walter et al. 2007) when `roughness` is above zero
+  dielectric,
   /// glTF 2.0's metallic-roughness model (its specification's appendix B): base colour `albedo`,
   /// `metallic`, `roughness`; a GGX specular lobe with Schlick's Fresnel, over a Lambertian base
   /// for the dielectric part (F0 from `ior`) and tinted by the base colour for the metal part.
@@ -39,7 +41,9 @@ struct Material {
   float ior = 1.5f;       ///< index of refraction inside, relative to outside (dielectric)
   Rgb absorption{0.0f};   ///< absorption coefficient σa per scene unit inside (dielectric)
   float metallic = 0.0f;  ///< metal fraction in [0, 1] (metallic_roughness)
-  float roughness = 1.0f; ///< perceptual roughness in [0, 1]; GGX α = roughness² (metallic_roughness)
+  /// Perceptual roughness in [0, 1]; GGX α = roughness² (metallic_roughness, and dielectric, where
+  /// make_dielectric's 0 is a perfect interface)
+  float roughness = 1.0f;
   /// Dielectric: transmitted light is multiplied by this colour (glTF's base colour of a
   /// transmissive material; white for MTL glass).
   Rgb transmission_tint{1.0f};
@@ -91,8 +95,14 @@ struct Material {
 
   /// True when the surface emits light.
   bool is_emissive() const { return !emission.is_black(); }
-  /// True when every scattering direction is a delta (mirror, dielectric): no light sampling.
-  bool is_specular() const { return kind == MaterialKind::mirror || kind == MaterialKind::dielectric; }
+  /// True when every scattering direction is a delta (mirror, smooth dielectric): no light sampling.
+  bool is_specular() const { return kind == MaterialKind::mirror || (kind == MaterialKind::dielectric && !is_rough_dielectric()); }
+  /// A dielectric whose GGX α = roughness² is above kMinGgxAlpha: a microfacet interface that
+  /// reflects and refracts into lobes (rough_dielectric.h); at or below it, a perfect interface.
+  bool is_rough_dielectric() const;
+  /// True when the surface has no Lambertian part: mirror and glass, smooth or rough. Radiosity
+  /// and photon mapping store no light on such a surface; they follow rays through it instead.
+  bool is_traced_through() const { return kind == MaterialKind::mirror || kind == MaterialKind::dielectric; }
 
   /// Material of the given kind with default parameters, named.
   static Material make_diffuse(std::string name, Rgb albedo);

@@ -29,7 +29,7 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
   const Vec3 wo = frame.to_local(wo_world);
   const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
 
-  if (!m.is_specular()) {
+  if (!m.is_traced_through()) {
     // Local shading: the material's diffuse + Phong BSDF lit by shadow rays, lights chosen by power.
     const Distribution1D& choice = scene.light_distribution();
     const int n = std::max(1, settings.area_light_samples);

@@ -7,7 +7,8 @@
 // Material mapping (documented in docs/scene-format.md); base = baseColorFactor.rgb,
 // m = metallicFactor, r = roughnessFactor:
 //   KHR_materials_transmission factor > 0.5 → dielectric, ior from KHR_materials_ior (1.5),
-//       transmission tinted by base; with KHR_materials_volume of thickness > 0 a solid with
+//       transmission tinted by base, GGX roughness r (0: a perfect interface; rough_dielectric.h);
+//       with KHR_materials_volume of thickness > 0 a solid with
 //       σa = −ln(attenuationColor) / attenuationDistance, else a thin sheet (light passes unbent)
 //   m = 1, r² ≤ kMinGgxAlpha, untextured     → mirror, reflectance base
 //   m = 0, KHR_materials_specular's specularFactor = 0 → diffuse (F0 = 0: exactly Lambertian)
@@ -172,6 +173,7 @@ Material convert_material(const tinygltf::Material& gm, const std::string& name)
     // The base colour tints what the surface transmits. Without KHR_materials_volume (or with a
     // thickness of zero) the surface is thin-walled: light passes through unbent.
     m.transmission_tint = base;
+    m.roughness = roughness;  // the extension's transmission is as rough as the surface
     m.thin_walled = !volume.IsObject() || !(number_or(volume, "thicknessFactor", 0.0) > 0.0);
     if (m.thin_walled) m.absorption = Rgb(0.0f);
   } else if (metallic == 1.0f && roughness * roughness <= kMinGgxAlpha && pbr.metallicRoughnessTexture.index < 0) {
@@ -233,15 +235,16 @@ class GltfLoader {
       // A mirror's or glass's base colour tints what it reflects or transmits, which a texture on
       // Material::albedo cannot express: left out, as the OBJ loader leaves out their map_Kd.
       const bool has_base_texture = gm.pbrMetallicRoughness.baseColorTexture.index >= 0;
-      note_ignored(has_base_texture && m.is_specular(), "base colour of mirror and glass materials");
-      if (has_base_texture && !m.is_specular())
+      note_ignored(has_base_texture && m.is_traced_through(), "base colour of mirror and glass materials");
+      if (has_base_texture && !m.is_traced_through())
         m.albedo_texture = read(gm.pbrMetallicRoughness.baseColorTexture, "pbrMetallicRoughness.baseColorTexture", true);
       const bool has_mr_texture = gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
-      if (has_mr_texture && m.kind == MaterialKind::metallic_roughness)
+      // Rough glass reads the texture's roughness (green); its metalness has no meaning there.
+      const bool reads_mr = m.kind == MaterialKind::metallic_roughness || m.is_rough_dielectric();
+      if (has_mr_texture && reads_mr)
         m.metallic_roughness_texture = read(gm.pbrMetallicRoughness.metallicRoughnessTexture,
                                             "pbrMetallicRoughness.metallicRoughnessTexture", false);
-      note_ignored(has_mr_texture && m.kind != MaterialKind::metallic_roughness,
-                   "metallic-roughness of mirror and glass materials");
+      note_ignored(has_mr_texture && !reads_mr, "metallic-roughness of mirror and smooth glass materials");
       if (gm.emissiveTexture.index >= 0 && m.is_emissive())
         m.emission_texture = read(gm.emissiveTexture, "emissiveTexture", true);
       if (gm.normalTexture.index >= 0) {

@@ -159,9 +159,11 @@ class JsonSceneReader {
         object(j, p, {"kind", "specular", "emission", "two_sided"});
         m = Material::make_mirror(name, reflectance(j, "specular", p, Rgb(1.0f)));
       } else if (kind == "dielectric") {
-        object(j, p, {"kind", "ior", "absorption", "emission", "two_sided"});
+        object(j, p, {"kind", "ior", "absorption", "roughness", "emission", "two_sided"});
         m = Material::make_dielectric(name, number(j, "ior", p, 1.5f), colour(j, "absorption", p, Rgb(0.0f)));
+        m.roughness = number(j, "roughness", p, 0.0f);
         if (!(m.ior > 0.0f)) fail(at(p, "ior"), "must be positive");
+        if (!(m.roughness >= 0.0f && m.roughness <= 1.0f)) fail(at(p, "roughness"), "must lie in [0, 1]");
       } else if (kind == "metallic_roughness") {
         object(j, p, {"kind", "albedo", "metallic", "roughness", "ior", "emission", "two_sided"});
         m = Material::make_metallic_roughness(name, reflectance(j, "albedo", p, Rgb(0.8f)), number(j, "metallic", p, 0.0f),

@@ -7,7 +7,8 @@
 //
 // MTL → Material (documented in docs/scene-format.md):
 //   Ke                                  → emission (emitted radiance, front face only)
-//   illum 4, 6, 7 or 9, or d < 1        → dielectric, ior = Ni (1.5 when Ni ≤ 1, i.e. unset);
+//   illum 4, 6, 7 or 9, or d < 1        → dielectric, ior = Ni (1.5 when Ni ≤ 1, i.e. unset),
+//                                         GGX roughness Pr (0 when unset: a perfect interface);
 //                                         σa = −ln(Tf) per scene unit when Tf is neither black
 //                                         (unset) nor white
 //   illum 3, 5 or 8 and max(Ks) ≥ 0.5   → mirror, reflectance Ks (ray-traced reflection models)
@@ -492,7 +493,9 @@ void load_obj(const fs::path& path, Scene& scene) {
     const DiffuseMap diffuse = read ? mtl_reader.diffuse_map_of_material[i] : DiffuseMap{};
     // The PBR extension (Pr roughness, Pm metallic): glTF's metallic-roughness model with base
     // colour Kd. Glass and mirrors keep their kind.
-    if (diffuse.pbr_given && !m.is_specular()) {
+    if (diffuse.pbr_given && m.kind == MaterialKind::dielectric) {
+      m.roughness = std::clamp(float(mtl.roughness), 0.0f, 1.0f);  // Pr on glass: frosted glass
+    } else if (diffuse.pbr_given && !m.is_traced_through()) {
       const Rgb emission = m.emission;
       m = Material::make_metallic_roughness(mtl.name, clamp(rgb(mtl.diffuse), 0.0f, 1.0f),
                                             std::clamp(float(mtl.metallic), 0.0f, 1.0f),
@@ -542,7 +545,7 @@ void load_obj(const fs::path& path, Scene& scene) {
     };
     // map_d: a cut-out (leaves, fences), its image read as data; coverage below one half is not
     // there.
-    if (!mtl.alpha_texname.empty() && m.is_specular()) {
+    if (!mtl.alpha_texname.empty() && m.is_traced_through()) {
       const char* kind = "map_d of mirror and glass materials";
       if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end()) ignored_maps.push_back(kind);
     } else if (!mtl.alpha_texname.empty()) {

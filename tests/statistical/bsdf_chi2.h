@@ -2,6 +2,8 @@
 // The chi-square test of a BSDF's sampling routine, shared by the BSDF test programs: directions
 // drawn by bsdf_sample (both random numbers uniform) against bsdf_pdf, on a θ × φ grid of the
 // whole sphere (see chi2.h; samples that bsdf_sample declines count in the remainder cell).
+// `adaptive_depth` > 0 refines the expected counts' integration where the density jumps inside
+// a cell.
 
 #include <optional>
 
@@ -11,7 +13,8 @@
 namespace gilt::test {
 
 inline Chi2Result chi2_bsdf(const raytrace_core::Material& material, const raytrace_core::Vec3& wo, size_t samples,
-                            uint64_t seed, double alpha, int theta_rows = 48, int phi_columns = 96) {
+                            uint64_t seed, double alpha, int theta_rows = 48, int phi_columns = 96,
+                            int adaptive_depth = 0) {
   using namespace raytrace_core;
   return chi2_directions(
       theta_grid(theta_rows, phi_columns), samples, seed,
@@ -21,7 +24,7 @@ inline Chi2Result chi2_bsdf(const raytrace_core::Material& material, const raytr
         if (!s) return std::nullopt;
         return s->wi;
       },
-      [&](Vec3 wi) { return bsdf_pdf(material, wo, wi); }, alpha);
+      [&](Vec3 wi) { return bsdf_pdf(material, wo, wi); }, alpha, 3, adaptive_depth);
 }
 
 }  // namespace gilt::test

@@ -93,6 +93,7 @@ newmtl glass
 illum 7
 Ni 1.33
 Tf 0.9 0.9 1
+Pr 0.4
 newmtl chrome
 illum 3
 Kd 0 0 0
@@ -153,6 +154,8 @@ f -4 -3 -2
   EXPECT_FLOAT_EQ(material("glass").ior, 1.33f);
   EXPECT_NEAR(material("glass").absorption.r, -std::log(0.9f), 1e-5f);
   EXPECT_EQ(material("glass").absorption.b, 0.0f);
+  EXPECT_FLOAT_EQ(material("glass").roughness, 0.4f);  // Pr on glass: frosted, still glass
+  EXPECT_TRUE(material("glass").is_rough_dielectric());
   EXPECT_EQ(material("chrome").kind, MaterialKind::mirror);
   EXPECT_FLOAT_EQ(material("chrome").specular.g, 0.9f);
   EXPECT_EQ(material("plastic").kind, MaterialKind::glossy);
@@ -496,6 +499,9 @@ void expect_gltf_contents(const Scene& scene) {
   EXPECT_FLOAT_EQ(glass.ior, 1.4f);
   EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
   EXPECT_TRUE(glass.thin_walled);  // no KHR_materials_volume: a sheet
+  // No pbrMetallicRoughness: glTF's default roughnessFactor of 1, which its transmission shares.
+  EXPECT_FLOAT_EQ(glass.roughness, 1.0f);
+  EXPECT_TRUE(glass.is_rough_dielectric());
   EXPECT_EQ(scene.materials[3].kind, MaterialKind::metallic_roughness);
   EXPECT_EQ(scene.materials[3].metallic, 0.0f);
   EXPECT_EQ(scene.materials[3].roughness, 0.5f);
@@ -642,7 +648,7 @@ TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
   const std::string path = write("scene.json", R"({
     // comments are allowed
     "materials": {"white": {"albedo": 0.7}, "lamp": {"albedo": 0, "emission": [4, 4, 4]},
-                  "glass": {"kind": "dielectric", "ior": 1.5}, "gloss": {"kind": "glossy", "specular": 0.2}},
+                  "glass": {"kind": "dielectric", "ior": 1.5, "roughness": 0.2}, "gloss": {"kind": "glossy", "specular": 0.2}},
     "meshes": [{"file": "meshes/tri.obj", "material": "white",
                 "transform": {"scale": 2, "rotate_deg_axis": [90, 0, 0, 1], "translate": [1, 0, 0]}},
                {"file": "meshes/tri.obj", "transform": {"scale": [-1, 1, 1]}}],
@@ -671,6 +677,7 @@ TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
   EXPECT_LT(triangle_normal(mesh_named(scene, "shapes:lamp"), 0).y, 0.0f);  // faces down
   ASSERT_EQ(scene.spheres.size(), 1u);
   EXPECT_EQ(scene.materials[scene.spheres[0].material].kind, MaterialKind::dielectric);
+  EXPECT_FLOAT_EQ(scene.materials[scene.spheres[0].material].roughness, 0.2f);
   ASSERT_EQ(scene.punctual_lights.size(), 4u);
   EXPECT_EQ(scene.punctual_lights[1].direction, Vec3(0, -1, 0));
   EXPECT_FLOAT_EQ(scene.punctual_lights[1].cos_outer, std::cos(glm::radians(30.0f)));
@@ -696,6 +703,9 @@ TEST_F(Loaders, JsonBadInputNamesTheField) {
   const std::string type =
       write("type.json", R"({"materials": {"glass": {"kind": "dielectric", "ior": "x"}}})");
   EXPECT_CONTAINS(error_of([&] { load_scene(type); }), "type.json: /materials/glass/ior: expected a number");
+  const std::string rough =
+      write("rough.json", R"({"materials": {"glass": {"kind": "dielectric", "roughness": 1.5}}})");
+  EXPECT_CONTAINS(error_of([&] { load_scene(rough); }), "rough.json: /materials/glass/roughness: must lie in [0, 1]");
 
   const std::string missing = write("missing.json", R"({"meshes": [{"file": "nowhere.obj"}]})");
   EXPECT_CONTAINS(error_of([&] { load_scene(missing); }), "missing.json: /meshes/0/file: no such file");
