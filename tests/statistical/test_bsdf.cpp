@@ -21,6 +21,7 @@
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sampling.h"
 #include "tests/statistical/bsdf_chi2.h"
+#include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::raytrace_core {
@@ -31,10 +32,8 @@ constexpr size_t kChi2Samples = 1000000;
 constexpr double kZ = 4.0;
 const double kAlpha = test::sidak_alpha(test::kFamilyAlpha, kChi2Tests);
 
-// Unit direction at polar angle theta (radians) from +z, azimuth phi.
-Vec3 spherical(float theta, float phi) {
-  return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-}
+using test::LobeCase;
+using test::spherical;
 
 // Outgoing directions: normal, 45°, grazing (cos θ = 0.02) and below the surface (θ = 120°).
 // The azimuth 0.7 keeps lobes off the grid's cell boundaries in φ.
@@ -45,12 +44,6 @@ const std::vector<std::pair<std::string, Vec3>> kWos{{"normal", kWoNormal},
                                                      {"below120", spherical(2.0f * kPi / 3.0f, 0.7f)}};
 
 // ---- Non-delta lobes: sampled density against bsdf_pdf, and sample consistency. ----
-
-struct LobeCase {
-  std::string name;
-  Material material;
-  Vec3 wo;
-};
 
 std::vector<LobeCase> lobe_cases() {
   std::vector<LobeCase> cases;

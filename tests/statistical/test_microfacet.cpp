@@ -29,6 +29,7 @@
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sampling.h"
 #include "tests/statistical/bsdf_chi2.h"
+#include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::raytrace_core {
@@ -39,9 +40,8 @@ constexpr size_t kChi2Samples = 1000000;
 constexpr double kZ = 4.0;
 const double kAlpha = test::sidak_alpha(test::kFamilyAlpha, kChi2Tests);
 
-Vec3 spherical(float theta, float phi) {
-  return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-}
+using test::LobeCase;
+using test::spherical;
 
 TEST(Ggx, DistributionIsNormalised) {
   // ∫ D cos θ dω = 2π ∫₀¹ D(μ) μ dμ with μ = cos θ. Midpoint rule on a grid graded towards μ = 1
@@ -103,12 +103,6 @@ const std::vector<std::pair<std::string, Vec3>> kWos{{"normal", {0.0f, 0.0f, 1.0
                                                      {"oblique45", spherical(0.25f * kPi, 0.7f)},
                                                      {"grazing", spherical(std::acos(0.05f), 0.7f)},
                                                      {"below120", spherical(2.0f * kPi / 3.0f, 0.7f)}};
-
-struct LobeCase {
-  std::string name;
-  Material material;
-  Vec3 wo;
-};
 
 std::vector<LobeCase> lobe_cases() {
   // Roughness 0.35 (α ≈ 0.12) is the narrowest lobe the 48-row θ grid resolves at this sample
@@ -244,21 +238,6 @@ TEST(MetallicRoughness, DegenerateInputsGiveFiniteResults) {
 
 // ---- White furnace. ----
 
-struct Albedo {
-  double mean = 0.0, standard_error = 0.0;
-};
-
-template <class Draw>
-Albedo estimate(int n, const Draw& draw) {
-  double sum = 0.0, sum_sq = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const double w = draw();
-    sum += w;
-    sum_sq += w * w;
-  }
-  const double mean = sum / n;
-  return {mean, std::sqrt(std::max(0.0, (sum_sq / n - mean * mean) / (n - 1)))};
-}
 
 TEST(MetallicRoughness, WhiteFurnace) {
   // Base colour 1. A metal then reflects all that its microfacets' single scattering reflects:
@@ -282,7 +261,7 @@ TEST(MetallicRoughness, WhiteFurnace) {
         const Material m = Material::make_metallic_roughness("white", Rgb(1.0f), metallic, roughness);
         const Vec3 wo = spherical(theta, 0.4f);
         Rng rng(77);
-        const Albedo by_bsdf = estimate(kN, [&] {
+        const test::MeanEstimate by_bsdf = test::estimate_mean(kN, [&] {
           const float u_lobe = rng.uniform();
           const auto s = bsdf_sample(m, wo, u_lobe, rng.uniform2());
           return s ? double(s->f.g) * std::fabs(s->wi.z) / s->pdf : 0.0;
@@ -295,7 +274,7 @@ TEST(MetallicRoughness, WhiteFurnace) {
         // For the rougher lobes, an independent estimate from uniform directions and bsdf_eval
         // alone (too noisy for the narrow r = 0.1 lobe, whose check is the chi-square above).
         if (roughness >= 0.5f) {
-          const Albedo by_uniform = estimate(kN, [&] {
+          const test::MeanEstimate by_uniform = test::estimate_mean(kN, [&] {
             Vec3 wi = sample_uniform_sphere(rng.uniform2());
             if (wi.z < 0.0f) wi.z = -wi.z;
             return double(bsdf_eval(m, wo, wi).g) * wi.z * 2.0 * std::numbers::pi;
