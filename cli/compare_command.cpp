@@ -31,6 +31,7 @@ namespace {
 
 struct CompareOptions {
   std::string scene, output;
+  rc::ExtraLighting lighting;
   std::string methods = "path,photon,sppm,radiosity,whitted";
   std::string budgets = "1,2,4,8,16";
   std::string reference;
@@ -67,15 +68,20 @@ struct Hasher {
 /// reference's settings: a second compare of the same thing reuses the reference.
 std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, const CompareOptions& o) {
   Hasher k;
-  const std::string version = "gilt-reference-1";
+  const std::string version = "gilt-reference-2";
   k.bytes(version.data(), version.size());
   for (const rc::TriangleMesh& m : scene.meshes) k.vector(m.positions), k.vector(m.indices), k.vector(m.normals), k.value(m.material);
   for (const rc::Sphere& s : scene.spheres) k.value(s);
   for (const rc::Material& m : scene.materials) {
     k.value(m.kind), k.value(m.albedo), k.value(m.emission), k.value(m.specular), k.value(m.exponent), k.value(m.ior);
-    k.value(m.absorption), k.value(m.two_sided_emission);
+    k.value(m.absorption), k.value(m.two_sided_emission), k.value(m.metallic), k.value(m.roughness);
+    k.value(m.transmission_tint), k.value(m.thin_walled);
   }
-  for (const rc::Light& l : scene.punctual_lights) k.value(l);
+  for (const rc::Light& l : scene.punctual_lights) {
+    k.value(l.kind), k.value(l.position), k.value(l.direction), k.value(l.intensity), k.value(l.irradiance);
+    k.value(l.radiance), k.value(l.cos_inner), k.value(l.cos_outer);
+    if (l.map) k.value(l.map->width()), k.value(l.map->rotate_degrees()), k.vector(l.map->texels());
+  }
   k.value(camera), k.value(o.width), k.value(o.height), k.value(o.reference_time), k.value(o.seed);
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(k.h));
@@ -248,7 +254,7 @@ void run_compare(const CompareOptions& o) {
   const fs::path parent = fs::absolute(o.output).parent_path();
   if (!fs::is_directory(parent)) throw rc::InputError("-o " + o.output + ": folder " + parent.string() + " does not exist");
 
-  const rc::Scene scene = rc::load_scene(o.scene);
+  const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: every image will be black\n";
   const rc::Camera camera = scene.effective_camera();
@@ -312,6 +318,7 @@ std::function<void()> add_compare_command(CLI::App& app) {
   auto o = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand("compare", "Render every method at every time budget and report error against time");
   cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
+  add_lighting_options(*cmd, o->lighting);
   cmd->add_option("-o,--output", o->output, "Report folder (index.html, metrics.json, metrics.csv, images/)")->required();
   cmd->add_option("--methods", o->methods, "Comma-separated methods (default path,photon,sppm,radiosity,whitted)");
   cmd->add_option("--budgets", o->budgets, "Comma-separated time budgets in seconds (default 1,2,4,8,16)");

@@ -21,6 +21,7 @@ namespace {
 
 struct InfoOptions {
   std::string scene;
+  rc::ExtraLighting lighting;
   bool json = false;
 };
 
@@ -106,7 +107,7 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
 }
 
 void run_info(const InfoOptions& o) {
-  const rc::Scene scene = rc::load_scene(o.scene);
+  const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   std::map<std::string, size_t> lights, materials;
   for (const rc::Light& l : scene.lights()) ++lights[light_kind_name(l.kind)];
@@ -220,6 +221,7 @@ std::function<void()> add_info_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("info", "Describe a scene and what each method will run or skip on it");
   cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
   cmd->add_flag("--json", o->json, "Print the description as one JSON object");
+  add_lighting_options(*cmd, o->lighting);
   return [o] { run_info(*o); };
 }
 

@@ -26,6 +26,7 @@ struct RadiosityOptions {
   std::string scene, output, quantity = "radiance", onto = "elements", fit = "least-squares", check_points_file;
   radiosity::SolverSettings solver;
   radiosity::CheckSettings check;
+  rc::ExtraLighting lighting;
   int check_points = 0;  ///< 0: no check
   int lightmap = 0;      ///< 0: no lightmap
   bool onto_given = false, fit_given = false;
@@ -72,7 +73,7 @@ void run_radiosity(RadiosityOptions& o) {
       throw rc::InputError("--check-points " + o.check_points_file + ": folder " + parent.string() + " does not exist");
   }
   const auto start = std::chrono::steady_clock::now();
-  const rc::Scene scene = rc::load_scene(o.scene);
+  const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (lightmap)
     radiosity::check_lightmap_output(o.output, scene);
@@ -340,6 +341,7 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
   cmd->add_option("-o,--output", o->output, "Output mesh (.ply, .obj, .gltf, .glb)")->required();
   add_solver_options(*cmd, o->solver);
+  add_lighting_options(*cmd, o->lighting);
   cmd->add_option("--time", o->solver.time_limit, "Stop after this many seconds")
       ->check(CLI::PositiveNumber)
       ->check(finite_number());

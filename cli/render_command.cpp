@@ -28,6 +28,7 @@ namespace {
 
 struct RenderOptions {
   std::string scene;
+  rc::ExtraLighting lighting;
   std::string output;
   std::string method = "path";
   std::optional<int> spp, width, height;
@@ -88,7 +89,7 @@ void check_output(const std::string& path) {
 
 void run_render(const RenderOptions& o) {
   check_output(o.output);
-  rc::Scene scene = rc::load_scene(o.scene);
+  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: the image will be black\n";
 
@@ -228,6 +229,7 @@ std::function<void()> add_render_command(CLI::App& app) {
       ->check(CLI::Range(1e-3f, 0.999f))
       ->check(finite_number());
   add_solver_options(*cmd, o->solver);
+  add_lighting_options(*cmd, o->lighting);
   cmd->add_option_function<std::string>(
          "--radiosity-view",
          [o](const std::string& name) {

@@ -122,8 +122,7 @@ rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
     if (!hit) {
-      for (const rc::Light& l : scene_.lights())
-        if (l.kind == rc::LightKind::environment) radiance += beta * l.radiance;
+      radiance += beta * rc::environment_radiance(scene_.lights(), glm::normalize(ray.direction));
       break;
     }
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
@@ -202,7 +201,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
                                     choice.pmf(uint32_t(li)) * rc::light_pdf(scene_, lights[li], si, dir, si));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
-          gathered += g * lights[li].radiance * w;
+          gathered += g * rc::environment_radiance(lights[li], dir) * w;
         }
         break;
       }

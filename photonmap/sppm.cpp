@@ -93,8 +93,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           ++local_rays;
           const std::optional<rc::Hit> hit = scene.intersect(ray);
           if (!hit) {
-            for (const rc::Light& l : lights)
-              if (l.kind == rc::LightKind::environment) direct += beta * l.radiance;
+            direct += beta * rc::environment_radiance(lights, glm::normalize(ray.direction));
             break;
           }
           const rc::SurfaceInteraction si = scene.surface(ray, *hit);

@@ -301,19 +301,20 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const
                         uint64_t& rays) {
   const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));  // rays take the origins in turn
   if (light.kind == rc::LightKind::environment) {
-    // E = L ∫ V cos dω, by cosine-weighted stratified directions: π L · (fraction unblocked).
+    // E = ∫ L V cos dω, by cosine-weighted stratified directions: π times the mean of L over
+    // the unblocked ones (π L times the fraction unblocked for a constant sky).
     const rc::Frame frame = rc::Frame::from_normal(n);
     const int side = std::max(1, int(std::sqrt(double(samples))));
-    int open = 0;
+    Rgb open(0.0f);
     for (int i = 0; i < side; ++i)
       for (int j = 0; j < side; ++j) {
         const rc::Vec2 u((i + rng.uniform()) / side, (j + rng.uniform()) / side);
         ++rays;
         const rc::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
-        open += !geometry.occluded(
-            rc::spawn_shadow_ray_to_infinity(at, frame.to_world(rc::sample_cosine_hemisphere(u))));
+        const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(u));
+        if (!geometry.occluded(rc::spawn_shadow_ray_to_infinity(at, w))) open += rc::environment_radiance(light, w);
       }
-    return light.radiance * (kPi * float(open) / float(side * side));
+    return open * (kPi / float(side * side));
   }
   const rc::LightSample ls = rc::sample_light(scene, light, from[first], rng.uniform2());
   const float cos_theta = glm::dot(ls.wi, n);
@@ -364,8 +365,8 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
             if (light.kind == rc::LightKind::environment) {
               const int k = pairing[size_t(i * side + j)];
               const rc::Vec2 u((k / side + rng.uniform()) / side, (k % side + rng.uniform()) / side);
-              if (!geometry.occluded(rc::spawn_shadow_ray_to_infinity(at, frame.to_world(rc::sample_cosine_hemisphere(u)))))
-                sum += light.radiance * kPi;
+              const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(u));
+              if (!geometry.occluded(rc::spawn_shadow_ray_to_infinity(at, w))) sum += rc::environment_radiance(light, w) * kPi;
               continue;
             }
             const rc::LightSample ls = rc::sample_light(scene, light, at, rng.uniform2());

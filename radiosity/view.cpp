@@ -90,8 +90,6 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
 
   // Geometry 0: every element; then the scene's specular meshes and spheres.
   display_ = element_scene(scene, mesh);
-  for (const rc::Light& l : scene.punctual_lights)
-    if (l.kind == rc::LightKind::environment) environment_ += l.radiance;
 }
 
 Rgb RadiosityView::radiance(const rc::Ray& ray, rc::SampleContext& ctx) const {
@@ -148,7 +146,7 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    if (!hit) return via_specular ? out + beta * environment_ : out;
+    if (!hit) return via_specular ? out + beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction)) : out;
     const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
     rc::Material textured;
     const rc::Material& mj = scene_.shading_material(sj, textured);
@@ -195,7 +193,7 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = display_.intersect(ray);
-    if (!hit) return beta * environment_;
+    if (!hit) return beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
     const rc::SurfaceInteraction si = display_.surface(ray, *hit);
     if (hit->geom_id == 0) {
       // Radiosity is solved for the element fronts; their backs are not part of the answer.
@@ -220,7 +218,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    if (!hit) return radiance + beta * environment_;
+    if (!hit) return radiance + beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
     rc::Material textured;
     const rc::Material& m = scene_.shading_material(si, textured);

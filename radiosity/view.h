@@ -90,7 +90,6 @@ class RadiosityView {
   bool has_specular_ = false;                ///< the scene has mirrors or glass
   std::vector<std::array<uint32_t, 3>> elements_;
   float reach_ = 0.0f;                       ///< how far from an element the two-pass view looks it up
-  Rgb environment_{0.0f};
 };
 
 }  // namespace gilt::radiosity

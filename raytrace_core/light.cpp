@@ -121,16 +121,24 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
       ls.shadow_ray = spawn_shadow_ray_to_infinity(ref, ls.wi);
       return ls;
     case LightKind::environment:
-      ls.wi = sample_uniform_sphere(u);
-      ls.pdf = uniform_sphere_pdf();
-      ls.radiance = light.radiance;
+      if (light.map) {  // by the map's power
+        const EnvironmentMap::Sample s = light.map->sample(u);
+        if (!(s.pdf > 0.0f)) return ls;
+        ls.wi = s.wi;
+        ls.pdf = s.pdf;
+        ls.radiance = light.radiance * s.radiance;
+      } else {
+        ls.wi = sample_uniform_sphere(u);
+        ls.pdf = uniform_sphere_pdf();
+        ls.radiance = light.radiance;
+      }
       ls.shadow_ray = spawn_shadow_ray_to_infinity(ref, ls.wi);
       return ls;
   }
   return ls;
 }
 
-float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref, const Vec3& /*wi*/,
+float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref, const Vec3& wi,
                 const SurfacePoint& on_light) {
   switch (light.kind) {
     case LightKind::area_triangle:
@@ -141,7 +149,7 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
         return area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, on_light);
       return 1.0f / (2.0f * kPi * sphere_cone(s, ref.p).one_minus_cos);
     }
-    case LightKind::environment: return uniform_sphere_pdf();
+    case LightKind::environment: return light.map ? light.map->pdf(wi) : uniform_sphere_pdf();
     case LightKind::point:
     case LightKind::spot:
     case LightKind::directional: return 0.0f;
@@ -198,7 +206,17 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
     case LightKind::environment: {
       // A disk of the bounding radius, perpendicular to the direction of travel, just outside
       // the bounding sphere: every line through the scene crosses it.
-      const Vec3 w = light.kind == LightKind::directional ? light.direction : -sample_uniform_sphere(u_direction);
+      Vec3 w = light.direction;
+      Rgb radiance_over_pdf(0.0f);  // environment: L(−w) / pdf(−w)
+      if (light.kind == LightKind::environment && light.map) {
+        const EnvironmentMap::Sample s = light.map->sample(u_direction);
+        if (!(s.pdf > 0.0f)) return es;
+        w = -s.wi;
+        radiance_over_pdf = light.radiance * s.radiance / s.pdf;
+      } else if (light.kind == LightKind::environment) {
+        w = -sample_uniform_sphere(u_direction);
+        radiance_over_pdf = light.radiance / uniform_sphere_pdf();
+      }
       const Bounds3& b = scene.bounds();
       const Vec3 center = 0.5f * (b.lo + b.hi);
       const float radius = std::max(b.radius(), 1e-30f);
@@ -207,12 +225,22 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
       es.ray = Ray{center - w * (1.01f * radius) + frame.s * d.x + frame.t * d.y, w};
       es.normal = w;
       const float disk_area = kPi * radius * radius;
-      es.power = light.kind == LightKind::directional ? light.irradiance * disk_area
-                                                       : light.radiance * (disk_area / uniform_sphere_pdf());
+      es.power = light.kind == LightKind::directional ? light.irradiance * disk_area : radiance_over_pdf * disk_area;
       return es;
     }
   }
   return es;
+}
+
+Rgb environment_radiance(const Light& light, const Vec3& w) {
+  return light.map ? light.radiance * light.map->radiance(w) : light.radiance;
+}
+
+Rgb environment_radiance(std::span<const Light> lights, const Vec3& w) {
+  Rgb sum(0.0f);
+  for (const Light& l : lights)
+    if (l.kind == LightKind::environment) sum += environment_radiance(l, w);
+  return sum;
 }
 
 Rgb light_power(const Scene& scene, const Light& light) {
@@ -229,7 +257,10 @@ Rgb light_power(const Scene& scene, const Light& light) {
       // ∫ falloff over the sphere: full cone to cos_inner, then the smoothstep band (its mean is ½).
       return light.intensity * (2.0f * kPi * (1.0f - 0.5f * (light.cos_inner + light.cos_outer)));
     case LightKind::directional: return light.irradiance * (kPi * scene_radius * scene_radius);
-    case LightKind::environment: return light.radiance * (4.0f * kPi * kPi * scene_radius * scene_radius);
+    case LightKind::environment: {
+      const Rgb mean = light.map ? light.radiance * light.map->mean_radiance() : light.radiance;
+      return mean * (4.0f * kPi * kPi * scene_radius * scene_radius);
+    }
   }
   return Rgb(0.0f);
 }

@@ -3,7 +3,10 @@
 // constant environment, and sampling of each from a point to be lit.
 
 #include <cstdint>
+#include <memory>
+#include <span>
 
+#include "raytrace_core/environment_map.h"
 #include "raytrace_core/material.h"
 #include "raytrace_core/ray.h"
 #include "raytrace_core/rgb.h"
@@ -19,7 +22,7 @@ enum class LightKind : uint8_t {
   point,          ///< isotropic point: `intensity` in W·sr⁻¹
   spot,           ///< point with a cone: `intensity` on the axis, smooth falloff from inner to outer
   directional,    ///< parallel light along `direction`: `irradiance` in W·m⁻² on a perpendicular plane
-  environment,    ///< constant radiance from every direction at infinity
+  environment,    ///< radiance from every direction at infinity: constant, or an image (`map`)
 };
 
 /// One light. Area lights take their radiance from the material of their primitive.
@@ -30,7 +33,8 @@ struct Light {
   Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis, or direction of travel of directional light (unit)
   Rgb intensity{0.0f};                ///< point, spot: W·sr⁻¹
   Rgb irradiance{0.0f};               ///< directional: W·m⁻²
-  Rgb radiance{0.0f};                 ///< environment: W·sr⁻¹·m⁻²
+  Rgb radiance{0.0f};                 ///< environment: W·sr⁻¹·m⁻², times the map's texel when there is one
+  std::shared_ptr<const EnvironmentMap> map;  ///< environment: an image of the sky (else constant)
   float cos_inner = 1.0f, cos_outer = 0.0f;  ///< spot cone, cosines of the half angles
 };
 
@@ -63,11 +67,19 @@ struct EmissionSample {
 /// Samples an emitted ray from `light`: area lights uniformly by area and cosine-distributed in
 /// direction (either side if two-sided), point lights uniformly over the sphere, spot lights
 /// uniformly inside the outer cone, directional and environment light from a disk of the scene's
-/// bounding radius facing the direction of travel. Zero power when the sample carries none.
+/// bounding radius facing the direction of travel (an environment map's directions drawn by its
+/// importance sampling). Zero power when the sample carries none.
 EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_position, Vec2 u_direction);
 
 /// Emitted power of the light in W (per channel), used to choose lights in proportion to power.
 Rgb light_power(const Scene& scene, const Light& light);
+
+/// Radiance of environment light `light` arriving from direction w (unit, pointing away from the
+/// scene): its constant radiance, times its map's texel in that direction when it has a map.
+Rgb environment_radiance(const Light& light, const Vec3& w);
+/// The sum of environment_radiance over the environment lights among `lights`: what a ray that
+/// leaves the scene along w sees.
+Rgb environment_radiance(std::span<const Light> lights, const Vec3& w);
 
 /// Radiance emitted by a surface of material m towards direction w leaving it (front = ng side).
 Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w);

@@ -30,7 +30,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
           const float light_pdf_v = light_choice.pmf(uint32_t(li)) * light_pdf(scene, lights[li], prev, -wo_world, prev);
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
-        radiance += beta * lights[li].radiance * weight;
+        radiance += beta * environment_radiance(lights[li], -wo_world) * weight;
       }
       break;
     }

@@ -99,4 +99,13 @@ uint32_t Distribution1D::sample(float u) const {
   return static_cast<uint32_t>(it - cdf_.begin());
 }
 
+uint32_t Distribution1D::sample(float u, float& remapped) const {
+  const uint32_t i = sample(u);
+  remapped = 0.0f;
+  if (size() == 0) return i;
+  const double lo = i > 0 ? cdf_[i - 1] : 0.0, width = cdf_[i] - lo;
+  remapped = width > 0.0 ? std::clamp(float((double(u) - lo) / width), 0.0f, kOneMinusEpsilon) : 0.0f;
+  return i;
+}
+
 }  // namespace gilt::raytrace_core

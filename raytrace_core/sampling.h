@@ -45,6 +45,9 @@ class Distribution1D {
 
   /// Index drawn with probability pmf(index); `u` in [0, 1).
   uint32_t sample(float u) const;
+  /// The same index, and in `remapped` where u fell inside its bin, stretched back to [0, 1): a
+  /// second uniform for sampling within the bin.
+  uint32_t sample(float u, float& remapped) const;
   /// Probability of drawing index i.
   float pmf(uint32_t i) const { return total_ > 0.0f ? weights_[i] / total_ : 0.0f; }
   /// Number of entries with any weight (0 for an empty or all-zero distribution).

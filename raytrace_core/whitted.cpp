@@ -9,17 +9,10 @@
 namespace gilt::raytrace_core {
 namespace {
 
-Rgb environment_radiance(const Scene& scene) {
-  Rgb sum(0.0f);
-  for (const Light& l : scene.lights())
-    if (l.kind == LightKind::environment) sum += l.radiance;
-  return sum;
-}
-
 Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings, int depth) {
   ++ctx.rays;
   const std::optional<Hit> hit = scene.intersect(ray);
-  if (!hit) return environment_radiance(scene);
+  if (!hit) return environment_radiance(scene.lights(), glm::normalize(ray.direction));
   const SurfaceInteraction si = scene.surface(ray, *hit);
   Material textured;
   const Material& m = scene.shading_material(si, textured);

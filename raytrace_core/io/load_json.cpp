@@ -327,9 +327,22 @@ class JsonSceneReader {
       light.direction = vec3(j, "direction", p, std::nullopt);
       light.irradiance = colour(j, "irradiance", p, std::nullopt);
     } else if (type == "environment") {
-      object(j, p, {"type", "radiance"});
+      object(j, p, {"type", "radiance", "file", "scale", "rotate_deg"});
       light.kind = LightKind::environment;
-      light.radiance = colour(j, "radiance", p, std::nullopt);
+      if (field(j, "file")) {  // an image: its texels times `scale`, tinted by `radiance` (default 1)
+        const fs::path relative = string(j, "file", p);
+        const fs::path image = relative.is_absolute() ? relative : path_.parent_path() / relative;
+        std::error_code ec;
+        if (!fs::is_regular_file(image, ec)) fail(at(p, "file"), "no such file '" + image.string() + "'");
+        const float scale = number(j, "scale", p, 1.0f), rotate = number(j, "rotate_deg", p, 0.0f);
+        if (!(scale >= 0.0f)) fail(at(p, "scale"), "must not be negative");
+        light.radiance = colour(j, "radiance", p, Rgb(1.0f));
+        light.map = EnvironmentMap::load(image.string(), scale, rotate);
+      } else {
+        for (const char* key : {"scale", "rotate_deg"})
+          if (field(j, key)) fail(at(p, key), "needs \"file\" (an environment image)");
+        light.radiance = colour(j, "radiance", p, std::nullopt);
+      }
     } else {
       fail(at(p, "type"), "unknown light '" + type + "' (expected point, spot, directional or environment)");
     }

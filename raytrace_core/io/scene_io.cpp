@@ -77,8 +77,23 @@ Scene load_scene_file(const std::string& path) {
   return scene;
 }
 
-Scene load_scene(const std::string& path_or_name) {
+Scene load_scene(const std::string& path_or_name) { return load_scene(path_or_name, ExtraLighting{}); }
+
+Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra) {
   Scene scene = is_builtin_scene(path_or_name) ? builtin_scene(path_or_name) : load_scene_file(path_or_name);
+  if (!extra.env_file.empty()) {
+    std::error_code ec;
+    if (!fs::is_regular_file(extra.env_file, ec)) throw InputError("--env " + extra.env_file + ": no such file");
+    const size_t before = scene.punctual_lights.size();
+    std::erase_if(scene.punctual_lights, [](const Light& l) { return l.kind == LightKind::environment; });
+    if (scene.punctual_lights.size() != before)
+      scene.warnings.push_back("the scene's own environment light is replaced by --env " + extra.env_file);
+    Light env;
+    env.kind = LightKind::environment;
+    env.radiance = Rgb(1.0f);
+    env.map = EnvironmentMap::load(extra.env_file, extra.env_scale, extra.env_rotate_degrees);
+    scene.punctual_lights.push_back(env);
+  }
   try {
     scene.commit();
   } catch (const InputError& e) {

@@ -13,6 +13,17 @@ namespace gilt::raytrace_core {
 /// or field.
 Scene load_scene(const std::string& path_or_name);
 
+/// Light given on the command line rather than in the scene file.
+struct ExtraLighting {
+  std::string env_file;             ///< an environment image (`--env`); empty: none
+  float env_scale = 1.0f;           ///< its radiance multiplier (`--env-scale`)
+  float env_rotate_degrees = 0.0f;  ///< its turn about +y (`--env-rotate`)
+};
+
+/// load_scene, with `extra`'s lights added before the commit. An environment image replaces the
+/// scene's own environment light, with a warning.
+Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra);
+
 /// Loads a scene file without committing it (so callers may still edit it).
 Scene load_scene_file(const std::string& path);
 

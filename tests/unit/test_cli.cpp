@@ -138,6 +138,7 @@ TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
   const fs::path bad_obj = write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
   const fs::path nan_obj = write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
   const fs::path bad_json = write("bad.json", "{\n  \"meshes\": [\n    oops\n  ]\n}\n");
+  const fs::path not_image = write("sky.hdr", "not an image");
   const std::vector<BadCase> cases = {
       {"missing file", "render " + (dir_ / "nope.obj").string() + " -o " + out, "nope.obj"},
       {"unknown scene type", "render " + write("scene.xyz", "x").string() + " -o " + out, "scene.xyz"},
@@ -159,6 +160,12 @@ TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
       {"missing output folder", "render cornell -o " + (dir_ / "no/such/dir/out.png").string(), "does not exist"},
       {"no output", "render cornell", "--output"},
       {"no subcommand", "", "subcommand"},
+      {"missing environment image", "render cornell --env " + (dir_ / "none.exr").string() + " -o " + out, "--env"},
+      {"environment not an image", "render cornell --env " + not_image.string() + " -o " + out, "sky.hdr"},
+      {"negative environment scale", "render cornell --env " + not_image.string() + " --env-scale -1 -o " + out,
+       "--env-scale"},
+      {"NaN environment turn", "render cornell --env " + not_image.string() + " --env-rotate nan -o " + out,
+       "--env-rotate"},
   };
   const size_t files_before = file_count();
   for (const BadCase& c : cases) {
@@ -168,6 +175,31 @@ TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
     EXPECT_FALSE(fs::exists(out)) << c.name << " left an output file";
     EXPECT_EQ(file_count(), files_before) << c.name << " left a file behind";
   }
+}
+
+// --env lights a scene with an image: here a render of the Cornell box used as a sky over an
+// open floor, which the scene's own constant sky gives way to, with a warning. Every method
+// renders it, and `info` lists it.
+TEST_F(Cli, EnvironmentImageLightsEveryMethod) {
+  const fs::path sky = dir_ / "sky.exr";
+  ASSERT_EQ(run("render cornell --spp 1 --width 32 --height 16 -q -o '" + sky.string() + "'").code, 0);
+  const fs::path scene = write("floor.json", R"({
+    "materials": {"grey": {"albedo": 0.5}},
+    "shapes": [{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "grey"}],
+    "lights": [{"type": "environment", "radiance": 0.2}],
+    "camera": {"look_from": [0, 2, 3], "look_at": [0, 0, 0], "vfov": 40}
+  })");
+  for (const char* method : {"path", "whitted", "photon", "sppm", "radiosity"}) {
+    const fs::path out = dir_ / (std::string(method) + ".exr");
+    const Result r = run("render '" + scene.string() + "' --env '" + sky.string() + "' --env-scale 2 --env-rotate 45 --method " +
+                         method + " --spp 2 --width 16 --height 12 -q -o '" + out.string() + "'");
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    EXPECT_TRUE(fs::exists(out)) << method;
+    EXPECT_NE(r.err.find("replaced by --env"), std::string::npos) << method << ": " << r.err;
+  }
+  const Result info = run("info '" + scene.string() + "' --env '" + sky.string() + "'");
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_NE(info.out.find("1 environment"), std::string::npos) << info.out;
 }
 
 TEST_F(Cli, FailedRunDoesNotClobberExistingOutput) {

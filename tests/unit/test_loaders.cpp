@@ -689,6 +689,36 @@ TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
   EXPECT_EQ(load_scene(path).lights().size(), 2u + 4u);
 }
 
+// An environment light from an image: its path relative to the JSON file, `scale` multiplying its
+// texels, `rotate_deg` turning it, `radiance` a tint (default 1). Misused fields are errors.
+TEST_F(Loaders, JsonEnvironmentImage) {
+  Image sky;
+  sky.width = 8, sky.height = 4;
+  sky.pixels.assign(32, Rgb(0.25f, 0.5f, 1.0f));
+  write_image(write("skies/sky.exr", ""), sky);
+  const std::string path = write("env.json", R"({
+    "lights": [{"type": "environment", "file": "skies/sky.exr", "scale": 2, "rotate_deg": 30}]})");
+  const Scene scene = load_scene_file(path);
+  ASSERT_EQ(scene.punctual_lights.size(), 1u);
+  const Light& env = scene.punctual_lights[0];
+  ASSERT_TRUE(env.map);
+  EXPECT_EQ(env.radiance, Rgb(1.0f));
+  EXPECT_EQ(env.map->rotate_degrees(), 30.0f);
+  EXPECT_EQ(environment_radiance(env, Vec3(0.0f, 1.0f, 0.0f)), Rgb(0.5f, 1.0f, 2.0f));
+  EXPECT_CONTAINS(error_of([&] {
+                    load_scene(write("a.json", R"({"lights": [{"type": "environment", "radiance": 1, "scale": 2}]})"));
+                  }),
+                  "a.json: /lights/0/scale: needs \"file\"");
+  EXPECT_CONTAINS(error_of([&] {
+                    load_scene(write("b.json", R"({"lights": [{"type": "environment", "file": "none.exr"}]})"));
+                  }),
+                  "b.json: /lights/0/file: no such file");
+  EXPECT_CONTAINS(error_of([&] {
+                    load_scene(write("c.json", R"({"lights": [{"type": "environment", "file": "skies/sky.exr", "scale": -1}]})"));
+                  }),
+                  "c.json: /lights/0/scale: must not be negative");
+}
+
 TEST_F(Loaders, JsonBadInputNamesTheField) {
   const std::string malformed =
       write("malformed.json", "{\n  \"materials\": {\n    \"a\": {\"albedo\": 0.5,,}\n  }\n}\n");
