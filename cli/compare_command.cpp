@@ -171,6 +171,7 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
 void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& ref) {
   const rc::ImageError error = rc::image_error(image, ref);
   e.rmse = error.rmse, e.relmse = error.relmse, e.mae = error.mae, e.mre = error.mean_relative;
+  e.mean_ratio = error.mean_ratio;
 }
 
 /// Radiosity against the path tracer in object space: at up to 64 element centroids (where the
@@ -276,7 +277,7 @@ void run_compare(const CompareOptions& o) {
   rc::RenderSettings settings;
   settings.width = o.width, settings.height = o.height, settings.seed = o.seed, settings.threads = o.threads;
   settings.progress = false;
-  if (!o.quiet) std::printf("  method     budget s  actual s  relMSE      mean rel. error\n");
+  if (!o.quiet) std::printf("  method     budget s  actual s  relMSE      mean rel. error  mean / reference\n");
   for (double budget : budgets) {
     for (const std::string& m : methods) {
       settings.time_limit = budget;
@@ -303,7 +304,8 @@ void run_compare(const CompareOptions& o) {
       rc::write_image((folder / e.image_png).string(), rc::Image{o.width, o.height, pixels}, o.exposure);
       write_error_png(folder / e.error_png, pixels, ref.pixels, o.width, o.height);
       if (!o.quiet)
-        std::printf("  %-9s  %8g  %8.2f  %-10.4g  %.2f %%\n", m.c_str(), budget, e.seconds, e.relmse, 100 * e.mre);
+        std::printf("  %-9s  %8g  %8.2f  %-10.4g  %6.2f %%         %.4f\n", m.c_str(), budget, e.seconds, e.relmse,
+                    100 * e.mre, e.mean_ratio);
       std::fflush(stdout);
       report.entries.push_back(e);
     }

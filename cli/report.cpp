@@ -123,18 +123,18 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
                       {"relmse_epsilon", 0.01},  {"entries", nlohmann::json::array()}};
   std::ostringstream csv;
   csv << "method,budget_seconds,seconds,spp_or_iterations,photons,shots,rmse,relmse,mae,mean_relative_error,"
-         "object_space_error,image\n";
+         "mean_ratio,object_space_error,image\n";
   for (const ReportEntry& e : r.entries) {
     nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
                          {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
                          {"rmse", e.rmse}, {"relmse", e.relmse}, {"mae", e.mae}, {"mean_relative_error", e.mre},
-                         {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
+                         {"mean_ratio", e.mean_ratio}, {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
                          {"notes", e.notes}};
     je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
     j["entries"].push_back(je);
     csv << e.method << ',' << e.budget << ',' << number(e.seconds, "%.4f") << ',' << e.spp << ',' << e.photons << ','
         << e.shots << ',' << number(e.rmse, "%.6g") << ',' << number(e.relmse, "%.6g") << ','
-        << number(e.mae, "%.6g") << ',' << number(e.mre, "%.6g") << ','
+        << number(e.mae, "%.6g") << ',' << number(e.mre, "%.6g") << ',' << number(e.mean_ratio, "%.6g") << ','
         << (e.object_space_error ? number(*e.object_space_error, "%.6g") : std::string()) << ',' << e.image_exr
         << '\n';
   }
@@ -207,7 +207,7 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
 
   h << "<h2>Metrics</h2>\n<table id=\"metrics\"><tr><th>method</th><th>budget s</th><th>actual s</th>"
        "<th>spp / iterations</th><th>photons</th><th>shots</th><th>RMSE</th><th>relMSE</th><th>MAE</th>"
-       "<th>mean rel. error</th><th>object-space error</th></tr>\n";
+       "<th>mean rel. error</th><th>mean / reference</th><th>object-space error</th></tr>\n";
   for (const ReportEntry& e : r.entries) {
     double best = 1e300;
     for (const ReportEntry& o : r.entries)
@@ -217,10 +217,11 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
       << e.photons << "</td><td>" << e.shots << "</td><td>" << number(e.rmse, "%.4g") << "</td><td"
       << (e.relmse == best ? " class=\"best\"" : "") << ">" << number(e.relmse, "%.4g") << "</td><td>"
       << number(e.mae, "%.4g") << "</td><td>" << number(100 * e.mre, "%.2f") << " %</td><td>"
-      << (e.object_space_error ? number(100 * *e.object_space_error, "%.2f") + " %" : std::string("")) << "</td></tr>\n";
+      << number(e.mean_ratio, "%.4f") << "</td><td>" << (e.object_space_error ? number(100 * *e.object_space_error, "%.2f") + " %" : std::string("")) << "</td></tr>\n";
   }
   h << "</table>\n<p>relMSE = mean over pixels and channels of (I &minus; R)&sup2; / (R&sup2; + 0.01). Times include "
-       "each method's preparation (radiosity solve, photon tracing). Object-space error: radiosity vertex radiance "
+       "each method's preparation (radiosity solve, photon tracing). Mean / reference: the image's sum over pixels and "
+       "channels over the reference's, its bias in overall brightness. Object-space error: radiosity vertex radiance "
        "against path-traced estimates at sampled vertices. Files: <a href=\"metrics.json\">metrics.json</a>, "
        "<a href=\"metrics.csv\">metrics.csv</a>.</p>\n</body>\n</html>\n";
   write_file(folder / "index.html", h.str());

@@ -23,6 +23,7 @@ struct ReportEntry {
   double relmse = 0.0;         ///< mean (I − R)² / (R² + 0.01)
   double mae = 0.0;            ///< mean |I − R|
   double mre = 0.0;            ///< mean |I − R| / (R + 0.01), the measure of gilt's benchmarks
+  double mean_ratio = 1.0;     ///< Σ I / Σ R: the image's overall brightness against the reference's
   std::optional<double> object_space_error;  ///< radiosity: vertex radiance against path-traced estimates
   std::string image_png, image_exr, error_png;  ///< relative to the report folder
   std::vector<std::string> notes;

@@ -14,9 +14,12 @@ struct ImageError {
   double relmse = 0.0;         ///< mean (I − R)² / (R² + 0.01)
   double mae = 0.0;            ///< mean |I − R|
   double mean_relative = 0.0;  ///< mean |I − R| / (R + 0.01); ε keeps black pixels from dominating
+  /// Σ I / Σ R over pixels and channels: a method's bias in overall brightness, which the
+  /// measures above mix with its noise (1 when the reference is black).
+  double mean_ratio = 1.0;
 };
 
-/// All four measures; throws std::invalid_argument when the sizes differ.
+/// All the measures; throws std::invalid_argument when the sizes differ.
 ImageError image_error(std::span<const Rgb> image, std::span<const Rgb> reference);
 
 /// mean |I − R| / (R + 0.01) over pixels and channels.

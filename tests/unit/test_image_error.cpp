@@ -22,5 +22,8 @@ TEST(ImageError, MatchesHandComputedValues) {
   EXPECT_NEAR(e.mean_relative, d / (r + 0.01) / 2, 1e-12);
   EXPECT_EQ(rc::mean_relative_error(image, reference), e.mean_relative);
   EXPECT_EQ(rc::image_error(reference, reference).rmse, 0.0);
+  // Brightness: (0.5 + 1) / (0.4 + 1) in every channel; a black reference reads 1.
+  EXPECT_NEAR(e.mean_ratio, (double(0.5f) + 1.0) / (r + 1.0), 1e-12);
+  EXPECT_EQ(rc::image_error(image, std::vector<rc::Rgb>(2, rc::Rgb(0.0f))).mean_ratio, 1.0);
   EXPECT_THROW(rc::image_error(image, std::vector<rc::Rgb>(1)), std::invalid_argument);
 }
