@@ -12,8 +12,9 @@ uniform background radiance is added back as rgb + (1 - alpha) L, which is exact
 
 Regions: "image" (every pixel), "objects" (alpha > 0.999 in both Cycles halves: pixels that do not
 see the background), and with --spheres one disc per sphere (0.7 of its projected radius, inside
-"objects"), and with --mask the pixels a render of part of the scene covers (alpha > 0.999), inside
-"objects", in all, where Cycles' colour is saturated ((max - min) / max > 0.5) and where it is grey
+"objects"; named by the layout's "label", else by metallic and roughness), and with --mask the
+pixels a render of part of the scene covers (alpha > 0.999), inside "objects", in all, where
+Cycles' colour is saturated ((max - min) / max > 0.5) and where it is grey
 (< 0.1). Per region and channel: mean ratio gilt / Cycles with its 1-sigma noise (from the
 per-pixel variances, pixels being independent), and relMSE = mean((a - b)^2 / (b^2 + 1e-2)) next to
 the value noise alone would give, mean((var a + var b) / (b^2 + 1e-2)).
@@ -135,7 +136,8 @@ def main():
     regions = [("image", np.ones((height, width), bool)), ("objects", objects)]
     if o.spheres:
         for s, m in sphere_masks(json.load(open(o.spheres)), wrapper["camera"], width, height):
-            regions.append(("sphere m=%g r=%g" % (s["metallic"], s["roughness"]), m & objects))
+            label = s.get("label", "sphere m=%g r=%g" % (s["metallic"], s["roughness"]))
+            regions.append((label, m & objects))
     # Saturation of Cycles' pixels: a textured region split into its colourful and its grey pixels
     # has the same ratio in both only if both renderers decode the texture's colours alike.
     sat = (b.max(axis=-1) - b.min(axis=-1)) / (b.max(axis=-1) + 1e-6)

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # gilt's path tracer against Blender Cycles (Debian 12's blender 3.4, CPU) on the same glTF scenes,
-# camera and lights, to check gilt's glTF metallic-roughness material and base-colour textures.
+# camera and lights, to check gilt's glTF metallic-roughness material, base-colour textures and
+# rough glass (KHR_materials_transmission with roughness).
 #   bash bench/cycles/compare.sh [OUT_DIR]                  (default out/cycles-compare)
 # Environment: GILT (the gilt binary; default build/cli/gilt of this checkout), SPP_GILT (2048),
 #   SPP_CYCLES (1024), WIDTH (320), HEIGHT (240), THREADS (2), NICE (10),
-#   CASES ("plane furnace lone spheres spheres-multiggx truck"), SHARED (../shared, for the truck).
+#   CASES ("plane furnace lone spheres spheres-multiggx truck glass glass-multiggx glass-furnace
+#   glass-furnace-multiggx"),
+#   SHARED (../shared, for the truck).
 # Every render is split in two halves of different seeds, whose difference measures the noise.
 # Writes OUT_DIR/results.md (all tables), *.png (gilt | Cycles | log2 luminance ratio gilt/Cycles,
 # +-0.5 stops, red where gilt is brighter), *.json (compare.py), importer.txt (what Blender's glTF
@@ -18,7 +21,7 @@ shared=${SHARED:-$root/../shared}
 out=${1:-$root/out/cycles-compare}
 spp_gilt=${SPP_GILT:-2048} spp_cycles=${SPP_CYCLES:-1024}
 width=${WIDTH:-320} height=${HEIGHT:-240} threads=${THREADS:-2} nice=${NICE:-10}
-cases=${CASES:-plane furnace lone spheres spheres-multiggx truck}
+cases=${CASES:-plane furnace lone spheres spheres-multiggx truck glass glass-multiggx glass-furnace glass-furnace-multiggx}
 py=/usr/bin/python3     # Debian's python, where python3-openimageio installs
 
 command -v blender >/dev/null || { echo "compare.sh: needs blender (apt-get install blender)" >&2; exit 1; }
@@ -54,6 +57,20 @@ cat > spheres-scene.json <<JSON
 {"meshes": [{"file": "spheres.gltf"}],
  $lights,
  $spheres_camera}
+JSON
+# Three solid glass spheres, roughness 0 / 0.3 / 0.6 left to right, on the ground; and the same
+# spheres alone under a uniform sky of radiance 1 (a white furnace: an energy-conserving glass
+# sphere is as bright as the sky, so a sphere's mean radiance is the fraction of energy it keeps).
+glass_camera='"camera": {"look_from": [0, 1.4, 4.6], "look_at": [0, 0.45, 0], "up": [0, 1, 0], "vfov": 34}'
+cat > glass-scene.json <<JSON
+{"meshes": [{"file": "glass.gltf"}],
+ $lights,
+ $glass_camera}
+JSON
+cat > glass-furnace-scene.json <<JSON
+{"meshes": [{"file": "glass-furnace.gltf"}],
+ "lights": [{"type": "environment", "radiance": 1}],
+ $glass_camera}
 JSON
 # The truck: the lights of $shared/scenes/wrap/truck-lit.json, on the ground square; and the truck
 # alone, whose Cycles alpha marks the truck's pixels.
@@ -98,7 +115,8 @@ render_cycles() {
 {
   echo "$("$gilt" --version) ($gilt, sha256 $(sha256sum "$gilt" | cut -c1-12); checkout" \
        "$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo '?')), $(blender --version | head -1);" \
-       "${width}x${height}; gilt $spp_gilt spp, Cycles $spp_cycles spp (plane: an eighth, lone: a quarter)," \
+       "${width}x${height}; gilt $spp_gilt spp, Cycles $spp_cycles spp (plane: an eighth, lone and glass-furnace*:" \
+       "a quarter)," \
        "each as two halves; $threads threads"
   echo
   echo "| case | region | pixels | mean ratio gilt/Cycles R / G / B (±1σ noise) | relMSE | relMSE of noise alone |" \
@@ -116,6 +134,11 @@ for case in $cases; do
     lone) scene=lone-scene.json dist=import div=4 layout=(--spheres lone-layout.json) ;;
     spheres) scene=spheres-scene.json dist=import layout=(--spheres spheres-layout.json) ;;
     spheres-multiggx) scene=spheres-scene.json dist=MULTI_GGX layout=(--spheres spheres-layout.json) ;;
+    glass) scene=glass-scene.json dist=GGX layout=(--spheres glass-layout.json) ;;
+    glass-multiggx) scene=glass-scene.json dist=MULTI_GGX layout=(--spheres glass-layout.json) ;;
+    glass-furnace) scene=glass-furnace-scene.json dist=GGX div=4 layout=(--spheres glass-furnace-layout.json) ;;
+    glass-furnace-multiggx) scene=glass-furnace-scene.json dist=MULTI_GGX div=4
+      layout=(--spheres glass-furnace-layout.json) ;;
     truck) scene=truck-scene.json dist=import layout=(--mask truck=truck-mask.exr)
       nice -n "$nice" blender -b --factory-startup -P "$here/cycles_render.py" -- truck-body-scene.json truck-mask.exr \
         16 "$width" "$height" --threads "$threads" > truck-mask.log 2>&1 || { tail -20 truck-mask.log >&2; exit 1; } ;;
@@ -170,6 +193,32 @@ if ran spheres; then
     $py "$here/sphere_model.py" spheres-scene.json spheres-layout.json "$width" "$height" GGX=spheres.json \
       "${multi[@]}"
     echo; } >> models.md
+fi
+if ran glass-furnace || ran glass-furnace-multiggx; then   # a sphere's radiance over the sky's: energy kept
+  { echo "### glass-furnace: each glass sphere's mean radiance / the sky's (1 for energy-conserving glass)"; echo
+    $py - glass-furnace.json glass-furnace-multiggx.json <<'PY'
+import json, os, sys
+runs = [(f, json.load(open(f))) for f in sys.argv[1:] if os.path.exists(f)]
+sky = next(l for l in json.load(open("glass-furnace-scene.json"))["lights"] if l["type"] == "environment")["radiance"]
+heads = ["gilt"] + ["Cycles " + ("MULTI_GGX" if "multiggx" in f else "GGX") for f, _ in runs]
+print("| sphere | " + " | ".join(heads) + " |\n|---|" + "---|" * len(heads))
+for i, r in enumerate(runs[0][1]):
+    if not r["region"].startswith("glass"):
+        continue
+    cells = ["%.4f ± %.4f" % (r["mean_gilt"][1] / sky, r["sigma_gilt"][1] / sky)]
+    cells += ["%.4f ± %.4f" % (x[i]["mean_cycles"][1] / sky, x[i]["sigma_cycles"][1] / sky) for _, x in runs]
+    print("| %s | %s |" % (r["region"], " | ".join(cells)))
+print()
+PY
+  } >> models.md
+fi
+if ran glass || ran glass-multiggx || ran glass-furnace || ran glass-furnace-multiggx; then
+  furnace=()   # with a furnace case, also trace perfect spheres through both models
+  if ran glass-furnace || ran glass-furnace-multiggx; then
+    furnace=(--furnace glass-furnace-scene.json glass-furnace-layout.json "$width" "$height")
+  fi
+  { echo "### one rough glass interface: reflected and transmitted energy in the two models (no renderer)"; echo
+    $py "$here/glass_albedo.py" "${furnace[@]}"; echo; } >> models.md
 fi
 { echo "### directional albedo of the two BRDF models (no renderer)"; echo
   $py "$here/brdf_albedo.py"; } >> models.md

@@ -7,7 +7,12 @@
 # The same wrapper file drives both renderers, so geometry, lights and camera cannot drift apart:
 #   meshes[].file        glTF files, imported with Blender's own importer (Principled BSDFs); a
 #                        material with metallic 0 and KHR_materials_specular's specularFactor 0, which
-#                        gilt reads as exactly Lambertian, gets a Diffuse BSDF (roughness 0) instead
+#                        gilt reads as exactly Lambertian, gets a Diffuse BSDF (roughness 0) instead.
+#                        Glass (KHR_materials_transmission): the Principled BSDF's Transmission; its
+#                        Roughness is checked against the glTF roughnessFactor (and set if the importer
+#                        did not), and the Volume Absorption of density 0 the importer attaches for
+#                        KHR_materials_volume without attenuation is removed (it absorbs nothing; in
+#                        Cycles a closed mesh with a refracting BSDF is a solid either way)
 #   lights[] directional a delta sun: angle 0, strength = irradiance (W/m^2), shining along `direction`
 #   lights[] environment the world: Background colour = radiance, strength 1
 #   camera               look_from / look_at / up / vfov (vertical, degrees)
@@ -56,8 +61,9 @@ bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 
 # Geometry and materials: Blender's glTF importer, nothing changed but (optionally) the
-# Principled BSDF's microfacet distribution.
+# Principled BSDF's microfacet distribution, the Lambertian ground and the glass's checks (above).
 lambertian = set()   # names of the glTF materials gilt makes diffuse
+glass = {}           # name of a glTF material with transmission > 0.5 (gilt's dielectric): its roughness
 for mesh in wrapper["meshes"]:
     if set(mesh) != {"file"}:
         sys.exit("cycles_render.py: only plain {\"file\": ...} meshes are supported")
@@ -68,6 +74,9 @@ for mesh in wrapper["meshes"]:
             spec = gm.get("extensions", {}).get("KHR_materials_specular", {}).get("specularFactor", 1.0)
             if pbr.get("metallicFactor", 1.0) == 0 and spec == 0 and "name" in gm:
                 lambertian.add(gm["name"])
+            transmission = gm.get("extensions", {}).get("KHR_materials_transmission", {})
+            if transmission.get("transmissionFactor", 0.0) > 0.5 and "name" in gm:
+                glass[gm["name"]] = pbr.get("roughnessFactor", 1.0)
     bpy.ops.import_scene.gltf(filepath=path)
 for mat in bpy.data.materials:
     if not mat.use_nodes:
@@ -97,6 +106,23 @@ for mat in bpy.data.materials:
         if opts["--distribution"] != "import":
             node.distribution = opts["--distribution"]
         inp = node.inputs
+        if mat.name in glass:
+            r = glass[mat.name]
+            if abs(inp["Roughness"].default_value - r) > 1e-6 and not inp["Roughness"].is_linked:
+                print("MATERIAL %s: the importer gave roughness %.3f for the glTF's %.3f; set to %.3f" %
+                      (mat.name, inp["Roughness"].default_value, r, r))
+                inp["Roughness"].default_value = r
+            out = next(n for n in mat.node_tree.nodes if n.type == "OUTPUT_MATERIAL")
+            for link in list(out.inputs["Volume"].links):
+                v = link.from_node
+                if v.type == "VOLUME_ABSORPTION" and v.inputs["Density"].default_value == 0 and \
+                        not v.inputs["Density"].is_linked:
+                    mat.node_tree.nodes.remove(v)
+                    print("MATERIAL %s: removed the importer's Volume Absorption of density 0 (absorbs nothing)" %
+                          mat.name)
+            print("MATERIAL %s: transmission %.3f, transmission_roughness %.3f, volume %s" %
+                  (mat.name, inp["Transmission"].default_value, inp["Transmission Roughness"].default_value,
+                   "linked" if out.inputs["Volume"].is_linked else "none"))
         base = "texture" if inp["Base Color"].is_linked else "%.3f,%.3f,%.3f" % tuple(inp["Base Color"].default_value[:3])
         print("MATERIAL %s: distribution %s (imported %s), base %s, metallic %.3f, roughness %.3f, specular %.3f, "
               "specular_tint %.3f, sheen %.3f, clearcoat %.3f, ior %.3f" %

@@ -18,6 +18,13 @@ OUT_DIR/furnace.gltf, furnace-layout.json  the same 15 spheres without the groun
                       a uniform sky their radiance is a closed form of the BRDF (sphere_model.py)
 OUT_DIR/lone.gltf, lone-layout.json  the ground and the rough metal sphere (metallic 1, roughness 1)
                       of spheres.gltf alone, where it was: the grid without the neighbours
+OUT_DIR/glass.gltf, glass-layout.json  three solid glass spheres (radius 0.5, 64 x 32 segments) in a
+                      row on the ground, left to right roughness 0, 0.3 and 0.6: base colour white,
+                      metallic 0, KHR_materials_transmission 1, KHR_materials_ior 1.5 and
+                      KHR_materials_volume with thicknessFactor 1 and no attenuation (a solid, refracting
+                      glass in gilt; without the volume gilt would make each surface a thin sheet)
+OUT_DIR/glass-furnace.gltf  the same three spheres without the ground (a white furnace under a
+                      uniform sky, where an energy-conserving glass sphere is exactly as bright as the sky)
 
 Buffers are embedded as base64 data URIs, so each .gltf is a single file.
 """
@@ -33,6 +40,10 @@ ROUGHNESS = [0.1, 0.3, 0.5, 0.7, 1.0]
 METALLIC = [0.0, 0.5, 1.0]          # front row first
 SPACING_X, SPACING_Z = 1.0, 1.1
 FURNACE_SPACING = 2.5
+GLASS_RADIUS = 0.5
+GLASS_ROUGHNESS = [0.0, 0.3, 0.6]   # left to right
+GLASS_SPACING = 1.25
+GLASS_IOR = 1.5
 BASE = [0.8, 0.4, 0.2, 1.0]
 GROUND_BASE = [0.5, 0.5, 0.5, 1.0]
 GROUND_HALF = 8.0
@@ -68,11 +79,14 @@ class Builder:
 
     def gltf(self, meshes, materials, nodes):
         uri = "data:application/octet-stream;base64," + base64.b64encode(bytes(self.data)).decode()
-        return {"asset": {"version": "2.0", "generator": "gilt bench/cycles/make_scenes.py"},
-                "extensionsUsed": ["KHR_materials_specular"],
-                "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
-                "materials": materials, "accessors": self.accessors, "bufferViews": self.views,
-                "buffers": [{"byteLength": len(self.data), "uri": uri}]}
+        doc = {"asset": {"version": "2.0", "generator": "gilt bench/cycles/make_scenes.py"},
+               "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
+               "materials": materials, "accessors": self.accessors, "bufferViews": self.views,
+               "buffers": [{"byteLength": len(self.data), "uri": uri}]}
+        used = sorted({e for m in materials for e in m.get("extensions", {})})
+        if used:   # the schema wants at least one name when the list is there
+            doc["extensionsUsed"] = used
+        return doc
 
 
 def uv_sphere(segments=32, rings=16):
@@ -138,12 +152,47 @@ def sphere_grid(out, name, with_ground, spacing_x, spacing_z, keep=lambda m, r: 
         json.dump(spheres, f, indent=1)
 
 
+def glass_row(out, name, with_ground=True):
+    """NAME.gltf: (the ground, mesh 0, material 0, and) one solid glass sphere per roughness, left to
+    right, resting on it; NAME-layout.json: those spheres. A finer tessellation than the grid's,
+    since a refracting sphere magnifies the facets' normal interpolation."""
+    b = Builder()
+    meshes, materials, nodes, spheres = [], [], [], []
+    if with_ground:
+        meshes, materials, nodes = [ground(b)], [ground_material()], [{"mesh": 0, "name": "ground"}]
+    unit_pos, unit_idx = uv_sphere(64, 32)
+    pos_acc = b.vec3([tuple(GLASS_RADIUS * c for c in p) for p in unit_pos])
+    nrm_acc = b.vec3(unit_pos)
+    idx_acc = b.indices(unit_idx)
+    n = len(GLASS_ROUGHNESS)
+    for i, r in enumerate(GLASS_ROUGHNESS):
+        mat = "glass_r%.1f" % r
+        center = [(i - (n - 1) / 2) * GLASS_SPACING, GLASS_RADIUS, 0.0]
+        materials.append({"name": mat,
+                          "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0,
+                                                   "roughnessFactor": r},
+                          "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                                         "KHR_materials_ior": {"ior": GLASS_IOR},
+                                         "KHR_materials_volume": {"thicknessFactor": 1.0}}})
+        meshes.append({"name": mat, "primitives": [{"attributes": {"POSITION": pos_acc, "NORMAL": nrm_acc},
+                                                    "indices": idx_acc, "material": len(materials) - 1}]})
+        nodes.append({"mesh": len(meshes) - 1, "name": mat, "translation": center})
+        spheres.append({"name": mat, "label": "glass r=%g" % r, "center": center, "radius": GLASS_RADIUS,
+                        "metallic": 0.0, "roughness": r, "transmission": 1.0, "ior": GLASS_IOR})
+    with open(os.path.join(out, name + ".gltf"), "w") as f:
+        json.dump(b.gltf(meshes, materials, nodes), f)
+    with open(os.path.join(out, name + "-layout.json"), "w") as f:
+        json.dump(spheres, f, indent=1)
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "."
     os.makedirs(out, exist_ok=True)
     sphere_grid(out, "spheres", True, SPACING_X, SPACING_Z)
     sphere_grid(out, "furnace", False, FURNACE_SPACING, FURNACE_SPACING)
     sphere_grid(out, "lone", True, SPACING_X, SPACING_Z, keep=lambda m, r: m == 1.0 and r == 1.0)
+    glass_row(out, "glass")
+    glass_row(out, "glass-furnace", with_ground=False)
 
     g = Builder()
     with open(os.path.join(out, "ground.gltf"), "w") as f:
