@@ -114,7 +114,8 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
       return ls;
     }
     case LightKind::directional:
-      ls.wi = -light.direction;
+      ls.wi = light.cos_angle < 1.0f ? Frame::from_normal(-light.direction).to_world(sample_uniform_cone(u, light.cos_angle))
+                                     : -light.direction;
       ls.pdf = 1.0f;
       ls.delta = true;
       ls.radiance = light.irradiance;
@@ -206,7 +207,9 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
     case LightKind::environment: {
       // A disk of the bounding radius, perpendicular to the direction of travel, just outside
       // the bounding sphere: every line through the scene crosses it.
-      Vec3 w = light.direction;
+      Vec3 w = light.cos_angle < 1.0f && light.kind == LightKind::directional
+                   ? Frame::from_normal(light.direction).to_world(sample_uniform_cone(u_direction, light.cos_angle))
+                   : light.direction;
       Rgb radiance_over_pdf(0.0f);  // environment: L(−w) / pdf(−w)
       if (light.kind == LightKind::environment && light.map) {
         const EnvironmentMap::Sample s = light.map->sample(u_direction);

@@ -36,6 +36,11 @@ struct Light {
   Rgb radiance{0.0f};                 ///< environment: W·sr⁻¹·m⁻², times the map's texel when there is one
   std::shared_ptr<const EnvironmentMap> map;  ///< environment: an image of the sky (else constant)
   float cos_inner = 1.0f, cos_outer = 0.0f;  ///< spot cone, cosines of the half angles
+  /// Directional: cosine of the angular radius of the disk it comes from (the sun's 0.27°); 1 is
+  /// a point at infinity. Each sample then comes from a direction uniform over the disk, which
+  /// softens shadows; it stays a delta light (BSDF sampling does not find it, mirrors do not
+  /// show it), its irradiance on a plane facing it unchanged.
+  float cos_angle = 1.0f;
 };
 
 /// Light arriving at a point from one sampled position on a light.

@@ -14,6 +14,7 @@
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/loaders.h"
+#include "raytrace_core/sun_sky.h"
 
 namespace gilt::raytrace_core {
 
@@ -81,18 +82,38 @@ Scene load_scene(const std::string& path_or_name) { return load_scene(path_or_na
 
 Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra) {
   Scene scene = is_builtin_scene(path_or_name) ? builtin_scene(path_or_name) : load_scene_file(path_or_name);
-  if (!extra.env_file.empty()) {
-    std::error_code ec;
-    if (!fs::is_regular_file(extra.env_file, ec)) throw InputError("--env " + extra.env_file + ": no such file");
-    const size_t before = scene.punctual_lights.size();
-    std::erase_if(scene.punctual_lights, [](const Light& l) { return l.kind == LightKind::environment; });
-    if (scene.punctual_lights.size() != before)
-      scene.warnings.push_back("the scene's own environment light is replaced by --env " + extra.env_file);
+  if (!extra.env_file.empty() && extra.sky_turbidity > 0.0f) throw InputError("--env and --sky: give one sky, not two");
+  if (extra.sky_turbidity > 0.0f && !extra.sun) throw InputError("--sky needs --sun: the sky is drawn for the sun's position");
+  if (!extra.env_file.empty() || extra.sky_turbidity > 0.0f) {
     Light env;
     env.kind = LightKind::environment;
     env.radiance = Rgb(1.0f);
-    env.map = EnvironmentMap::load(extra.env_file, extra.env_scale, extra.env_rotate_degrees);
+    std::string flag;
+    if (!extra.env_file.empty()) {
+      std::error_code ec;
+      if (!fs::is_regular_file(extra.env_file, ec)) throw InputError("--env " + extra.env_file + ": no such file");
+      env.map = EnvironmentMap::load(extra.env_file, extra.env_scale, extra.env_rotate_degrees);
+      flag = "--env " + extra.env_file;
+    } else {
+      env.map = preetham_sky(sky_direction(extra.sun_elevation_degrees, extra.sun_azimuth_degrees), extra.sky_turbidity);
+      flag = "--sky";
+    }
+    const size_t before = scene.punctual_lights.size();
+    std::erase_if(scene.punctual_lights, [](const Light& l) { return l.kind == LightKind::environment; });
+    if (scene.punctual_lights.size() != before)
+      scene.warnings.push_back("the scene's own environment light is replaced by " + flag);
     scene.punctual_lights.push_back(env);
+  }
+  if (extra.sun) {
+    if (!(extra.sun_elevation_degrees >= -90.0f && extra.sun_elevation_degrees <= 90.0f) ||
+        !std::isfinite(extra.sun_azimuth_degrees) || !(extra.sun_irradiance >= 0.0f) || !std::isfinite(extra.sun_irradiance))
+      throw InputError("--sun: elevation must lie in [-90, 90] degrees, azimuth be finite and irradiance ≥ 0");
+    Light sun;
+    sun.kind = LightKind::directional;
+    sun.direction = -sky_direction(extra.sun_elevation_degrees, extra.sun_azimuth_degrees);
+    sun.irradiance = Rgb(extra.sun_irradiance);
+    sun.cos_angle = std::cos(kSunAngularRadiusDegrees * (kPi / 180.0f));
+    scene.punctual_lights.push_back(sun);
   }
   try {
     scene.commit();

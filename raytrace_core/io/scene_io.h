@@ -18,10 +18,13 @@ struct ExtraLighting {
   std::string env_file;             ///< an environment image (`--env`); empty: none
   float env_scale = 1.0f;           ///< its radiance multiplier (`--env-scale`)
   float env_rotate_degrees = 0.0f;  ///< its turn about +y (`--env-rotate`)
+  bool sun = false;                 ///< a sun (`--sun ELEVATION,AZIMUTH[,IRRADIANCE]`): a 0.53° disk
+  float sun_elevation_degrees = 45.0f, sun_azimuth_degrees = 0.0f, sun_irradiance = 1.0f;
+  float sky_turbidity = 0.0f;       ///< > 0: Preetham's clear sky for the sun's position (`--sky`)
 };
 
-/// load_scene, with `extra`'s lights added before the commit. An environment image replaces the
-/// scene's own environment light, with a warning.
+/// load_scene, with `extra`'s lights added before the commit. An environment image or a sky
+/// replaces the scene's own environment light, with a warning; a sun is added to its lights.
 Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra);
 
 /// Loads a scene file without committing it (so callers may still edit it).

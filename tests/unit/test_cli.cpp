@@ -164,6 +164,10 @@ TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
       {"environment not an image", "render cornell --env " + not_image.string() + " -o " + out, "sky.hdr"},
       {"negative environment scale", "render cornell --env " + not_image.string() + " --env-scale -1 -o " + out,
        "--env-scale"},
+      {"sky without a sun", "render cornell --sky -o " + out, "--sky needs --sun"},
+      {"sun of four numbers", "render cornell --sun 1,2,3,4 -o " + out, "--sun"},
+      {"sun below the nadir", "render cornell --sun -100,0 -o " + out, "--sun"},
+      {"turbidity out of range", "render cornell --sun 40,120 --sky 20 -o " + out, "--sky"},
       {"NaN environment turn", "render cornell --env " + not_image.string() + " --env-rotate nan -o " + out,
        "--env-rotate"},
   };
@@ -200,6 +204,27 @@ TEST_F(Cli, EnvironmentImageLightsEveryMethod) {
   const Result info = run("info '" + scene.string() + "' --env '" + sky.string() + "'");
   ASSERT_EQ(info.code, 0) << info.err;
   EXPECT_NE(info.out.find("1 environment"), std::string::npos) << info.out;
+}
+
+// --sun and --sky light a scene in every method; the sky takes the place of the scene's own.
+TEST_F(Cli, SunAndSkyLightEveryMethod) {
+  const fs::path scene = write("floor.json", R"({
+    "materials": {"grey": {"albedo": 0.5}},
+    "shapes": [{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "grey"}],
+    "lights": [{"type": "environment", "radiance": 0.2}],
+    "camera": {"look_from": [0, 2, 3], "look_at": [0, 0, 0], "vfov": 40}
+  })");
+  for (const char* method : {"path", "whitted", "photon", "sppm", "radiosity"}) {
+    const fs::path out = dir_ / (std::string(method) + ".exr");
+    const Result r = run("render '" + scene.string() + "' --sun 40,120,3 --sky 4 --method " + method +
+                         " --spp 2 --width 16 --height 12 -q -o '" + out.string() + "'");
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    EXPECT_TRUE(fs::exists(out)) << method;
+    EXPECT_NE(r.err.find("replaced by --sky"), std::string::npos) << method << ": " << r.err;
+  }
+  const Result info = run("info '" + scene.string() + "' --sun 40,120 --sky");
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_NE(info.out.find("1 directional; 1 environment"), std::string::npos) << info.out;
 }
 
 TEST_F(Cli, FailedRunDoesNotClobberExistingOutput) {
