@@ -23,7 +23,7 @@ using Result = gilt::test::CliResult;
 using gilt::test::slurp;
 
 class Cli : public ::testing::Test {
- protected:
+ public:
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("gilt-cli-" + std::to_string(::getpid()) + "-" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -181,26 +181,35 @@ TEST_F(Cli, BadInputExitsTwoWithMessageAndNoOutput) {
   }
 }
 
+// An open floor under a constant sky of its own, for the command line's lights to replace.
+const char* kOpenFloor = R"({
+    "materials": {"grey": {"albedo": 0.5}},
+    "shapes": [{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "grey"}],
+    "lights": [{"type": "environment", "radiance": 0.2}],
+    "camera": {"look_from": [0, 2, 3], "look_at": [0, 0, 0], "vfov": 40}
+  })";
+
+// Every method renders `scene` with `flags`, each saying that the scene's sky was `replaced`.
+void expect_every_method_renders(Cli& cli, const fs::path& dir, const fs::path& scene, const std::string& flags,
+                                 const std::string& replaced) {
+  for (const char* method : {"path", "whitted", "photon", "sppm", "radiosity"}) {
+    const fs::path out = dir / (std::string(method) + ".exr");
+    const Result r = cli.run("render '" + scene.string() + "' " + flags + " --method " + method +
+                             " --spp 2 --width 16 --height 12 -q -o '" + out.string() + "'");
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    EXPECT_TRUE(fs::exists(out)) << method;
+    EXPECT_NE(r.err.find("replaced by " + replaced), std::string::npos) << method << ": " << r.err;
+  }
+}
+
 // --env lights a scene with an image: here a render of the Cornell box used as a sky over an
 // open floor, which the scene's own constant sky gives way to, with a warning. Every method
 // renders it, and `info` lists it.
 TEST_F(Cli, EnvironmentImageLightsEveryMethod) {
   const fs::path sky = dir_ / "sky.exr";
   ASSERT_EQ(run("render cornell --spp 1 --width 32 --height 16 -q -o '" + sky.string() + "'").code, 0);
-  const fs::path scene = write("floor.json", R"({
-    "materials": {"grey": {"albedo": 0.5}},
-    "shapes": [{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "grey"}],
-    "lights": [{"type": "environment", "radiance": 0.2}],
-    "camera": {"look_from": [0, 2, 3], "look_at": [0, 0, 0], "vfov": 40}
-  })");
-  for (const char* method : {"path", "whitted", "photon", "sppm", "radiosity"}) {
-    const fs::path out = dir_ / (std::string(method) + ".exr");
-    const Result r = run("render '" + scene.string() + "' --env '" + sky.string() + "' --env-scale 2 --env-rotate 45 --method " +
-                         method + " --spp 2 --width 16 --height 12 -q -o '" + out.string() + "'");
-    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
-    EXPECT_TRUE(fs::exists(out)) << method;
-    EXPECT_NE(r.err.find("replaced by --env"), std::string::npos) << method << ": " << r.err;
-  }
+  const fs::path scene = write("floor.json", kOpenFloor);
+  expect_every_method_renders(*this, dir_, scene, "--env '" + sky.string() + "' --env-scale 2 --env-rotate 45", "--env");
   const Result info = run("info '" + scene.string() + "' --env '" + sky.string() + "'");
   ASSERT_EQ(info.code, 0) << info.err;
   EXPECT_NE(info.out.find("1 environment"), std::string::npos) << info.out;
@@ -208,20 +217,8 @@ TEST_F(Cli, EnvironmentImageLightsEveryMethod) {
 
 // --sun and --sky light a scene in every method; the sky takes the place of the scene's own.
 TEST_F(Cli, SunAndSkyLightEveryMethod) {
-  const fs::path scene = write("floor.json", R"({
-    "materials": {"grey": {"albedo": 0.5}},
-    "shapes": [{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "grey"}],
-    "lights": [{"type": "environment", "radiance": 0.2}],
-    "camera": {"look_from": [0, 2, 3], "look_at": [0, 0, 0], "vfov": 40}
-  })");
-  for (const char* method : {"path", "whitted", "photon", "sppm", "radiosity"}) {
-    const fs::path out = dir_ / (std::string(method) + ".exr");
-    const Result r = run("render '" + scene.string() + "' --sun 40,120,3 --sky 4 --method " + method +
-                         " --spp 2 --width 16 --height 12 -q -o '" + out.string() + "'");
-    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
-    EXPECT_TRUE(fs::exists(out)) << method;
-    EXPECT_NE(r.err.find("replaced by --sky"), std::string::npos) << method << ": " << r.err;
-  }
+  const fs::path scene = write("floor.json", kOpenFloor);
+  expect_every_method_renders(*this, dir_, scene, "--sun 40,120,3 --sky 4", "--sky");
   const Result info = run("info '" + scene.string() + "' --sun 40,120 --sky");
   ASSERT_EQ(info.code, 0) << info.err;
   EXPECT_NE(info.out.find("1 directional; 1 environment"), std::string::npos) << info.out;
