@@ -34,7 +34,7 @@ struct Light {
   Rgb intensity{0.0f};                ///< point, spot: W·sr⁻¹
   Rgb irradiance{0.0f};               ///< directional: W·m⁻²
   Rgb radiance{0.0f};                 ///< environment: W·sr⁻¹·m⁻², times the map's texel when there is one
-  std::shared_ptr<const EnvironmentMap> map;  ///< environment: an image of the sky (else constant)
+  std::shared_ptr<const EnvironmentMap> map{};  ///< environment: an image of the sky (else constant)
   float cos_inner = 1.0f, cos_outer = 0.0f;  ///< spot cone, cosines of the half angles
   /// Directional: cosine of the angular radius of the disk it comes from (the sun's 0.27°); 1 is
   /// a point at infinity. Each sample then comes from a direction uniform over the disk, which

@@ -141,8 +141,9 @@ TEST(RoughDielectric, AdjointAndReciprocalAndPositive) {
           if (cancelling) continue;
           // Float evaluation of two different half-vector constructions: relative 1e-3.
           ASSERT_NEAR(f_ab.g, g_ba.g, 1e-3f * f_ab.g + 1e-7f) << roughness << " " << ior << " " << thin;
-          if (a.z * b.z > 0.0f || thin)  // no refraction, no 1/η²: plainly reciprocal
+          if (a.z * b.z > 0.0f || thin) {  // no refraction, no 1/η²: plainly reciprocal
             ASSERT_NEAR(f_ab.g, bsdf_eval(m, b, a).g, 1e-3f * f_ab.g + 1e-7f);
+          }
           nonzero_t += a.z * b.z < 0.0f && f_ab.g > 0.0f;
         }
         EXPECT_GT(nonzero_t, 0);
@@ -185,8 +186,9 @@ TEST(RoughDielectric, WhiteFurnace) {
         }
         // Nearly smooth: G1 of an α = 0.0025 surface differs from one by < 1e-3 except at the
         // most grazing microfacets, so at these angles R + T is one within that and the noise.
-        if (roughness == 0.05f && theta != 1.3f)
+        if (roughness == 0.05f && theta != 1.3f) {
           EXPECT_NEAR(by_bsdf.mean, 1.0, kZ * by_bsdf.standard_error + 2e-3) << thin << " " << theta;
+        }
       }
 }
 
