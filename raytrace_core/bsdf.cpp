@@ -33,9 +33,6 @@ float phong_exponent(const Material& m) {
   return m.exponent > 0.0f ? std::min(m.exponent, kMaxPhongExponent) : 0.0f;  // NaN → 0
 }
 
-// Reflective lobes work on both sides: bring wo (and wi with it) to the +z side.
-Vec3 flip_z(Vec3 w) { return {w.x, w.y, -w.z}; }
-
 // Mirror direction of wo about the normal +z.
 Vec3 mirror_direction(const Vec3& wo) { return {-wo.x, -wo.y, wo.z}; }
 
@@ -87,8 +84,6 @@ float dielectric_f0(float ior) {
   return sqr((eta - 1.0f) / (eta + 1.0f));
 }
 
-GgxDistribution ggx_of(const Material& m) { return GgxDistribution(sqr(std::clamp(m.roughness, 0.0f, 1.0f))); }
-
 float clamped_metallic(const Material& m) { return m.metallic > 0.0f ? std::min(m.metallic, 1.0f) : 0.0f; }  // NaN → 0
 
 Rgb metallic_roughness_eval_front(const Material& m, const Vec3& wo, const Vec3& wi) {
@@ -96,7 +91,7 @@ Rgb metallic_roughness_eval_front(const Material& m, const Vec3& wo, const Vec3&
   const float len2 = glm::dot(sum, sum);
   if (!(len2 > 0.0f)) return Rgb(0.0f);
   const Vec3 h = sum / std::sqrt(len2);
-  const GgxDistribution ggx = ggx_of(m);
+  const GgxDistribution ggx = ggx_of_roughness(m.roughness);
   const float metal = clamped_metallic(m);
   const float weight = schlick_weight(std::fabs(glm::dot(wo, h)));
   const float f0 = dielectric_f0(m.ior);
@@ -130,7 +125,7 @@ float metallic_roughness_pdf_front(const Material& m, const Vec3& wo, const Vec3
     const Vec3 h = sum / std::sqrt(len2);
     const float cos_oh = glm::dot(wo, h);
     // Reflection maps h to wi with Jacobian 1 / (4 wo·h).
-    if (cos_oh > 0.0f) specular_pdf = ggx_of(m).visible_d(wo, h) / (4.0f * cos_oh);
+    if (cos_oh > 0.0f) specular_pdf = ggx_of_roughness(m.roughness).visible_d(wo, h) / (4.0f * cos_oh);
   }
   return ps * specular_pdf + (1.0f - ps) * cosine_hemisphere_pdf(wi.z);
 }
@@ -146,7 +141,7 @@ std::optional<BsdfSample> sample_reflective(const Material& m, Vec3 wo, float u_
   } else if (m.kind == MaterialKind::metallic_roughness) {
     const float ps = metallic_roughness_specular_probability(m, wo);
     if (ps < 0.0f) return std::nullopt;
-    wi = u_lobe < ps ? reflect_about(wo, ggx_of(m).sample_visible(wo, u)) : sample_cosine_hemisphere(u);
+    wi = u_lobe < ps ? reflect_about(wo, ggx_of_roughness(m.roughness).sample_visible(wo, u)) : sample_cosine_hemisphere(u);
   } else {
     const float ps = specular_lobe_probability(m);
     if (ps < 0.0f) return std::nullopt;

@@ -45,6 +45,13 @@ float spot_falloff(const Light& l, const Vec3& w_from_light) {
   return x * x * (3.0f - 2.0f * x);
 }
 
+/// The direction a directional light's sample travels: its own, or towards a point of its disk
+/// (Light::cos_angle) drawn uniformly.
+Vec3 directional_travel(const Light& light, Vec2 u) {
+  if (!(light.cos_angle < 1.0f)) return light.direction;
+  return Frame::from_normal(light.direction).to_world(sample_uniform_cone(u, light.cos_angle));
+}
+
 }  // namespace
 
 Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w) {
@@ -114,8 +121,7 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
       return ls;
     }
     case LightKind::directional:
-      ls.wi = light.cos_angle < 1.0f ? Frame::from_normal(-light.direction).to_world(sample_uniform_cone(u, light.cos_angle))
-                                     : -light.direction;
+      ls.wi = -directional_travel(light, u);
       ls.pdf = 1.0f;
       ls.delta = true;
       ls.radiance = light.irradiance;
@@ -207,9 +213,7 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
     case LightKind::environment: {
       // A disk of the bounding radius, perpendicular to the direction of travel, just outside
       // the bounding sphere: every line through the scene crosses it.
-      Vec3 w = light.cos_angle < 1.0f && light.kind == LightKind::directional
-                   ? Frame::from_normal(light.direction).to_world(sample_uniform_cone(u_direction, light.cos_angle))
-                   : light.direction;
+      Vec3 w = light.kind == LightKind::directional ? directional_travel(light, u_direction) : Vec3(0.0f);
       Rgb radiance_over_pdf(0.0f);  // environment: L(−w) / pdf(−w)
       if (light.kind == LightKind::environment && light.map) {
         const EnvironmentMap::Sample s = light.map->sample(u_direction);

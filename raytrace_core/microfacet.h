@@ -48,6 +48,16 @@ class GgxDistribution {
   float alpha_;
 };
 
+/// The distribution of a perceptual roughness r: α = r², r clamped to [0, 1] (glTF's remapping).
+inline GgxDistribution ggx_of_roughness(float roughness) {
+  return GgxDistribution(sqr(std::clamp(roughness, 0.0f, 1.0f)));
+}
+
+/// w mirrored through the local xy-plane: the same direction seen from the other side of the
+/// surface (how two-sided lobes bring wo to +z, and how a thin sheet's transmission mirrors its
+/// reflection).
+inline Vec3 flip_z(const Vec3& w) { return {w.x, w.y, -w.z}; }
+
 /// Mirror direction of w about the unit normal h.
 inline Vec3 reflect_about(const Vec3& w, const Vec3& h) { return 2.0f * glm::dot(w, h) * h - w; }
 

@@ -16,10 +16,6 @@
 namespace gilt::raytrace_core {
 namespace {
 
-Vec3 flip_z(Vec3 w) { return {w.x, w.y, -w.z}; }
-
-GgxDistribution ggx_of(const Material& m) { return GgxDistribution(sqr(std::clamp(m.roughness, 0.0f, 1.0f))); }
-
 bool valid_ior(float eta) { return eta > 0.0f && std::isfinite(eta); }
 
 struct Value {
@@ -48,7 +44,7 @@ Value thin_sheet(const Material& m, const GgxDistribution& ggx, const Vec3& wo, 
 
 Value evaluate(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   if (wo.z == 0.0f || wi.z == 0.0f || !valid_ior(m.ior)) return {};
-  const GgxDistribution ggx = ggx_of(m);
+  const GgxDistribution ggx = ggx_of_roughness(m.roughness);
   if (m.thin_walled) return wo.z > 0.0f ? thin_sheet(m, ggx, wo, wi) : thin_sheet(m, ggx, flip_z(wo), flip_z(wi));
 
   const bool reflected = wo.z * wi.z > 0.0f;
@@ -95,7 +91,7 @@ float rough_dielectric_pdf(const Material& m, const Vec3& wo, const Vec3& wi) {
 std::optional<BsdfSample> rough_dielectric_sample(const Material& m, const Vec3& wo, float u_lobe, Vec2 u,
                                                   TransportMode mode) {
   if (wo.z == 0.0f || !valid_ior(m.ior)) return std::nullopt;
-  const GgxDistribution ggx = ggx_of(m);
+  const GgxDistribution ggx = ggx_of_roughness(m.roughness);
   Vec3 wi;
   if (m.thin_walled) {
     const bool flipped = wo.z < 0.0f;
