@@ -463,7 +463,8 @@ Rgb Lightmap::at(size_t mesh, size_t face, float u, float v) const {
          (texel(x0, y0 + 1) * (1.0f - fx) + texel(x0 + 1, y0 + 1) * fx) * fy;
 }
 
-Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size) {
+Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size,
+                       BakeGather gather) {
   if (size < 16 || size > 16384)
     throw InputError("--lightmap " + std::to_string(size) + ": the atlas's size must be 16 to 16384 texels");
   auto start = std::chrono::steady_clock::now();
@@ -570,7 +571,7 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
 
   // Each owned texel: the mean of the solution at four points of its footprint, clamped onto
   // its face.
-  const SolutionAtInput at_input(scene, solution, quantity);
+  const SolutionAtInput at_input(scene, solution, quantity, gather);
   out.image.width = out.image.height = size;
   out.image.pixels.assign(texels, Rgb(0.0f));
   std::vector<char> filled(texels, 0);
@@ -623,6 +624,7 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
     filled = std::move(next);
     out.image.pixels = std::move(pixels);
   }
+  out.stats.gather = at_input.gather_count();
   out.stats.bake_seconds = seconds_since(start);
   return out;
 }

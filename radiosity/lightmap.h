@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "radiosity/export.h"
+#include "radiosity/onto_input.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/io/image_io.h"
 
@@ -48,6 +49,7 @@ struct LightmapStats {
   int uv_set = -1;              ///< the input's UV set used (glTF TEXCOORD_n; OBJ/PLY 0), or −1: gilt's own
   std::string uv_source;        ///< which UVs, and why the input's were not used
   double layout_seconds = 0, bake_seconds = 0;
+  BakeGatherCount gather;       ///< with a final gather: how the texels' points were evaluated
 };
 
 struct Lightmap {
@@ -67,7 +69,8 @@ struct Lightmap {
 /// Lays out and bakes a size × size lightmap of the solution's `quantity` over the non-specular
 /// meshes read from the scene's model file (onto_input_file). Throws InputError when size is
 /// outside 16..16384.
-Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size);
+Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size,
+                       BakeGather gather = {});
 
 /// The atlas's file for a model output: `<folder>/<stem>_lightmap.exr`.
 std::string lightmap_image_path(const std::string& model_output);

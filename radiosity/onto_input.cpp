@@ -2,6 +2,7 @@
 
 #include "radiosity/onto_input.h"
 
+#include <bit>
 #include <chrono>
 #include <filesystem>
 #include <limits>
@@ -33,9 +34,10 @@ int32_t onto_input_file(const rc::Scene& scene) {
   return 0;
 }
 
-SolutionAtInput::SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity)
+SolutionAtInput::SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity,
+                                 BakeGather gather)
     : scene_(scene), solution_(solution), view_(scene, solution, ViewMode::mesh, /*ambient=*/false),
-      quantity_(quantity) {
+      quantity_(quantity), gather_(gather) {
   // Point, spot and directional lights reach each point by its own shadow ray against the input,
   // so a sun patch or a sharp shadow falls as it does on the input's faces, not as the elements'
   // vertices caught it; the rest (sky, emitting surfaces, interreflection) is the solution's,
@@ -48,10 +50,25 @@ SolutionAtInput::SolutionAtInput(const rc::Scene& scene, const Solution& solutio
 std::optional<Rgb> SolutionAtInput::operator()(const rc::Material& m, const Vec3& p, const Vec3& n) const {
   const std::optional<RadiosityView::Location> at = view_.locate(p, n);
   if (!at) return std::nullopt;
-  const auto& corner = solution_.mesh.elements[at->element];
+  const Rgb e = gather_.rays > 0 && std::chrono::steady_clock::now() < gather_.deadline ? gathered(p, n) : read(*at, p, n);
+  const Rgb radiosity = m.emission * rc::kPi + rc::diffuse_reflectance(m) * e;
+  return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
+}
+
+Rgb SolutionAtInput::gathered(const Vec3& p, const Vec3& n) const {
+  ++gathered_;
+  // The point's own stream, keyed by its position and normal: the same for any thread order.
+  const auto bits = [](float x) { return uint64_t(std::bit_cast<uint32_t>(x)); };
+  const uint64_t key = rc::mix64(bits(p.x) | bits(p.y) << 32) ^ rc::mix64(bits(p.z) | bits(n.x) << 32);
+  rc::SampleContext ctx{rc::Rng::for_item(gather_.seed, key, bits(n.y) | bits(n.z) << 32), 0};
+  return view_.gathered_irradiance(mesh_surface_point(p, n), gather_.rays, ctx);
+}
+
+Rgb SolutionAtInput::read(const RadiosityView::Location& at, const Vec3& p, const Vec3& n) const {
+  if (gather_.rays > 0) ++late_;
+  const auto& corner = solution_.mesh.elements[at.element];
   const auto interpolate = [&](const std::vector<Rgb>& per_vertex) {
-    return per_vertex[corner[0]] * (1.0f - at->u - at->v) + per_vertex[corner[1]] * at->u +
-           per_vertex[corner[2]] * at->v;
+    return per_vertex[corner[0]] * (1.0f - at.u - at.v) + per_vertex[corner[1]] * at.u + per_vertex[corner[2]] * at.v;
   };
   Rgb e = interpolate(solution_.vertex_irradiance);
   if (exact_direct_) {
@@ -63,8 +80,7 @@ std::optional<Rgb> SolutionAtInput::operator()(const rc::Material& m, const Vec3
       if (cos_theta > 0.0f && !ls.radiance.is_black() && !scene_.occluded(ls.shadow_ray)) e += ls.radiance * cos_theta;
     }
   }
-  const Rgb radiosity = m.emission * rc::kPi + rc::diffuse_reflectance(m) * e;
-  return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
+  return e;
 }
 
 std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec3> positions,
@@ -77,14 +93,15 @@ std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec
   return buried;
 }
 
-InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity) {
+InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity,
+                               BakeGather gather) {
   const auto start = std::chrono::steady_clock::now();
   InputColours out;
   out.file = onto_input_file(scene);
   const std::string ext = rc::lower_extension(scene.model_files[size_t(out.file)]);
   const bool per_file_vertex = ext == ".obj" || ext == ".ply";
   const float spacing = 0.5f * solution.mesh_report.max_edge;
-  const SolutionAtInput at_input(scene, solution, quantity);
+  const SolutionAtInput at_input(scene, solution, quantity, gather);
   const auto value = [&](const rc::Material& m, const Vec3& p, const Vec3& n) { return at_input(m, p, n); };
   const auto baked = [&](const rc::TriangleMesh& mesh) {
     return mesh.origin.file == out.file && !scene.materials[mesh.material].is_traced_through();
@@ -134,6 +151,7 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
     };
     out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats);
   }
+  out.gather = at_input.gather_count();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

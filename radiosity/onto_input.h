@@ -21,6 +21,8 @@
 // (radiosity/onto_obj.cpp). PLY in, PLY out: every element and property as it was, with colour
 // properties added to the vertices (radiosity/onto_ply.cpp).
 
+#include <atomic>
+#include <chrono>
 #include <optional>
 #include <span>
 #include <string>
@@ -33,6 +35,21 @@
 
 namespace gilt::radiosity {
 
+/// A bake's final gather (SolutionAtInput).
+/// Under a time limit, points reached after `deadline` read the solution instead, and are
+/// counted as such: the bake is then complete but only partly gathered.
+struct BakeGather {
+  int rays = 0;       ///< samples per point (one shadow ray and one gather ray each); 0: read the solution
+  uint64_t seed = 0;
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+};
+
+/// Points a bake evaluated, by how.
+struct BakeGatherCount {
+  uint64_t gathered = 0;  ///< traced from the point
+  uint64_t late = 0;      ///< read from the solution because the deadline had passed
+};
+
 /// Colours for the vertices of the meshes read from one model file.
 struct InputColours {
   int32_t file = -1;                        ///< index into Scene::model_files
@@ -42,6 +59,7 @@ struct InputColours {
   /// faces of every material at once, since the file has one colour per vertex.
   std::vector<Rgb> per_file_vertex;
   FitStats stats;
+  BakeGatherCount gather;   ///< with a final gather: how its points were evaluated
   size_t buried_faces = 0;  ///< input faces left out of the fit: inside closed solids or under objects
   double seconds = 0.0;
 };
@@ -55,16 +73,28 @@ int32_t onto_input_file(const rc::Scene& scene);
 /// directional lights replaced by its own shadow ray from the point, turned into the quantity by
 /// the point's material (B = π·Le + ρ·E, L = B/π). Nothing where no element is near. Safe to call
 /// from several threads at once; scene and solution must outlive it.
+///
+/// With a final gather (`gather.rays` > 0), the irradiance is instead traced from the point
+/// (RadiosityView::gathered_irradiance): every light by shadow rays, and the light other surfaces
+/// reflect by gather rays that read the solution where they land. Each point draws from its own
+/// random stream, keyed by its coordinates and gather.seed, so the bake is the same for any
+/// thread count.
 class SolutionAtInput {
  public:
-  SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity);
+  SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity, BakeGather gather = {});
   std::optional<Rgb> operator()(const rc::Material& m, const Vec3& p, const Vec3& n) const;
+  BakeGatherCount gather_count() const { return {gathered_.load(), late_.load()}; }
 
  private:
+  Rgb gathered(const Vec3& p, const Vec3& n) const;
+  Rgb read(const RadiosityView::Location& at, const Vec3& p, const Vec3& n) const;
+
   const rc::Scene& scene_;
   const Solution& solution_;
   RadiosityView view_;
   Quantity quantity_;
+  BakeGather gather_;
+  mutable std::atomic<uint64_t> gathered_{0}, late_{0};
   std::vector<const rc::Light*> delta_lights_;
   bool exact_direct_ = false;
 };
@@ -81,7 +111,8 @@ std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec
 /// solution's target edge. Each point's irradiance E is turned into the quantity by its face's
 /// material (B = π·Le + ρ·E, L = B/π) before fitting, so a vertex shared by two materials gets
 /// the colour nearest both.
-InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity);
+InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity,
+                               BakeGather gather = {});
 
 /// Throws InputError unless write_onto_input can write `path` for the scene: called before
 /// solving, so a mistyped output does not cost a solve.

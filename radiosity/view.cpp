@@ -129,6 +129,22 @@ std::optional<Rgb> RadiosityView::indirect_irradiance(const rc::SurfacePoint& p,
   return indirect_at(*at);
 }
 
+Rgb RadiosityView::gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const {
+  // A white Lambertian stands in for the surface: π times its reflected radiance is irradiance.
+  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
+  rc::SurfaceInteraction si;
+  static_cast<rc::SurfacePoint&>(si) = p;
+  si.ns = p.ng;
+  const rc::Frame frame = rc::Frame::from_normal(p.ng);
+  const Vec3 wo(0.0f, 0.0f, 1.0f);
+  Rgb sum(0.0f);
+  for (int r = 0; r < rays; ++r) {
+    sum += rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.rng, ctx.rays) * rc::kPi;
+    sum += gather(si, frame, true, ctx);
+  }
+  return sum / float(std::max(rays, 1));
+}
+
 Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
                           rc::SampleContext& ctx, bool via_specular_only) const {
   // One cosine-distributed ray on the lit side: its estimate of the irradiance is the radiance

@@ -65,6 +65,15 @@ class RadiosityView {
   };
   std::optional<Location> locate(const Vec3& p, const Vec3& n) const;
 
+  /// Irradiance (W·m⁻²) at a point p of the input whose lit side faces along its unit geometric
+  /// normal p.ng, estimated from `rays` samples, each one shadow ray's direct light
+  /// (rc::estimate_direct, as the two-pass view takes it at a pixel) and one cosine-distributed
+  /// gather ray that reads the solution where it lands (its element's direct light and reflected
+  /// light, through mirrors and glass). The final gather of a bake: what a point sees is traced,
+  /// so light does not leak across a roof line or a wall that no element edge follows, and the
+  /// solution's own error enters one bounce later, damped by the reflectance there.
+  Rgb gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const;
+
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
   /// cosine-distributed gather ray (through mirrors and glass), times π: where it lands, the
