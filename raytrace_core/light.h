@@ -83,7 +83,8 @@ Rgb light_power(const Scene& scene, const Light& light);
 /// scene): its constant radiance, times its map's texel in that direction when it has a map.
 Rgb environment_radiance(const Light& light, const Vec3& w);
 /// The sum of environment_radiance over the environment lights among `lights`: what a ray that
-/// leaves the scene along w sees.
+/// leaves the scene along w sees. Pass Scene::punctual_lights: lights() also holds every emitting
+/// triangle, and visiting them per escaped ray made a scene of 15,000 emitters 20 times slower.
 Rgb environment_radiance(std::span<const Light> lights, const Vec3& w);
 
 /// Radiance emitted by a surface of material m towards direction w leaving it (front = ng side).

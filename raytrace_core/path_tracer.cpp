@@ -23,11 +23,10 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     const Vec3 wo_world = -glm::normalize(ray.direction);
     if (!hit) {
       // Escaped: environment lights, MIS-weighted against light sampling.
-      for (size_t li = 0; li < lights.size(); ++li) {
-        if (lights[li].kind != LightKind::environment) continue;
+      for (const uint32_t li : scene.environment_lights()) {
         float weight = 1.0f;
         if (!specular_bounce) {
-          const float light_pdf_v = light_choice.pmf(uint32_t(li)) * light_pdf(scene, lights[li], prev, -wo_world, prev);
+          const float light_pdf_v = light_choice.pmf(li) * light_pdf(scene, lights[li], prev, -wo_world, prev);
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
         radiance += beta * environment_radiance(lights[li], -wo_world) * weight;

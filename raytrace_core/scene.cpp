@@ -387,6 +387,8 @@ void Scene::commit() {
     lights_.push_back(l);
   }
   lights_.insert(lights_.end(), punctual_lights.begin(), punctual_lights.end());
+  for (size_t i = lights_.size() - punctual_lights.size(); i < lights_.size(); ++i)
+    if (lights_[i].kind == LightKind::environment) environment_lights_.push_back(uint32_t(i));
   committed_ = true;  // light_power needs bounds and geometry queries
   std::vector<float> power(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) power[i] = light_power(*this, lights_[i]).average();

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <span>
 #include <vector>
 
 #include "raytrace_core/camera.h"
@@ -134,6 +135,9 @@ class Scene {
 
   /// All lights: one per emissive triangle and sphere, then the punctual lights.
   const std::vector<Light>& lights() const { return lights_; }
+  /// Indices into lights() of the environment lights, so that a ray escaping the scene need not
+  /// visit every emitting triangle to find them.
+  std::span<const uint32_t> environment_lights() const { return environment_lights_; }
   /// Light chosen with probability proportional to its power.
   const Distribution1D& light_distribution() const { return light_distribution_; }
   /// Bounds of all finite geometry.
@@ -181,6 +185,7 @@ class Scene {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<Light> lights_;
+  std::vector<uint32_t> environment_lights_;
   Distribution1D light_distribution_;
   Bounds3 bounds_;
   bool committed_ = false;
