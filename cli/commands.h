@@ -34,6 +34,13 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& settings);
 /// Registers --env, --env-scale and --env-rotate (light given on the command line) on a subcommand.
 void add_lighting_options(CLI::App& cmd, raytrace_core::ExtraLighting& lighting);
 
+/// Registers --camera N|NAME (one of the scene file's cameras) on a subcommand.
+inline void add_camera_option(CLI::App& cmd, std::string& camera) {
+  cmd.add_option("--camera", camera,
+                 "View through one of the scene file's cameras: its number from 0 in file order, or its name "
+                 "(gilt info lists them; default: the first)");
+}
+
 /// Check for floating-point options: the value must be a finite number. CLI::Range and
 /// CLI::PositiveNumber let NaN through (it fails every comparison), so every float option has it.
 inline const CLI::Validator& finite_number() {

@@ -35,6 +35,7 @@ struct CompareOptions {
   std::string methods = "path,photon,sppm,radiosity,whitted";
   std::string budgets = "1,2,4,8,16";
   std::string reference;
+  std::string camera;  ///< --camera N|NAME; empty: the scene's own
   double reference_time = 60.0;
   int width = 256, height = 256;
   uint64_t seed = 0;
@@ -82,7 +83,11 @@ std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, cons
     k.value(l.radiance), k.value(l.cos_inner), k.value(l.cos_outer);
     if (l.map) k.value(l.map->width()), k.value(l.map->rotate_degrees()), k.vector(l.map->texels());
   }
-  k.value(camera), k.value(o.width), k.value(o.height), k.value(o.reference_time), k.value(o.seed);
+  // Field by field: Camera has padding after its bool, whose bytes are not part of its value.
+  k.value(camera.look_from), k.value(camera.look_at), k.value(camera.up), k.value(camera.vfov_degrees);
+  k.value(camera.aperture_radius), k.value(camera.focus_distance), k.value(uint8_t(camera.orthographic));
+  k.value(camera.ortho_height);
+  k.value(o.width), k.value(o.height), k.value(o.reference_time), k.value(o.seed);
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(k.h));
   return text;
@@ -255,7 +260,8 @@ void run_compare(const CompareOptions& o) {
   const fs::path parent = fs::absolute(o.output).parent_path();
   if (!fs::is_directory(parent)) throw rc::InputError("-o " + o.output + ": folder " + parent.string() + " does not exist");
 
-  const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: every image will be black\n";
   const rc::Camera camera = scene.effective_camera();
@@ -321,6 +327,7 @@ std::function<void()> add_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("compare", "Render every method at every time budget and report error against time");
   cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
   add_lighting_options(*cmd, o->lighting);
+  add_camera_option(*cmd, o->camera);
   cmd->add_option("-o,--output", o->output, "Report folder (index.html, metrics.json, metrics.csv, images/)")->required();
   cmd->add_option("--methods", o->methods, "Comma-separated methods (default path,photon,sppm,radiosity,whitted)");
   cmd->add_option("--budgets", o->budgets, "Comma-separated time budgets in seconds (default 1,2,4,8,16)");

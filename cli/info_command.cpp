@@ -22,6 +22,7 @@ namespace {
 struct InfoOptions {
   std::string scene;
   rc::ExtraLighting lighting;
+  std::string camera;  ///< --camera N|NAME; empty: the scene's own
   bool json = false;
 };
 
@@ -106,8 +107,17 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   return plans;
 }
 
+/// One camera as info describes it: "perspective, 39.6° vertical" or "orthographic, 4 high".
+std::string camera_text(const rc::Camera& c) {
+  char text[96];
+  if (c.orthographic) std::snprintf(text, sizeof text, "orthographic, %g high", double(c.ortho_height));
+  else std::snprintf(text, sizeof text, "perspective, %g degrees vertical", double(c.vfov_degrees));
+  return text;
+}
+
 void run_info(const InfoOptions& o) {
-  const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   std::map<std::string, size_t> lights, materials;
   for (const rc::Light& l : scene.lights()) ++lights[light_kind_name(l.kind)];
@@ -188,6 +198,12 @@ void run_info(const InfoOptions& o) {
                                       {"normal_mapped_materials", normal_mapped},
                                       {"texels", texels}, {"memory_estimate_bytes", texture_bytes}}},
                         {"memory_estimate_bytes", bytes}};
+    j["cameras"] = nlohmann::json::array();
+    for (const rc::NamedCamera& c : scene.cameras)
+      j["cameras"].push_back({{"name", c.name}, {"orthographic", c.camera.orthographic},
+                              {"vfov_degrees", c.camera.vfov_degrees}, {"height", c.camera.ortho_height},
+                              {"aspect", c.aspect}});
+    j["view"] = scene.camera ? camera_text(*scene.camera) : "none: the default view of the bounds";
     for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};
     std::cout << j.dump() << std::endl;
     return;
@@ -202,6 +218,11 @@ void run_info(const InfoOptions& o) {
   std::printf("\n  materials:");
   for (const auto& [kind, n] : materials) std::printf(" %zu %s;", n, kind.c_str());
   std::printf(" %zu emissive\n", emissive);
+  std::printf("  cameras:  ");
+  if (scene.cameras.empty()) std::printf(" none (the default view frames the bounds)");
+  for (size_t i = 0; i < scene.cameras.size(); ++i)
+    std::printf("%s %zu '%s' (%s)", i ? ";" : "", i, scene.cameras[i].name.c_str(), camera_text(scene.cameras[i].camera).c_str());
+  std::printf("\n");
   if (!scene.textures.empty())
     std::printf("  textures:  %zu image(s) read by %zu material(s): %.1f Mtexel channels, about %.1f MB as linear half floats with MIP levels\n",
                 scene.textures.size(), textured, double(texels) / 1e6, double(texture_bytes) / 1e6);
@@ -222,6 +243,7 @@ std::function<void()> add_info_command(CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file or built-in name")->required();
   cmd->add_flag("--json", o->json, "Print the description as one JSON object");
   add_lighting_options(*cmd, o->lighting);
+  add_camera_option(*cmd, o->camera);
   return [o] { run_info(*o); };
 }
 

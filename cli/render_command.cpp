@@ -35,6 +35,7 @@ struct RenderOptions {
   double time_limit = 0.0;
   int threads = 0;
   uint64_t seed = 0;
+  std::string camera;  ///< --camera N|NAME; empty: the scene's own
   std::string look_from, look_at, up;
   std::optional<float> fov, aperture, focus_distance;
   std::string filter = "gaussian";
@@ -90,12 +91,15 @@ void check_output(const std::string& path) {
 void run_render(const RenderOptions& o) {
   check_output(o.output);
   rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: the image will be black\n";
 
   rc::RenderSettings settings;
-  settings.width = o.width.value_or(scene.render.width);
-  settings.height = o.height.value_or(scene.render.height);
+  // One of --width and --height alone keeps the scene's aspect ratio (its camera's, if it has one).
+  const double aspect = double(scene.render.width) / double(std::max(scene.render.height, 1));
+  settings.width = o.width.value_or(o.height ? std::max(1, int(std::lround(*o.height * aspect))) : scene.render.width);
+  settings.height = o.height.value_or(o.width ? std::max(1, int(std::lround(*o.width / aspect))) : scene.render.height);
   settings.spp = o.spp.value_or(scene.render.spp);
   settings.time_limit = o.time_limit;
   settings.seed = o.seed;
@@ -230,6 +234,7 @@ std::function<void()> add_render_command(CLI::App& app) {
       ->check(finite_number());
   add_solver_options(*cmd, o->solver);
   add_lighting_options(*cmd, o->lighting);
+  add_camera_option(*cmd, o->camera);
   cmd->add_option_function<std::string>(
          "--radiosity-view",
          [o](const std::string& name) {
@@ -244,8 +249,8 @@ std::function<void()> add_render_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->check(finite_number())
       ->excludes(spp);
-  cmd->add_option("--width", o->width, "Image width in pixels")->check(CLI::Range(1, 65536));
-  cmd->add_option("--height", o->height, "Image height in pixels")->check(CLI::Range(1, 65536));
+  cmd->add_option("--width", o->width, "Image width in pixels (given alone, the height keeps the camera's aspect ratio)")->check(CLI::Range(1, 65536));
+  cmd->add_option("--height", o->height, "Image height in pixels (given alone, the width keeps the camera's aspect ratio)")->check(CLI::Range(1, 65536));
   cmd->add_option("--threads", o->threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--seed", o->seed, "Random seed; the image is a function of the seed, not of --threads")
       ->check(unsigned_integer());

@@ -1,4 +1,4 @@
-// Pinhole and thin-lens perspective cameras.
+// Pinhole, thin-lens and orthographic cameras.
 
 #include "raytrace_core/camera.h"
 
@@ -17,6 +17,11 @@ void Camera::validate() const {
   const Vec3 side = glm::cross(forward, up);
   if (!(glm::dot(side, side) > 1e-12f * glm::dot(forward, forward) * glm::dot(up, up)))
     throw InputError("camera: up is zero or parallel to the view direction");
+  if (orthographic) {
+    if (!(ortho_height > 0.0f) || !std::isfinite(ortho_height))
+      throw InputError("camera: an orthographic camera's height must be a finite number > 0");
+    return;
+  }
   if (!(vfov_degrees > 0.0f && vfov_degrees < 180.0f))
     throw InputError("camera: vertical field of view must lie in (0, 180) degrees");
   if (!(aperture_radius >= 0.0f) || !std::isfinite(aperture_radius))
@@ -29,6 +34,10 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float aspect) const {
   const Vec3 w = glm::normalize(look_at - look_from);  // forward
   const Vec3 u = glm::normalize(glm::cross(w, up));     // right
   const Vec3 v = glm::cross(u, w);                      // up on the image
+  if (orthographic) {
+    const float half_h = 0.5f * ortho_height, half_w = half_h * aspect;
+    return {look_from + (2.0f * film.x - 1.0f) * half_w * u + (1.0f - 2.0f * film.y) * half_h * v, w, kInfinity};
+  }
   const float half_h = std::tan(0.5f * vfov_degrees * kPi / 180.0f);
   const float half_w = half_h * aspect;
   // Direction through the film point at unit distance in front of the pinhole.
@@ -42,6 +51,7 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float aspect) const {
 }
 
 float Camera::pixel_spread(int height) const {
+  if (orthographic) return 0.0f;
   return 2.0f * std::tan(0.5f * vfov_degrees * kPi / 180.0f) / float(std::max(height, 1));
 }
 

@@ -109,6 +109,7 @@ class Scene {
   std::vector<TextureImage> textures;  ///< the images materials read (TextureRef::image)
   std::vector<Light> punctual_lights;  ///< point, spot, directional and environment lights
   std::optional<Camera> camera;        ///< the scene's own camera, if it has one
+  std::vector<NamedCamera> cameras;    ///< every camera its files define, in file order (select_camera)
   RenderDefaults render;
   std::vector<std::string> warnings;   ///< non-fatal problems found while loading or committing
   std::vector<std::string> model_files;  ///< the mesh files read, as given (see MeshOrigin::file)

@@ -1,6 +1,6 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf: the node hierarchy of the default scene with its
-// transforms, triangle primitives, materials with their textures, the first perspective camera
-// and KHR_lights_punctual lights. Occlusion textures, extensions' textures, skins, morph targets
+// transforms, triangle primitives, materials with their textures, its cameras (perspective and
+// orthographic; the first frames the scene) and KHR_lights_punctual lights. Occlusion textures, extensions' textures, skins, morph targets
 // and animations are ignored (with a warning naming them). Normal textures are read, with the
 // primitive's TANGENT when it has one (else tangents are generated: normal_map.h).
 //
@@ -545,7 +545,7 @@ class GltfLoader {
         }
       }
     }
-    if (node.camera >= 0) add_camera(node.camera, world);
+    if (node.camera >= 0) add_camera(node.camera, node.name, world);
     const tinygltf::Value& light = extension(node.extensions, "KHR_lights_punctual");
     if (light.IsObject() && light.Has("light")) add_light(light.Get("light").GetNumberAsInt(), world);
     for (int child : node.children) visit(child, world);
@@ -729,28 +729,44 @@ class GltfLoader {
     scene_.meshes.push_back(std::move(mesh));
   }
 
-  void add_camera(int index, const glm::mat4& world) {
-    if (camera_done_) return;
+  void add_camera(int index, const std::string& node_name, const glm::mat4& world) {
     if (size_t(index) >= model_.cameras.size()) fail("camera " + std::to_string(index) + " does not exist");
     const tinygltf::Camera& c = model_.cameras[size_t(index)];
-    if (c.type != "perspective") {
-      scene_.warnings.push_back(file_ + ": camera " + std::to_string(index) + " is not perspective; ignored");
-      return;
-    }
+    const std::string what = file_ + ": camera " + std::to_string(index);
     // A glTF camera looks down its node's −z with +y up.
     const Vec3 forward(world * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
     const Vec3 up(world * glm::vec4(0.0f, 1.0f, 0.0f, 0.0f));
     if (!(glm::length(forward) > 0.0f) || !(glm::length(up) > 0.0f))
       fail("camera node has a singular transform");
-    Camera camera;
+    NamedCamera named;
+    named.name = !c.name.empty() ? c.name : !node_name.empty() ? node_name : "camera " + std::to_string(scene_.cameras.size());
+    Camera& camera = named.camera;
     camera.look_from = Vec3(world[3]);
     camera.look_at = camera.look_from + glm::normalize(forward);
     camera.up = glm::normalize(up);
-    camera.vfov_degrees = float(c.perspective.yfov * 180.0 / kPi);
-    if (c.perspective.aspectRatio > 0.0)
-      scene_.render.width = std::max(1, int(std::lround(scene_.render.height * c.perspective.aspectRatio)));
+    if (c.type == "perspective") {
+      camera.vfov_degrees = float(c.perspective.yfov * 180.0 / kPi);
+      if (c.perspective.aspectRatio > 0.0) named.aspect = float(c.perspective.aspectRatio);
+    } else if (c.type == "orthographic") {
+      // ymag and xmag are half the view's height and width, in the node's units.
+      camera.orthographic = true;
+      camera.ortho_height = float(2.0 * std::abs(c.orthographic.ymag)) * glm::length(up);
+      if (c.orthographic.ymag != 0.0 && c.orthographic.xmag != 0.0)
+        named.aspect = float(std::abs(c.orthographic.xmag / c.orthographic.ymag));
+    } else {
+      scene_.warnings.push_back(what + " of unknown type '" + c.type + "' ignored");
+      return;
+    }
+    try {
+      camera.validate();
+    } catch (const InputError& e) {
+      scene_.warnings.push_back(what + " ('" + named.name + "') ignored: " + e.what());
+      return;
+    }
+    scene_.cameras.push_back(named);
+    if (scene_.camera) return;  // the first camera frames the scene
     scene_.camera = camera;
-    camera_done_ = true;
+    if (named.aspect > 0.0f) scene_.render.width = std::max(1, int(std::lround(scene_.render.height * named.aspect)));
   }
 
   void add_light(int index, const glm::mat4& world) {
@@ -792,7 +808,6 @@ class GltfLoader {
   std::vector<int> sourceless_;          // textures without an image, warned about already
   int default_material_ = -1;
   int32_t file_index_ = -1;
-  bool camera_done_ = false;
 };
 
 

@@ -251,17 +251,28 @@ class JsonSceneReader {
     }
     // The first included file's camera frames the scene, moved with the file, unless the JSON has
     // its own; its image size (a glTF camera's aspect ratio) comes with it.
-    if (part.camera && !own_camera_ && !scene_.camera) {
-      Camera camera = *part.camera;
+    // Every camera of the file is kept, moved with it, for --camera to choose from.
+    const auto moved = [&transform](Camera camera) {
       camera.look_from = Vec3(transform * glm::vec4(camera.look_from, 1.0f));
       camera.look_at = Vec3(transform * glm::vec4(camera.look_at, 1.0f));
       const Vec3 up = glm::mat3(transform) * camera.up;
-      if (glm::length(up) > 0.0f) camera.up = glm::normalize(up);
-      scene_.camera = camera;
+      if (glm::length(up) > 0.0f) {
+        camera.ortho_height *= glm::length(up) / std::max(glm::length(camera.up), 1e-30f);
+        camera.up = glm::normalize(up);
+      }
+      return camera;
+    };
+    for (NamedCamera named : part.cameras) {
+      named.camera = moved(named.camera);
+      scene_.cameras.push_back(std::move(named));
+    }
+    if (part.camera && !own_camera_ && !scene_.camera) {
+      scene_.camera = moved(*part.camera);
       scene_.render = part.render;
     } else if (part.camera) {
-      scene_.warnings.push_back(file_ + ": " + p + ": the camera of '" + relative.string() + "' is ignored (" +
-                                (own_camera_ ? "the scene's own" : "an earlier file's") + " is used)");
+      scene_.warnings.push_back(file_ + ": " + p + ": the camera of '" + relative.string() + "' frames nothing (" +
+                                (own_camera_ ? "the scene's own" : "an earlier file's") +
+                                " is used; --camera chooses another)");
     }
     for (std::string& w : part.warnings) scene_.warnings.push_back(std::move(w));
   }
@@ -354,7 +365,7 @@ class JsonSceneReader {
 
   void read_camera(const Json& j) {
     const std::string p = "/camera";
-    object(j, p, {"look_from", "look_at", "up", "vfov", "aperture_radius", "focus_distance"});
+    object(j, p, {"name", "look_from", "look_at", "up", "vfov", "aperture_radius", "focus_distance", "orthographic_height"});
     Camera camera;
     camera.look_from = vec3(j, "look_from", p, std::nullopt);
     camera.look_at = vec3(j, "look_at", p, std::nullopt);
@@ -363,12 +374,18 @@ class JsonSceneReader {
     camera.aperture_radius = number(j, "aperture_radius", p, 0.0f);
     camera.focus_distance = number(j, "focus_distance", p, 0.0f);
     if (camera.focus_distance < 0.0f) fail(at(p, "focus_distance"), "must not be negative");
+    if (j.contains("orthographic_height")) {
+      camera.orthographic = true;
+      camera.ortho_height = number(j, "orthographic_height", p, 0.0f);
+    }
     try {
       camera.validate();
     } catch (const InputError& e) {
       fail(p, e.what());
     }
     scene_.camera = camera;
+    // The scene's own camera comes first among those --camera chooses from.
+    scene_.cameras.insert(scene_.cameras.begin(), NamedCamera{j.contains("name") ? string(j, "name", p) : "scene", camera, 0.0f});
   }
 
   void read_render(const Json& j) {

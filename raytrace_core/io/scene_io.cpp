@@ -4,6 +4,8 @@
 #include "raytrace_core/io/scene_io.h"
 
 #include <algorithm>
+#include <optional>
+#include <string>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -76,6 +78,30 @@ Scene load_scene_file(const std::string& path) {
                      "' (expected .obj, .gltf, .glb, .ply or .json)");
   }
   return scene;
+}
+
+void select_camera(Scene& scene, const std::string& choice) {
+  // A scene whose camera came from no file's list (a built-in scene) offers that one.
+  if (scene.cameras.empty() && scene.camera) scene.cameras.push_back({"scene", *scene.camera, 0.0f});
+  const auto listed = [&scene] {
+    if (scene.cameras.empty()) return std::string(scene.name + " defines no camera");
+    std::string list = scene.name + " has";
+    for (size_t i = 0; i < scene.cameras.size(); ++i)
+      list += (i ? ", " : " ") + std::to_string(i) + " '" + scene.cameras[i].name + "'";
+    return list;
+  };
+  std::optional<size_t> index;
+  for (size_t i = 0; i < scene.cameras.size() && !index; ++i)
+    if (scene.cameras[i].name == choice) index = i;
+  if (!index && !choice.empty() && choice.find_first_not_of("0123456789") == std::string::npos) {
+    if (choice.size() > 9 || std::stoul(choice) >= scene.cameras.size())
+      throw InputError("--camera " + choice + ": no such camera; " + listed());
+    index = std::stoul(choice);
+  }
+  if (!index) throw InputError("--camera '" + choice + "': no camera of that name; " + listed());
+  const NamedCamera& chosen = scene.cameras[*index];
+  scene.camera = chosen.camera;
+  if (chosen.aspect > 0.0f) scene.render.width = std::max(1, int(std::lround(float(scene.render.height) * chosen.aspect)));
 }
 
 Scene load_scene(const std::string& path_or_name) { return load_scene(path_or_name, ExtraLighting{}); }

@@ -27,6 +27,11 @@ struct ExtraLighting {
 /// replaces the scene's own environment light, with a warning; a sun is added to its lights.
 Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra);
 
+/// Makes camera `choice` of scene.cameras the scene's camera (`--camera N|NAME`): N counts from 0
+/// in file order, else the name must match one exactly. The image's width follows the camera's
+/// aspect ratio when it has one. Throws InputError naming the cameras there are.
+void select_camera(Scene& scene, const std::string& choice);
+
 /// Loads a scene file without committing it (so callers may still edit it).
 Scene load_scene_file(const std::string& path);
 

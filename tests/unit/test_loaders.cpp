@@ -451,14 +451,15 @@ std::string gltf_json(const std::string& buffer, int position_type = 5126) {
   return R"({"asset": {"version": "2.0"}, "scene": 0,
   "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
                      "KHR_materials_ior"],
-  "scenes": [{"nodes": [0, 3, 4, 5, 6]}],
+  "scenes": [{"nodes": [0, 3, 4, 5, 6, 7]}],
   "nodes": [{"name": "root", "translation": [10, 0, 0], "children": [1, 2]},
             {"mesh": 0, "translation": [0, 1, 0]},
             {"mesh": 1, "scale": [2, 2, 2]},
             {"camera": 0, "translation": [0, 0, 5]},
             {"translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
             {"extensions": {"KHR_lights_punctual": {"light": 1}}},
-            {"rotation": [-0.70710678, 0, 0, 0.70710678], "extensions": {"KHR_lights_punctual": {"light": 2}}}],
+            {"rotation": [-0.70710678, 0, 0, 0.70710678], "extensions": {"KHR_lights_punctual": {"light": 2}}},
+            {"name": "above", "camera": 1, "translation": [0, 4, 0], "rotation": [-0.70710678, 0, 0, 0.70710678]}],
   "meshes": [{"name": "lamp", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]},
              {"name": "pane", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 1}]}],
   "materials": [{"name": "lamp", "emissiveFactor": [1, 1, 1], "doubleSided": true,
@@ -468,7 +469,8 @@ std::string gltf_json(const std::string& buffer, int position_type = 5126) {
                                                  "KHR_materials_ior": {"ior": 1.4}}},
                 {"name": "chrome", "pbrMetallicRoughness": {"metallicFactor": 1, "roughnessFactor": 0}},
                 {"name": "satin", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0.5}}],
-  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "aspectRatio": 1.5}}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "aspectRatio": 1.5}},
+              {"name": "plan", "type": "orthographic", "orthographic": {"xmag": 4, "ymag": 2, "znear": 0, "zfar": 9}}],
   "extensions": {"KHR_lights_punctual": {"lights": [
       {"type": "point", "color": [1, 0.5, 0.25], "intensity": 10},
       {"type": "spot", "intensity": 20, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
@@ -555,6 +557,62 @@ TEST_F(Loaders, JsonSceneKeepsItsGltfsCameraUnlessItHasOne) {
   ASSERT_TRUE(with_own.camera.has_value());
   EXPECT_EQ(with_own.camera->look_from, Vec3(0, 0, -3));
   EXPECT_TRUE(has_warning(with_own, "the scene's own is used"));
+}
+
+TEST_F(Loaders, GltfCamerasAreAllKeptAndChosenByNumberOrName) {
+  // Two cameras: the first (unnamed, on an unnamed node) frames the scene; the second is
+  // orthographic, 2·ymag = 4 high with aspect xmag / ymag = 2, on a node 4 above the origin
+  // turned to look straight down.
+  const std::string path = write("scene.gltf", gltf_json(embedded_buffer(quad_buffer())));
+  Scene scene = load_scene_file(path);
+  ASSERT_EQ(scene.cameras.size(), 2u);
+  EXPECT_EQ(scene.cameras[0].name, "camera 0");
+  EXPECT_EQ(scene.cameras[1].name, "plan");  // the camera's own name before its node's
+  EXPECT_FALSE(scene.camera->orthographic);
+  const Camera& plan = scene.cameras[1].camera;
+  EXPECT_TRUE(plan.orthographic);
+  EXPECT_FLOAT_EQ(plan.ortho_height, 4.0f);
+  EXPECT_FLOAT_EQ(scene.cameras[1].aspect, 2.0f);
+  EXPECT_EQ(plan.look_from, Vec3(0, 4, 0));
+  EXPECT_NEAR(plan.look_at.y, 3.0f, 1e-6f);
+  // An orthographic camera's rays are parallel, from a film 4 × 8 centred on look_from.
+  const Ray left = plan.generate_ray(Vec2(0.0f, 0.5f), Vec2(0.5f), 2.0f);
+  const Ray right = plan.generate_ray(Vec2(1.0f, 0.5f), Vec2(0.5f), 2.0f);
+  EXPECT_NEAR(glm::distance(left.direction, right.direction), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::distance(left.origin, right.origin), 8.0f, 1e-5f);
+  EXPECT_NEAR(left.direction.y, -1.0f, 1e-6f);
+  EXPECT_EQ(plan.pixel_spread(100), 0.0f);
+
+  select_camera(scene, "1");
+  EXPECT_TRUE(scene.camera->orthographic);
+  EXPECT_EQ(scene.render.width, 1024);  // the height's 512 times the aspect 2
+  select_camera(scene, "camera 0");
+  EXPECT_FALSE(scene.camera->orthographic);
+  EXPECT_EQ(scene.render.width, 768);
+  select_camera(scene, "plan");
+  EXPECT_TRUE(scene.camera->orthographic);
+  for (const std::string bad : {"2", "planned", "", "99999999999999999999"}) {
+    try {
+      select_camera(scene, bad);
+      ADD_FAILURE() << "'" << bad << "' was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("0 'camera 0', 1 'plan'"), std::string::npos) << e.what();
+    }
+  }
+  // A JSON scene keeps every included file's cameras, moved with the file, after its own.
+  const std::string own = write("own.json", R"({"meshes": [{"file": "scene.gltf", "transform": {"translate": [1, 2, 3]}}],
+      "camera": {"name": "mine", "look_from": [0, 0, -3], "look_at": [0, 0, 0], "orthographic_height": 6}})");
+  Scene wrapped = load_scene_file(own);
+  ASSERT_EQ(wrapped.cameras.size(), 3u);
+  EXPECT_EQ(wrapped.cameras[0].name, "mine");
+  EXPECT_TRUE(wrapped.camera->orthographic);
+  EXPECT_FLOAT_EQ(wrapped.camera->ortho_height, 6.0f);
+  EXPECT_EQ(wrapped.cameras[2].camera.look_from, Vec3(1, 6, 3));
+  select_camera(wrapped, "plan");
+  EXPECT_EQ(wrapped.camera->look_from, Vec3(1, 6, 3));
+  const std::string bad_height = write("bad.json", R"({"meshes": [{"file": "scene.gltf"}],
+      "camera": {"look_from": [0, 0, -3], "look_at": [0, 0, 0], "orthographic_height": 0}})");
+  EXPECT_THROW(load_scene_file(bad_height), InputError);
 }
 
 TEST_F(Loaders, GlbBinaryContainer) {
