@@ -122,7 +122,7 @@ rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
     if (!hit) {
-      radiance += beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+      radiance += beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
       break;
     }
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);

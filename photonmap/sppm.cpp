@@ -93,7 +93,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           ++local_rays;
           const std::optional<rc::Hit> hit = scene.intersect(ray);
           if (!hit) {
-            direct += beta * rc::environment_radiance(lights, glm::normalize(ray.direction));
+            direct += beta * rc::escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
             break;
           }
           const rc::SurfaceInteraction si = scene.surface(ray, *hit);

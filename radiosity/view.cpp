@@ -162,7 +162,7 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    if (!hit) return via_specular ? out + beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction)) : out;
+    if (!hit) return via_specular ? out + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction)) : out;
     const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
     rc::Material textured;
     const rc::Material& mj = scene_.shading_material(sj, textured);
@@ -209,7 +209,7 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = display_.intersect(ray);
-    if (!hit) return beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+    if (!hit) return beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
     const rc::SurfaceInteraction si = display_.surface(ray, *hit);
     if (hit->geom_id == 0) {
       // Radiosity is solved for the element fronts; their backs are not part of the answer.
@@ -234,7 +234,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    if (!hit) return radiance + beta * rc::environment_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+    if (!hit) return radiance + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
     const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
     rc::Material textured;
     const rc::Material& m = scene_.shading_material(si, textured);

@@ -250,6 +250,18 @@ Rgb environment_radiance(std::span<const Light> lights, const Vec3& w) {
   return sum;
 }
 
+Rgb sun_disk_radiance(std::span<const Light> lights, const Vec3& w) {
+  Rgb sum(0.0f);
+  for (const Light& l : lights)
+    if (l.kind == LightKind::directional && l.cos_angle < 1.0f && glm::dot(w, -l.direction) >= l.cos_angle)
+      sum += l.irradiance / (2.0f * kPi * (1.0f - l.cos_angle));
+  return sum;
+}
+
+Rgb escaped_radiance(std::span<const Light> lights, const Vec3& w) {
+  return environment_radiance(lights, w) + sun_disk_radiance(lights, w);
+}
+
 Rgb light_power(const Scene& scene, const Light& light) {
   const float scene_radius = scene.bounds().radius();
   switch (light.kind) {

@@ -37,9 +37,10 @@ struct Light {
   std::shared_ptr<const EnvironmentMap> map{};  ///< environment: an image of the sky (else constant)
   float cos_inner = 1.0f, cos_outer = 0.0f;  ///< spot cone, cosines of the half angles
   /// Directional: cosine of the angular radius of the disk it comes from (the sun's 0.27°); 1 is
-  /// a point at infinity. Each sample then comes from a direction uniform over the disk, which
-  /// softens shadows; it stays a delta light (BSDF sampling does not find it, mirrors do not
-  /// show it), its irradiance on a plane facing it unchanged.
+  /// a point at infinity. Each light sample then comes from a direction uniform over the disk,
+  /// which softens shadows, its irradiance on a plane facing it unchanged. Light sampling
+  /// stands for it at every surface it can sample (a delta light to MIS); rays no light sampling
+  /// stands for (camera rays, rays after a mirror or glass) see the disk (escaped_radiance).
   float cos_angle = 1.0f;
 };
 
@@ -86,6 +87,16 @@ Rgb environment_radiance(const Light& light, const Vec3& w);
 /// leaves the scene along w sees. Pass Scene::punctual_lights: lights() also holds every emitting
 /// triangle, and visiting them per escaped ray made a scene of 15,000 emitters 20 times slower.
 Rgb environment_radiance(std::span<const Light> lights, const Vec3& w);
+
+/// Radiance of the disks of the directional lights among `lights` that w (unit, towards the
+/// light) falls in: irradiance / solid angle of the disk, so that the disk seen gives what a
+/// light sample of it gives. None for a directional light without a disk (cos_angle = 1).
+Rgb sun_disk_radiance(std::span<const Light> lights, const Vec3& w);
+
+/// What a ray leaving the scene along w sees when no light sampling stands for it (a camera ray,
+/// a ray after a mirror or glass): the environment, and the directional lights' disks. Pass
+/// Scene::punctual_lights.
+Rgb escaped_radiance(std::span<const Light> lights, const Vec3& w);
 
 /// Radiance emitted by a surface of material m towards direction w leaving it (front = ng side).
 Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w);

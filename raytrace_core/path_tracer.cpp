@@ -31,6 +31,8 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
         }
         radiance += beta * environment_radiance(lights[li], -wo_world) * weight;
       }
+      // The sun's disk, where light sampling could not stand for it (the camera, a mirror, glass).
+      if (specular_bounce) radiance += beta * sun_disk_radiance(scene.punctual_lights, -wo_world);
       break;
     }
     const SurfaceInteraction si = scene.surface(ray, *hit);

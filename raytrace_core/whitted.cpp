@@ -12,7 +12,7 @@ namespace {
 Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings, int depth) {
   ++ctx.rays;
   const std::optional<Hit> hit = scene.intersect(ray);
-  if (!hit) return environment_radiance(scene.punctual_lights, glm::normalize(ray.direction));
+  if (!hit) return escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
   const SurfaceInteraction si = scene.surface(ray, *hit);
   Material textured;
   const Material& m = scene.shading_material(si, textured);

@@ -333,10 +333,14 @@ class JsonSceneReader {
       light.cos_inner = std::cos(glm::radians(inner));
       light.cos_outer = std::cos(glm::radians(outer));
     } else if (type == "directional") {
-      object(j, p, {"type", "direction", "irradiance"});
+      object(j, p, {"type", "direction", "irradiance", "angular_radius_deg"});
       light.kind = LightKind::directional;
       light.direction = vec3(j, "direction", p, std::nullopt);
       light.irradiance = colour(j, "irradiance", p, std::nullopt);
+      // A disk rather than a point at infinity (the sun's is 0.27°): soft shadows, and seen.
+      const float radius = number(j, "angular_radius_deg", p, 0.0f);
+      if (!(radius >= 0.0f && radius <= 45.0f)) fail(at(p, "angular_radius_deg"), "must lie in [0, 45] degrees");
+      light.cos_angle = radius > 0.0f ? std::cos(glm::radians(radius)) : 1.0f;
     } else if (type == "environment") {
       object(j, p, {"type", "radiance", "file", "scale", "rotate_deg"});
       light.kind = LightKind::environment;

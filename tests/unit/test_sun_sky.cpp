@@ -4,10 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/light.h"
+#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/scene.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sun_sky.h"
 
@@ -85,6 +90,60 @@ TEST(SunSky, SunIsADiskOfTheSunsSizeWithItsIrradiance) {
   ExtraLighting no_sun;
   no_sun.sky_turbidity = 3.0f;
   EXPECT_THROW(load_scene("cornell", no_sun), InputError);
+}
+
+TEST(SunSky, TheDiskIsSeenByCameraRaysAndThroughMirrors) {
+  // A mirror floor and, 1 above it, a small black plate; a sun of irradiance 1 at 45° elevation
+  // with a disk 10° in radius (wide, so that the test can find it by BSDF sampling). Light
+  // sampling stands for the disk at the plate's underside but finds it behind the surface: the
+  // only light there comes through the mirror, which a path can reach only by a BSDF sample
+  // that, after the mirror, leaves through the disk. The disk's radiance is E / Ω (Ω its solid
+  // angle), so the underside's irradiance is E cos 45° (1 + cos α) / 2 (the cosine over a cone
+  // of radius α about a direction 45° from the normal).
+  Scene scene;
+  scene.materials = {Material::make_mirror("mirror"), Material::make_diffuse("black", Rgb(0.0f))};
+  TriangleMesh floor, plate;
+  floor.positions = {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}};
+  floor.indices = {0, 1, 2, 0, 2, 3};
+  plate.positions = {{-0.1f, 1, -0.1f}, {0.1f, 1, -0.1f}, {0.1f, 1, 0.1f}, {-0.1f, 1, 0.1f}};
+  plate.indices = {0, 1, 2, 0, 2, 3};
+  plate.material = 1;
+  scene.meshes = {floor, plate};
+  const float alpha = 10.0f * kPi / 180.0f;
+  const Vec3 to_sun = glm::normalize(Vec3(1.0f, 1.0f, 0.0f));
+  Light sun;
+  sun.kind = LightKind::directional;
+  sun.direction = -to_sun;
+  sun.irradiance = Rgb(1.0f);
+  sun.cos_angle = std::cos(alpha);
+  scene.punctual_lights = {sun};
+  scene.commit();
+  const double solid_angle = 2.0 * std::numbers::pi * (1.0 - std::cos(double(alpha)));
+
+  // A camera ray into the disk sees its radiance; one just outside it sees nothing.
+  SampleContext ctx{Rng(5), 0};
+  EXPECT_NEAR(path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), to_sun}, ctx, {}).g, 1.0 / solid_angle, 1e-4);
+  const Vec3 outside = glm::normalize(glm::rotate(glm::mat4(1.0f), 1.1f * alpha, Vec3(0, 0, 1)) * glm::vec4(to_sun, 0.0f));
+  EXPECT_EQ(path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), outside}, ctx, {}), Rgb(0.0f));
+
+  // The plate's underside, probed by a white Lambertian: π L is its irradiance. A sample finds
+  // the disk with probability about cos 45° sin²α = 0.021 and then reads π/Ω = 32.9, so one
+  // sample's standard deviation is about 4.8; 10⁶ samples give a standard error of 0.0048, and
+  // the test allows four of them.
+  static const Material white = Material::make_diffuse("probe", Rgb(1.0f));
+  PathSettings probe;
+  probe.first_surface = &white;
+  const int n = 1000000;
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    SampleContext c{Rng::for_item(9, 0, uint64_t(i)), 0};
+    const double e = std::numbers::pi * path_radiance(scene, Ray{Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0)}, c, probe).g;
+    sum += e, sum2 += e * e;
+  }
+  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+  const double expected = std::cos(std::numbers::pi / 4.0) * (1.0 + std::cos(double(alpha))) / 2.0;
+  EXPECT_NEAR(mean, expected, 4.0 * se);
+  EXPECT_LT(se, 0.01);
 }
 
 }  // namespace
