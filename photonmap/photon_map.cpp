@@ -21,10 +21,11 @@ constexpr uint64_t kChunk = 4096;
 /// Stored normals within about 25° of the query's count (cos 25° ≈ 0.9).
 constexpr float kNormalAgreement = 0.9f;
 
-/// Emits `count` photons and keeps those `keep` accepts, in photon order.
+/// Emits photons first, …, first + count − 1 and keeps those `keep` accepts, in photon order,
+/// each with its power divided by `count`.
 template <class Keep>
-std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t count, uint64_t stream, const PhotonSettings& settings,
-                              uint64_t& paths, Keep keep) {
+std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t first, uint64_t count, uint64_t stream,
+                              const PhotonSettings& settings, uint64_t& paths, Keep keep) {
   const auto& lights = scene.lights();
   const rc::Distribution1D& choice = scene.light_distribution();
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
@@ -32,7 +33,7 @@ std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t count, uint64_t s
   rc::parallel_for(chunks, [&](size_t c) {
     std::vector<Photon>& out = stored[c];
     for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
-      rc::Rng rng = rc::Rng::for_item(settings.seed, i, stream);
+      rc::Rng rng = rc::Rng::for_item(settings.seed, first + i, stream);
       const uint32_t li = choice.sample(rng.uniform());
       const float pmf = choice.pmf(li);
       if (!(pmf > 0.0f)) continue;
@@ -118,18 +119,32 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
   else if (settings.global_photons == 0) maps.skipped.push_back("global map skipped: --photons 0");
 
   if (needs.global && settings.global_photons > 0) {
-    maps.global.emitted = settings.global_photons;
-    maps.global.photons = trace_map(scene, settings.global_photons, 0xb000000000ull, settings, maps.paths,
-                                    [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
-                                      // After at least one diffuse bounce: not direct, not a caustic.
-                                      if (!specular_only) out.push_back(p);
-                                      return true;
-                                    });
+    // Rounds of global_photons paths until half as many photons are stored: in an open scene
+    // or an interior lit through its windows most paths from a distant light store nothing, and
+    // a sparse map's estimates are biased. Each round's photons carry 1 / global_photons of the
+    // power; with r rounds they are scaled by 1 / r.
+    const uint64_t round = settings.global_photons;
+    for (int r = 0; r < std::max(settings.global_rounds, 1); ++r) {
+      const std::vector<Photon> more =
+          trace_map(scene, maps.global.emitted, round, 0xb000000000ull, settings, maps.paths,
+                    [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
+                      // After at least one diffuse bounce: not direct, not a caustic.
+                      if (!specular_only) out.push_back(p);
+                      return true;
+                    });
+      maps.global.emitted += round;
+      maps.global.photons.insert(maps.global.photons.end(), more.begin(), more.end());
+      // A first round that stores nothing finds a scene with no interreflection worth a map.
+      if (maps.global.photons.empty() || 2 * maps.global.photons.size() >= round) break;
+    }
+    const float rounds = float(maps.global.emitted / round);
+    if (rounds > 1.0f)
+      for (Photon& p : maps.global.photons) p.power /= rounds;
     maps.global.build_index(settings.index);
   }
   if (needs.caustic && settings.caustic_photons > 0) {
     maps.caustic.emitted = settings.caustic_photons;
-    maps.caustic.photons = trace_map(scene, settings.caustic_photons, 0xc000000000ull, settings, maps.paths,
+    maps.caustic.photons = trace_map(scene, 0, settings.caustic_photons, 0xc000000000ull, settings, maps.paths,
                                      [](const Photon& p, int depth, bool specular_only, std::vector<Photon>& out) {
                                        // Light → specular⁺ → here: a caustic; the path ends either way.
                                        if (specular_only && depth > 0) out.push_back(p);

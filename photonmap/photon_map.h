@@ -21,7 +21,10 @@ namespace gilt::photonmap {
 
 /// How many photons to emit and how far to follow them. The defaults are the documented ones.
 struct PhotonSettings {
-  uint64_t global_photons = 200'000;   ///< emitted for the global map (0: no global map)
+  /// Paths emitted for the global map per round (0: no global map); rounds go on until half as
+  /// many photons are stored, or the first round stores none, or global_rounds rounds.
+  uint64_t global_photons = 200'000;
+  int global_rounds = 16;
   uint64_t caustic_photons = 200'000;  ///< emitted for the caustic map (0: no caustic map)
   int max_depth = 1 << 16;             ///< bounces per photon path at most; Russian roulette ends
                                        ///< paths long before (a low cap would bias albedo near 1)

@@ -3,6 +3,9 @@
 
 #include "raytrace_core/light.h"
 
+#include <algorithm>
+#include <array>
+
 #include <cmath>
 
 #include "raytrace_core/sampling.h"
@@ -50,6 +53,66 @@ float spot_falloff(const Light& l, const Vec3& w_from_light) {
 Vec3 directional_travel(const Light& light, Vec2 u) {
   if (!(light.cos_angle < 1.0f)) return light.direction;
   return Frame::from_normal(light.direction).to_world(sample_uniform_cone(u, light.cos_angle));
+}
+
+/// The scene's bounding box seen along a direction: the convex outline of its corners projected
+/// onto the plane through its centre perpendicular to that direction, in the plane's frame
+/// (s, t), counter-clockwise. Every line along the direction that crosses the box crosses the
+/// outline, so photons from a distant light start on it rather than on a disk of the bounding
+/// radius: a cube's outline covers 42–74 % of that disk, a flatter box's less.
+struct BoxOutline {
+  std::array<Vec2, 9> corner{};  // up to 6 hull corners (room for Andrew's chain)
+  int count = 0;
+  float area = 0.0f;
+};
+
+BoxOutline box_outline(const Bounds3& b, const Frame& frame) {
+  const Vec3 half = 0.5f * (b.hi - b.lo);
+  std::array<Vec2, 8> p;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 q((i & 1 ? 1.0f : -1.0f) * half.x, (i & 2 ? 1.0f : -1.0f) * half.y, (i & 4 ? 1.0f : -1.0f) * half.z);
+    p[size_t(i)] = Vec2(glm::dot(q, frame.s), glm::dot(q, frame.t));
+  }
+  std::sort(p.begin(), p.end(), [](Vec2 a, Vec2 c) { return a.x < c.x || (a.x == c.x && a.y < c.y); });
+  // Andrew's monotone chain: lower hull left to right, then upper hull right to left.
+  const auto cross = [](Vec2 o, Vec2 a, Vec2 c) { return (a.x - o.x) * (c.y - o.y) - (a.y - o.y) * (c.x - o.x); };
+  BoxOutline out;
+  int k = 0;
+  for (int i = 0; i < 8; ++i) {
+    while (k >= 2 && cross(out.corner[size_t(k - 2)], out.corner[size_t(k - 1)], p[size_t(i)]) <= 0.0f) --k;
+    out.corner[size_t(k++)] = p[size_t(i)];
+  }
+  for (int i = 6, lower = k + 1; i >= 0; --i) {
+    while (k >= lower && cross(out.corner[size_t(k - 2)], out.corner[size_t(k - 1)], p[size_t(i)]) <= 0.0f) --k;
+    out.corner[size_t(k++)] = p[size_t(i)];
+  }
+  out.count = std::max(0, k - 1);  // the last repeats the first
+  for (int i = 1; i + 1 < out.count; ++i)
+    out.area += 0.5f * cross(out.corner[0], out.corner[size_t(i)], out.corner[size_t(i + 1)]);
+  return out;
+}
+
+/// A point uniform over the outline (a fan of triangles from its first corner, one chosen by
+/// area with u.x, which is then reused within it).
+Vec2 sample_outline(const BoxOutline& o, Vec2 u) {
+  float target = u.x * o.area;
+  for (int i = 1; i + 1 < o.count; ++i) {
+    const Vec2 a = o.corner[0], b = o.corner[size_t(i)], c = o.corner[size_t(i + 1)];
+    const float area = 0.5f * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+    if (target < area || i + 2 == o.count) {
+      const float ux = std::clamp(area > 0.0f ? target / area : 0.0f, 0.0f, kOneMinusEpsilon);
+      const Vec2 bary = sample_uniform_triangle(Vec2(ux, u.y));
+      return a + (b - a) * bary.x + (c - a) * bary.y;
+    }
+    target -= area;
+  }
+  return o.count > 0 ? o.corner[0] : Vec2(0.0f);
+}
+
+/// Area of the bounding box's outline seen along unit w.
+float box_outline_area(const Bounds3& b, const Vec3& w) {
+  const Vec3 d = b.hi - b.lo;
+  return std::fabs(w.x) * d.y * d.z + std::fabs(w.y) * d.x * d.z + std::fabs(w.z) * d.x * d.y;
 }
 
 }  // namespace
@@ -211,8 +274,8 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
     }
     case LightKind::directional:
     case LightKind::environment: {
-      // A disk of the bounding radius, perpendicular to the direction of travel, just outside
-      // the bounding sphere: every line through the scene crosses it.
+      // A point of the bounding box's outline seen along the direction of travel, moved back
+      // outside the bounding sphere: every line through the scene crosses the outline.
       Vec3 w = light.kind == LightKind::directional ? directional_travel(light, u_direction) : Vec3(0.0f);
       Rgb radiance_over_pdf(0.0f);  // environment: L(−w) / pdf(−w)
       if (light.kind == LightKind::environment && light.map) {
@@ -227,12 +290,13 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
       const Bounds3& b = scene.bounds();
       const Vec3 center = 0.5f * (b.lo + b.hi);
       const float radius = std::max(b.radius(), 1e-30f);
-      const Vec2 d = sample_uniform_disk(u_position) * radius;
       const Frame frame = Frame::from_normal(w);
+      const BoxOutline outline = box_outline(b, frame);
+      if (!(outline.area > 0.0f)) return es;  // a flat scene seen edge on: nothing crosses it
+      const Vec2 d = sample_outline(outline, u_position);
       es.ray = Ray{center - w * (1.01f * radius) + frame.s * d.x + frame.t * d.y, w};
       es.normal = w;
-      const float disk_area = kPi * radius * radius;
-      es.power = light.kind == LightKind::directional ? light.irradiance * disk_area : radiance_over_pdf * disk_area;
+      es.power = (light.kind == LightKind::directional ? light.irradiance : radiance_over_pdf) * outline.area;
       return es;
     }
   }
@@ -263,7 +327,7 @@ Rgb escaped_radiance(std::span<const Light> lights, const Vec3& w) {
 }
 
 Rgb light_power(const Scene& scene, const Light& light) {
-  const float scene_radius = scene.bounds().radius();
+  const Bounds3& b = scene.bounds();
   switch (light.kind) {
     case LightKind::area_triangle:
     case LightKind::area_sphere: {
@@ -275,10 +339,19 @@ Rgb light_power(const Scene& scene, const Light& light) {
     case LightKind::spot:
       // ∫ falloff over the sphere: full cone to cos_inner, then the smoothstep band (its mean is ½).
       return light.intensity * (2.0f * kPi * (1.0f - 0.5f * (light.cos_inner + light.cos_outer)));
-    case LightKind::directional: return light.irradiance * (kPi * scene_radius * scene_radius);
+    // Distant lights: what crosses the bounding box's outline (sample_emission). A directional
+    // light's disk is counted as its centre direction (its outline's area changes by a fraction
+    // of the order of the disk's radius squared).
+    case LightKind::directional: return b.empty() ? Rgb(0.0f) : light.irradiance * box_outline_area(b, light.direction);
     case LightKind::environment: {
+      // Over all directions the outline's mean area is a quarter of the box's surface area
+      // (Cauchy's formula), so a constant sky's power is π L S; a map counts as a constant sky of
+      // its mean radiance.
+      if (b.empty()) return Rgb(0.0f);
+      const Vec3 d = b.hi - b.lo;
+      const float surface = 2.0f * (d.x * d.y + d.y * d.z + d.x * d.z);
       const Rgb mean = light.map ? light.radiance * light.map->mean_radiance() : light.radiance;
-      return mean * (4.0f * kPi * kPi * scene_radius * scene_radius);
+      return mean * (kPi * surface);
     }
   }
   return Rgb(0.0f);

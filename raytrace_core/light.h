@@ -63,18 +63,19 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
 
 /// A ray of light leaving a light, for tracing photons.
 struct EmissionSample {
-  Ray ray;             ///< origin on the light (or on a disk outside the scene for directional and
-                       ///< environment light), direction of travel (unit)
+  Ray ray;             ///< origin on the light (or outside the scene, on the bounding box's outline,
+                       ///< for directional and environment light), direction of travel (unit)
   Rgb power{0.0f};     ///< W carried by this sample: emitted radiance·cos / (area pdf · direction pdf);
-                       ///< averaged over samples it is light_power()
+                       ///< averaged over samples it is light_power() (nearly, for an environment
+                       ///< map or a directional light's disk)
   Vec3 normal{0.0f};   ///< surface normal at the origin (area lights), else the direction
 };
 
 /// Samples an emitted ray from `light`: area lights uniformly by area and cosine-distributed in
 /// direction (either side if two-sided), point lights uniformly over the sphere, spot lights
-/// uniformly inside the outer cone, directional and environment light from a disk of the scene's
-/// bounding radius facing the direction of travel (an environment map's directions drawn by its
-/// importance sampling). Zero power when the sample carries none.
+/// uniformly inside the outer cone, directional and environment light from the outline of the
+/// scene's bounding box seen along the direction of travel (an environment map's directions drawn
+/// by its importance sampling). Zero power when the sample carries none.
 EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_position, Vec2 u_direction);
 
 /// Emitted power of the light in W (per channel), used to choose lights in proportion to power.

@@ -178,8 +178,9 @@ Scene environment_scene(std::shared_ptr<const EnvironmentMap> map, Rgb radiance 
   env.kind = LightKind::environment;
   env.radiance = radiance;
   env.map = std::move(map);
-  TriangleMesh far_away;  // geometry only so that the scene has bounds; never in the way
-  far_away.positions = {{100.0f, 100.0f, 100.0f}, {101.0f, 100.0f, 100.0f}, {100.0f, 101.0f, 100.0f}};
+  // Geometry only so that the scene has bounds, a unit cube; never in the way.
+  TriangleMesh far_away;
+  far_away.positions = {{100.0f, 100.0f, 100.0f}, {101.0f, 100.0f, 100.0f}, {100.0f, 101.0f, 101.0f}};
   far_away.indices = {0, 1, 2};
   Scene scene;
   scene.materials = {Material::make_diffuse("grey", Rgb(0.5f))};
@@ -240,12 +241,12 @@ TEST(LightSampling, EnvironmentMapPhotonsDeliverItsIrradiance) {
   for (int k = 0; k < kN; ++k) {
     const EmissionSample es = sample_emission(scene, light, rng.uniform2(), rng.uniform2());
     double e = 0.0;
-    // The square: 0.4 × 0.4 of the plane y = 100.5 through the scene's centre, well inside the
-    // emission disk's reach (every line through it crosses the disk).
+    // The square: 0.4 × 0.4 of the plane y = 100.5 through the scene's centre, inside its
+    // bounding box, so every line through it crosses the box's outline that photons start on.
     if (es.ray.direction.y < 0.0f && es.ray.origin.y > 100.5f) {
       const float t = (100.5f - es.ray.origin.y) / es.ray.direction.y;
       const Vec3 p = es.ray.origin + t * es.ray.direction;
-      if (std::fabs(p.x - 100.5f) < 0.2f && std::fabs(p.z - 100.0f) < 0.2f) e = es.power.g / 0.16;
+      if (std::fabs(p.x - 100.5f) < 0.2f && std::fabs(p.z - 100.5f) < 0.2f) e = es.power.g / 0.16;
     }
     sum += e;
     sum_sq += e * e;
