@@ -107,6 +107,16 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   return plans;
 }
 
+/// Whether `named` is the camera the scene renders with (the file's first, or --camera's choice).
+bool is_view(const rc::Scene& scene, const rc::NamedCamera& named) {
+  if (!scene.camera) return false;
+  const rc::Camera& a = *scene.camera;
+  const rc::Camera& b = named.camera;
+  return a.look_from == b.look_from && a.look_at == b.look_at && a.up == b.up && a.vfov_degrees == b.vfov_degrees &&
+         a.aperture_radius == b.aperture_radius && a.focus_distance == b.focus_distance &&
+         a.orthographic == b.orthographic && a.ortho_height == b.ortho_height;
+}
+
 /// One camera as info describes it: "perspective, 39.6° vertical" or "orthographic, 4 high".
 std::string camera_text(const rc::Camera& c) {
   char text[96];
@@ -202,7 +212,7 @@ void run_info(const InfoOptions& o) {
     for (const rc::NamedCamera& c : scene.cameras)
       j["cameras"].push_back({{"name", c.name}, {"orthographic", c.camera.orthographic},
                               {"vfov_degrees", c.camera.vfov_degrees}, {"height", c.camera.ortho_height},
-                              {"aspect", c.aspect}});
+                              {"aspect", c.aspect}, {"view", is_view(scene, c)}});
     j["view"] = scene.camera ? camera_text(*scene.camera) : "none: the default view of the bounds";
     for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};
     std::cout << j.dump() << std::endl;
@@ -221,7 +231,8 @@ void run_info(const InfoOptions& o) {
   std::printf("  cameras:  ");
   if (scene.cameras.empty()) std::printf(" none (the default view frames the bounds)");
   for (size_t i = 0; i < scene.cameras.size(); ++i)
-    std::printf("%s %zu '%s' (%s)", i ? ";" : "", i, scene.cameras[i].name.c_str(), camera_text(scene.cameras[i].camera).c_str());
+    std::printf("%s %zu '%s' (%s)%s", i ? ";" : "", i, scene.cameras[i].name.c_str(),
+                camera_text(scene.cameras[i].camera).c_str(), is_view(scene, scene.cameras[i]) ? " [the view]" : "");
   std::printf("\n");
   if (!scene.textures.empty())
     std::printf("  textures:  %zu image(s) read by %zu material(s): %.1f Mtexel channels, about %.1f MB as linear half floats with MIP levels\n",

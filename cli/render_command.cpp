@@ -65,9 +65,10 @@ rc::Vec3 parse_vec3(const std::string& text, const std::string& flag) {
   return v;
 }
 
-/// The camera: the scene's (or a default view), overridden by any camera flag.
-rc::Camera make_camera(const rc::Scene& scene, const RenderOptions& o) {
-  rc::Camera c = scene.effective_camera();
+/// The camera: the scene's (or a default view framed for an image of `aspect`), overridden by any
+/// camera flag.
+rc::Camera make_camera(const rc::Scene& scene, const RenderOptions& o, float aspect) {
+  rc::Camera c = scene.effective_camera(aspect);
   if (!o.look_from.empty()) c.look_from = parse_vec3(o.look_from, "--lookfrom");
   if (!o.look_at.empty()) c.look_at = parse_vec3(o.look_at, "--lookat");
   if (!o.up.empty()) c.up = parse_vec3(o.up, "--up");
@@ -107,7 +108,7 @@ void run_render(const RenderOptions& o) {
   settings.filter.kind = rc::Filter::parse(o.filter);
   settings.filter.radius = o.filter_radius;
   settings.progress = !o.quiet && !o.json;
-  const rc::Camera camera = make_camera(scene, o);
+  const rc::Camera camera = make_camera(scene, o, float(settings.width) / float(settings.height));
 
   MethodOptions mo;
   mo.solver = o.solver;

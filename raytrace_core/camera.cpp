@@ -2,6 +2,7 @@
 
 #include "raytrace_core/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "raytrace_core/error.h"
@@ -55,14 +56,25 @@ float Camera::pixel_spread(int height) const {
   return 2.0f * std::tan(0.5f * vfov_degrees * kPi / 180.0f) / float(std::max(height, 1));
 }
 
-Camera default_camera(const Bounds3& bounds) {
+Camera default_camera(const Bounds3& bounds, float aspect) {
   Camera c;
   if (bounds.empty()) return c;
-  const float radius = std::max(bounds.radius(), 1e-30f);
+  if (!(aspect > 0.0f) || !std::isfinite(aspect)) aspect = 1.0f;
   c.vfov_degrees = 40.0f;
-  // Far enough back along +z that the bounding sphere fills the vertical field of view.
-  const float distance = radius / std::sin(0.5f * c.vfov_degrees * kPi / 180.0f);
-  c.look_at = bounds.center();
+  // The nearest distance along +z at which every corner of the box lies inside the frustum: a
+  // corner at (±hx, ±hy, ±hz) from the centre needs (d − hz)·tan(vfov/2) ≥ hy vertically and
+  // (d − hz)·tan(vfov/2)·aspect ≥ hx across; the front corners (+hz) decide. The 8 % margin
+  // keeps the model off the image's edge. Framing the bounding sphere instead leaves a flat or
+  // long model small in the middle of the picture.
+  const Vec3 half = 0.5f * (bounds.hi - bounds.lo);
+  const float tan_half = std::tan(0.5f * c.vfov_degrees * kPi / 180.0f);
+  const float reach = std::max(half.y, half.x / aspect) / tan_half;
+  // A box with no extent across the view (a point, a line along z) still gets a camera apart from
+  // it, far enough that the two are distinct floats.
+  const Vec3 centre = bounds.center();
+  const float floor = std::max(1e-4f * std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)}), 1e-20f);
+  const float distance = half.z + 1.08f * std::max(reach, floor);
+  c.look_at = centre;
   c.look_from = c.look_at + Vec3(0.0f, 0.0f, distance);
   c.up = Vec3(0.0f, 1.0f, 0.0f);
   return c;

@@ -41,7 +41,9 @@ struct NamedCamera {
   float aspect = 0.0f;  ///< width / height the file asks for; 0: none
 };
 
-/// A camera that frames the bounding box, looking down −z from in front of it.
-Camera default_camera(const Bounds3& bounds);
+/// A camera that frames the bounding box for an image of the given aspect ratio (width /
+/// height), looking down −z from in front of it: the box's front face fills the view's height or
+/// width, whichever binds, with an 8 % margin.
+Camera default_camera(const Bounds3& bounds, float aspect);
 
 }  // namespace gilt::raytrace_core

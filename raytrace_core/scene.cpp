@@ -675,7 +675,11 @@ size_t Scene::triangle_count() const {
   return n;
 }
 
-Camera Scene::effective_camera() const { return camera ? *camera : default_camera(bounds_); }
+Camera Scene::effective_camera(float aspect) const {
+  if (camera) return *camera;
+  if (!(aspect > 0.0f)) aspect = float(render.width) / float(std::max(render.height, 1));
+  return default_camera(bounds_, aspect);
+}
 
 void* Scene::embree_scene() const { return impl_->scene; }
 

@@ -147,8 +147,9 @@ class Scene {
   uint32_t sphere_geom_id() const { return static_cast<uint32_t>(meshes.size()); }
   /// Total triangle count after commit().
   size_t triangle_count() const;
-  /// The camera to render with: the scene's own, or a default view of its bounds.
-  Camera effective_camera() const;
+  /// The camera to render with: the scene's own, or a default view that frames its bounds for an
+  /// image of the given aspect ratio (width / height; 0: the scene's render size).
+  Camera effective_camera(float aspect = 0.0f) const;
 
   /// Area of one triangle or sphere, in scene units².
   float primitive_area(uint32_t geom_id, uint32_t prim_id) const;
