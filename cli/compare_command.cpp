@@ -69,7 +69,7 @@ struct Hasher {
 /// reference's settings: a second compare of the same thing reuses the reference.
 std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, const CompareOptions& o) {
   Hasher k;
-  const std::string version = "gilt-reference-2";
+  const std::string version = "gilt-reference-3";
   k.bytes(version.data(), version.size());
   for (const rc::TriangleMesh& m : scene.meshes) k.vector(m.positions), k.vector(m.indices), k.vector(m.normals), k.value(m.material);
   for (const rc::Sphere& s : scene.spheres) k.value(s);
@@ -102,6 +102,9 @@ fs::path cache_folder() {
 
 struct Reference {
   std::vector<rc::Rgb> pixels;
+  /// Per pixel and channel, the variance of `pixels` estimated from the two halves (empty for a
+  /// --reference file, whose noise is unknown).
+  std::vector<rc::Rgb> variance;
   std::string description;
   double noise = 0.0;
 };
@@ -123,12 +126,15 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   const fs::path folder = cache_folder();
   const std::string key = reference_key(scene, camera, o);
   const fs::path exr = folder / ("reference-" + key + ".exr"), meta = folder / ("reference-" + key + ".json");
-  if (!folder.empty() && fs::exists(exr) && fs::exists(meta)) {
+  const fs::path variance_exr = folder / ("reference-" + key + "-variance.exr");
+  if (!folder.empty() && fs::exists(exr) && fs::exists(meta) && fs::exists(variance_exr)) {
     try {
-      const rc::Image image = rc::read_image(exr.string());
+      const rc::Image image = rc::read_image(exr.string()), variance = rc::read_image(variance_exr.string());
       const nlohmann::json j = nlohmann::json::parse(std::ifstream(meta));
-      if (image.width == o.width && image.height == o.height) {
+      if (image.width == o.width && image.height == o.height && variance.width == o.width &&
+          variance.height == o.height) {
         ref.pixels = image.pixels;
+        ref.variance = variance.pixels;
         ref.noise = j.at("noise").get<double>();
         ref.description = j.at("description").get<std::string>() + " (cached in " + exr.string() + ")";
         return ref;
@@ -157,6 +163,9 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   for (size_t i = 0; i < a.size(); ++i) ref.pixels[i] = a[i] * wa + b[i] * (1.0f - wa);
   // Each half carries about √2 times the noise of the mean: halve their mutual error.
   ref.noise = 0.5 * rc::mean_relative_error(a, b);
+  // Its variance per pixel, when both halves got samples (a budget too short for one leaves the
+  // noise unknown, and the errors uncorrected).
+  if (wa > 0.0f && wa < 1.0f) ref.variance = rc::reference_variance(a, b, wa);
   ref.description = "path tracer, " + std::to_string(sa.spp + sb.spp) + " spp in " +
                     std::to_string(int(std::lround(sa.seconds + sb.seconds))) + " s";
   if (!folder.empty()) {
@@ -164,6 +173,7 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
     fs::create_directories(folder, ec);
     try {
       rc::write_image(exr.string(), rc::Image{o.width, o.height, ref.pixels});
+      if (!ref.variance.empty()) rc::write_image(variance_exr.string(), rc::Image{o.width, o.height, ref.variance});
       rc::StagedFile m(meta, nlohmann::json{{"noise", ref.noise}, {"description", ref.description}}.dump());
       m.commit();
     } catch (const std::exception& e) {
@@ -173,10 +183,12 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   return ref;
 }
 
-void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const std::vector<rc::Rgb>& ref) {
-  const rc::ImageError error = rc::image_error(image, ref);
+void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const Reference& ref) {
+  const rc::ImageError error = rc::image_error(image, ref.pixels, ref.variance);
   e.rmse = error.rmse, e.relmse = error.relmse, e.mae = error.mae, e.mre = error.mean_relative;
   e.mean_ratio = error.mean_ratio;
+  e.relmse_stderr = error.relmse_stderr;
+  e.rmse_measured = error.rmse_measured, e.relmse_measured = error.relmse_measured;
 }
 
 /// Radiosity against the path tracer in object space: at up to 64 element centroids (where the
@@ -264,7 +276,7 @@ void run_compare(const CompareOptions& o) {
   if (!o.camera.empty()) rc::select_camera(scene, o.camera);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: every image will be black\n";
-  const rc::Camera camera = scene.effective_camera();
+  const rc::Camera camera = scene.effective_camera(float(o.width) / float(std::max(o.height, 1)));
   const Reference ref = make_reference(scene, camera, o);
 
   const fs::path folder = o.output;
@@ -274,6 +286,11 @@ void run_compare(const CompareOptions& o) {
   report.width = o.width, report.height = o.height, report.exposure = o.exposure;
   report.reference = ref.description;
   report.reference_noise_mre = ref.noise;
+  if (!ref.variance.empty()) {
+    const rc::ImageError floor = rc::image_error(ref.pixels, ref.pixels, ref.variance);
+    report.reference_relmse_floor = floor.relmse_floor;
+    report.reference_mse_floor = floor.mse_floor;
+  }
   report.methods = methods;
   report.budgets = budgets;
   report.reference_png = "images/reference.png";
@@ -302,7 +319,7 @@ void run_compare(const CompareOptions& o) {
       if (result.sppm) e.photons = result.sppm->photons;
       if (result.solution) e.shots = result.solution->shots;
       e.notes = result.notes;
-      fill_errors(e, pixels, ref.pixels);
+      fill_errors(e, pixels, ref);
       if (result.solution) e.object_space_error = object_space_error(scene, *result.solution, o.seed);
       const std::string stem = "images/" + m + "_" + budget_name(budget);
       e.image_exr = stem + ".exr", e.image_png = stem + ".png", e.error_png = stem + "_error.png";

@@ -46,14 +46,19 @@ void write_file(const std::filesystem::path& path, const std::string& text) {
   file.commit();
 }
 
-/// Log-log plot of relMSE against seconds, one polyline per method.
+/// Log-log plot of relMSE against seconds, one polyline per method, and the reference's noise
+/// floor as a dashed line. An error corrected to 0 or below (within the reference's noise) is
+/// drawn as an open circle at a tenth of the floor, the bottom of the plot.
 std::string plot_svg(const Report& r) {
-  const double w = 640, h = 400, left = 70, right = 130, top = 20, bottom = 50;
-  double tmin = 1e30, tmax = 0, emin = 1e30, emax = 0;
+  const double w = 660, h = 400, left = 70, right = 150, top = 20, bottom = 50;
+  const double floor = r.reference_relmse_floor, lowest = 0.1 * floor;
+  const auto shown = [&](const ReportEntry& e) { return std::max(e.relmse, lowest); };
+  const auto plotted = [&](const ReportEntry& e) { return shown(e) > 0.0 && e.seconds > 0.0; };
+  double tmin = 1e30, tmax = 0, emin = floor > 0.0 ? floor : 1e30, emax = floor;
   for (const ReportEntry& e : r.entries) {
-    if (!(e.relmse > 0.0) || !(e.seconds > 0.0)) continue;
+    if (!plotted(e)) continue;
     tmin = std::min(tmin, e.seconds), tmax = std::max(tmax, e.seconds);
-    emin = std::min(emin, e.relmse), emax = std::max(emax, e.relmse);
+    emin = std::min(emin, shown(e)), emax = std::max(emax, shown(e));
   }
   if (!(tmax > 0.0)) return "<p>No errors to plot.</p>";
   // Whole decades around the data.
@@ -82,19 +87,31 @@ std::string plot_svg(const Report& r) {
   s << "<text x=\"16\" y=\"" << (top + h - bottom) / 2 << "\" text-anchor=\"middle\" transform=\"rotate(-90 16 "
     << (top + h - bottom) / 2 << ")\">relative MSE (log scale)</text>\n";
   int legend = 0;
+  if (floor > 0.0) {
+    const double y = y_of(floor), ly = top + 10 + 20 * legend++;
+    s << "<line id=\"noise-floor\" x1=\"" << left << "\" y1=\"" << y << "\" x2=\"" << w - right << "\" y2=\"" << y
+      << "\" stroke=\"#777777\" stroke-width=\"2\" stroke-dasharray=\"6 4\"><title>the reference's noise floor: relMSE "
+      << number(floor) << "</title></line>\n";
+    s << "<line x1=\"" << w - right + 12 << "\" y1=\"" << ly << "\" x2=\"" << w - right + 40 << "\" y2=\"" << ly
+      << "\" stroke=\"#777777\" stroke-width=\"2\" stroke-dasharray=\"6 4\"/><text x=\"" << w - right + 46
+      << "\" y=\"" << ly + 4 << "\">reference noise</text>\n";
+  }
   for (const std::string& m : r.methods) {
     std::ostringstream points;
     int n = 0;
     for (const ReportEntry& e : r.entries)
-      if (e.method == m && e.relmse > 0.0 && e.seconds > 0.0) points << x_of(e.seconds) << ',' << y_of(e.relmse) << ' ', ++n;
+      if (e.method == m && plotted(e)) points << x_of(e.seconds) << ',' << y_of(shown(e)) << ' ', ++n;
     if (n == 0) continue;
     s << "<polyline class=\"method-line\" data-method=\"" << m << "\" fill=\"none\" stroke=\"" << method_colour(m)
       << "\" stroke-width=\"3\" points=\"" << points.str() << "\"/>\n";
     for (const ReportEntry& e : r.entries)
-      if (e.method == m && e.relmse > 0.0 && e.seconds > 0.0)
-        s << "<circle cx=\"" << x_of(e.seconds) << "\" cy=\"" << y_of(e.relmse) << "\" r=\"4\" fill=\""
-          << method_colour(m) << "\"><title>" << m << ": " << number(e.seconds) << " s, relMSE " << number(e.relmse)
-          << "</title></circle>\n";
+      if (e.method == m && plotted(e)) {
+        const bool below = !(e.relmse > lowest);
+        s << "<circle cx=\"" << x_of(e.seconds) << "\" cy=\"" << y_of(shown(e)) << "\" r=\"4\" fill=\""
+          << (below ? "#ffffff" : method_colour(m)) << "\" stroke=\"" << method_colour(m) << "\"><title>" << m << ": "
+          << number(e.seconds) << " s, relMSE " << number(e.relmse) << " ± " << number(e.relmse_stderr)
+          << (below ? " (within the reference's noise)" : "") << "</title></circle>\n";
+      }
     const double ly = top + 10 + 20 * legend++;
     s << "<line x1=\"" << w - right + 12 << "\" y1=\"" << ly << "\" x2=\"" << w - right + 40 << "\" y2=\"" << ly
       << "\" stroke=\"" << method_colour(m) << "\" stroke-width=\"3\"/><text x=\"" << w - right + 46 << "\" y=\""
@@ -120,14 +137,19 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
   // metrics.json and metrics.csv.
   nlohmann::json j = {{"scene", r.scene},       {"width", r.width},         {"height", r.height},
                       {"reference", r.reference}, {"reference_noise_mean_relative_error", r.reference_noise_mre},
+                      {"reference_relmse_floor", r.reference_relmse_floor},
+                      {"reference_mse_floor", r.reference_mse_floor},
+                      {"errors_noise_corrected", r.reference_relmse_floor > 0.0},
                       {"relmse_epsilon", 0.01},  {"entries", nlohmann::json::array()}};
   std::ostringstream csv;
   csv << "method,budget_seconds,seconds,spp_or_iterations,photons,shots,rmse,relmse,mae,mean_relative_error,"
-         "mean_ratio,object_space_error,image\n";
+         "mean_ratio,object_space_error,image,relmse_stderr,rmse_measured,relmse_measured\n";
   for (const ReportEntry& e : r.entries) {
     nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
                          {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
-                         {"rmse", e.rmse}, {"relmse", e.relmse}, {"mae", e.mae}, {"mean_relative_error", e.mre},
+                         {"rmse", e.rmse}, {"relmse", e.relmse}, {"relmse_stderr", e.relmse_stderr},
+                         {"rmse_measured", e.rmse_measured}, {"relmse_measured", e.relmse_measured},
+                         {"mae", e.mae}, {"mean_relative_error", e.mre},
                          {"mean_ratio", e.mean_ratio}, {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
                          {"notes", e.notes}};
     je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
@@ -136,7 +158,8 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
         << e.shots << ',' << number(e.rmse, "%.6g") << ',' << number(e.relmse, "%.6g") << ','
         << number(e.mae, "%.6g") << ',' << number(e.mre, "%.6g") << ',' << number(e.mean_ratio, "%.6g") << ','
         << (e.object_space_error ? number(*e.object_space_error, "%.6g") : std::string()) << ',' << e.image_exr
-        << '\n';
+        << ',' << number(e.relmse_stderr, "%.6g") << ',' << number(e.rmse_measured, "%.6g") << ','
+        << number(e.relmse_measured, "%.6g") << '\n';
   }
   write_file(folder / "metrics.json", j.dump(2) + "\n");
   write_file(folder / "metrics.csv", csv.str());
@@ -160,8 +183,17 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
     << " pixels, every method on the same camera. Reference: " << escape(r.reference);
   if (r.reference_noise_mre > 0.0)
     h << " (its own noise: mean relative error " << number(100 * r.reference_noise_mre, "%.2f")
-      << " %; errors below that cannot be told apart)";
+      << " %)";
   h << ".</p>\n";
+  if (r.reference_relmse_floor > 0.0)
+    h << "<p id=\"noise-note\">The reference's own noise, estimated pixel by pixel from its two independent halves, "
+         "is subtracted from every RMSE and relMSE below, so that they estimate each method's error against the exact "
+         "image (a perfect image would measure relMSE " << number(r.reference_relmse_floor, "%.3g")
+      << " against this reference: the dashed line in the plot). An error within the reference's noise may come out "
+         "below 0 by its standard error (&plusmn;). The errors against the reference as it is are in the last column "
+         "and in the files.</p>\n";
+  else
+    h << "<p id=\"noise-note\">The reference's noise is not known (a reference file), so the errors include it.</p>\n";
 
   // Winners.
   h << "<h2>Best method at each budget</h2>\n<table id=\"winners\"><tr><th>budget</th>";
@@ -207,7 +239,8 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
 
   h << "<h2>Metrics</h2>\n<table id=\"metrics\"><tr><th>method</th><th>budget s</th><th>actual s</th>"
        "<th>spp / iterations</th><th>photons</th><th>shots</th><th>RMSE</th><th>relMSE</th><th>MAE</th>"
-       "<th>mean rel. error</th><th>mean / reference</th><th>object-space error</th></tr>\n";
+       "<th>mean rel. error</th><th>mean / reference</th><th>object-space error</th><th>relMSE against the "
+       "reference as it is</th></tr>\n";
   for (const ReportEntry& e : r.entries) {
     double best = 1e300;
     for (const ReportEntry& o : r.entries)
@@ -215,9 +248,12 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
     h << "<tr><td class=\"m\" style=\"color:" << method_colour(e.method) << "\">" << e.method << "</td><td>"
       << number(e.budget) << "</td><td>" << number(e.seconds, "%.2f") << "</td><td>" << e.spp << "</td><td>"
       << e.photons << "</td><td>" << e.shots << "</td><td>" << number(e.rmse, "%.4g") << "</td><td"
-      << (e.relmse == best ? " class=\"best\"" : "") << ">" << number(e.relmse, "%.4g") << "</td><td>"
+      << (e.relmse == best ? " class=\"best\"" : "") << ">" << number(e.relmse, "%.4g") << " &plusmn; "
+      << number(e.relmse_stderr, "%.2g") << "</td><td>"
       << number(e.mae, "%.4g") << "</td><td>" << number(100 * e.mre, "%.2f") << " %</td><td>"
-      << number(e.mean_ratio, "%.4f") << "</td><td>" << (e.object_space_error ? number(100 * *e.object_space_error, "%.2f") + " %" : std::string("")) << "</td></tr>\n";
+      << number(e.mean_ratio, "%.4f") << "</td><td>"
+      << (e.object_space_error ? number(100 * *e.object_space_error, "%.2f") + " %" : std::string("")) << "</td><td>"
+      << number(e.relmse_measured, "%.4g") << "</td></tr>\n";
   }
   h << "</table>\n<p>relMSE = mean over pixels and channels of (I &minus; R)&sup2; / (R&sup2; + 0.01). Times include "
        "each method's preparation (radiosity solve, photon tracing). Mean / reference: the image's sum over pixels and "

@@ -19,8 +19,13 @@ struct ReportEntry {
   int spp = 0;                 ///< samples per pixel, or SPPM iterations
   uint64_t photons = 0;        ///< photon paths traced (photon, sppm)
   uint64_t shots = 0;          ///< radiosity shots
-  double rmse = 0.0;           ///< √mean (I − R)² over pixels and channels
-  double relmse = 0.0;         ///< mean (I − R)² / (R² + 0.01)
+  /// √mean (I − R)² over pixels and channels, and mean (I − R)² / (R² + 0.01), each less the
+  /// reference's own noise when it is known (raytrace_core/io/image_error.h): estimates of the
+  /// error against the exact image. relmse may then come out below 0 by about relmse_stderr.
+  double rmse = 0.0;
+  double relmse = 0.0;
+  double relmse_stderr = 0.0;  ///< standard error of relmse, from its per-pixel terms
+  double rmse_measured = 0.0, relmse_measured = 0.0;  ///< against the reference as it is
   double mae = 0.0;            ///< mean |I − R|
   double mre = 0.0;            ///< mean |I − R| / (R + 0.01), the measure of gilt's benchmarks
   double mean_ratio = 1.0;     ///< Σ I / Σ R: the image's overall brightness against the reference's
@@ -36,6 +41,9 @@ struct Report {
   float exposure = 0.0f;
   std::string reference;            ///< how the reference was made or where it came from
   double reference_noise_mre = 0.0; ///< the reference's own noise in the mre measure (0: unknown)
+  /// What a perfect image would measure against the reference, in relMSE and MSE: its noise
+  /// floor, subtracted from every entry's errors (0: unknown, nothing subtracted).
+  double reference_relmse_floor = 0.0, reference_mse_floor = 0.0;
   std::string reference_png;
   std::vector<std::string> methods;
   std::vector<double> budgets;

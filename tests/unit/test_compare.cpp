@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -59,12 +60,22 @@ TEST_F(Compare, WritesReportMetricsAndImages) {
   ASSERT_TRUE(fs::exists(report / "index.html"));
   const nlohmann::json j = nlohmann::json::parse(slurp(report / "metrics.json"));
   ASSERT_EQ(j["entries"].size(), 4u);
+  // The path-traced reference's noise, from its two halves, is taken out of the squared errors.
+  EXPECT_TRUE(j["errors_noise_corrected"].get<bool>());
+  const double floor = j["reference_relmse_floor"].get<double>();
+  EXPECT_GT(floor, 0.0);
+  EXPECT_GT(j["reference_mse_floor"].get<double>(), 0.0);
   for (const auto& e : j["entries"]) {
     for (const char* key : {"image_exr", "image_png", "error_png"})
       EXPECT_TRUE(fs::exists(report / e[key].get<std::string>())) << e[key];
     EXPECT_GT(e["seconds"].get<double>(), 0.0);
-    EXPECT_GE(e["relmse"].get<double>(), 0.0);
+    // Corrected, a relMSE may fall below 0 within its standard error, no further (4 of them).
+    const double relmse = e["relmse"].get<double>(), stderr_ = e["relmse_stderr"].get<double>();
+    EXPECT_GT(stderr_, 0.0);
+    EXPECT_GT(relmse, -4.0 * stderr_);
+    EXPECT_NEAR(e["relmse_measured"].get<double>() - floor, relmse, 1e-9 * (1.0 + std::abs(relmse)));
     EXPECT_GE(e["rmse"].get<double>(), 0.0);
+    EXPECT_LE(e["rmse"].get<double>(), e["rmse_measured"].get<double>());
     if (e["method"] == "radiosity") {
       EXPECT_TRUE(e["object_space_error"].is_number());
       // No shot starts that would end past the budget, and under AddressSanitizer with another
@@ -84,6 +95,7 @@ TEST_F(Compare, WritesReportMetricsAndImages) {
   const std::string html = slurp(report / "index.html");
   EXPECT_NE(html.find("data-method=\"path\""), std::string::npos);
   EXPECT_NE(html.find("data-method=\"radiosity\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"noise-floor\""), std::string::npos);  // the floor, drawn in the plot
   // Offline: nothing is fetched from elsewhere.
   EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org/2000/svg"));
   EXPECT_EQ(html.find("https://"), std::string::npos);
