@@ -166,17 +166,21 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
 
   // index.html. Small images are shown enlarged by a whole factor (pixels stay square and sharp).
   const int scale = std::max(1, 192 / std::max(1, std::max(r.width, r.height)));
-  const int display_width = r.width * scale, display_height = r.height * scale;
+  const int display_width = r.width * scale;
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>gilt compare: "
     << escape(r.scene) << "</title>\n<style>\n"
     << "body{font-family:sans-serif;margin:20px;color:#222;background:#fafafa}\n"
     << "table{border-collapse:collapse;margin:12px 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}\n"
     << "th{background:#eee}td.m{text-align:left;font-weight:bold}td.best{background:#d8f0d8}\n"
-    << ".grid{display:grid;gap:8px;justify-content:start;grid-template-columns:100px repeat(" << r.budgets.size()
-    << "," << display_width << "px)}.grid img{width:" << display_width << "px;height:" << display_height
-    << "px;image-rendering:pixelated;display:block}\n"
-    << ".cell{font-size:12px}.head{font-weight:bold;align-self:center}\n"
+    // Each method's images wrap onto further lines where the window is too narrow for one row, and
+    // shrink (keeping their shape) where it is narrower than one image; tables and the plot scroll
+    // or shrink inside the page rather than widen it.
+    << ".row{display:flex;flex-wrap:wrap;gap:8px;margin-bottom:12px}.cell{width:" << display_width
+    << "px;max-width:100%}.cell img{width:100%;height:auto;aspect-ratio:" << r.width << "/" << r.height
+    << ";image-rendering:pixelated;display:block}\n"
+    << ".scroll{overflow-x:auto;max-width:100%}svg{max-width:100%;height:auto}\n"
+    << ".cell{font-size:12px}.head{font-weight:bold;margin:8px 0 4px}\n"
     << ".legend{height:14px;width:300px;background:linear-gradient(to right,rgb(10,10,60),rgb(30,80,220),"
        "rgb(40,200,200),rgb(240,220,40),rgb(220,30,30))}\n</style>\n</head>\n<body>\n";
   h << "<h1>gilt compare: " << escape(r.scene) << "</h1>\n<p>" << r.width << " &times; " << r.height
@@ -213,31 +217,23 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
   h << "<h2>Images</h2>\n<p>All at exposure " << number(r.exposure) << " EV. Under each image its per-pixel "
     << "relative error |I &minus; R| / (R + 0.01), false colour on a log scale:</p>\n"
     << "<div style=\"display:flex;gap:8px;align-items:center;font-size:12px\">0.001<div class=\"legend\"></div>1</div>\n";
-  h << "<div class=\"grid\">\n<div class=\"head\">reference</div>";
-  h << "<div class=\"cell\"><img class=\"render\" src=\"" << r.reference_png << "\" alt=\"reference\"></div>";
-  for (size_t i = 1; i < r.budgets.size(); ++i) h << "<div></div>";
-  h << "\n<div></div>";
-  for (double b : r.budgets) h << "<div class=\"head\">" << number(b) << " s</div>";
-  h << "\n";
+  h << "<div class=\"head\">reference</div>\n<div class=\"row\"><div class=\"cell\"><img class=\"render\" src=\""
+    << r.reference_png << "\" alt=\"reference\"></div></div>\n";
   for (const std::string& m : r.methods) {
-    h << "<div class=\"head\" style=\"color:" << method_colour(m) << "\">" << m << "</div>";
+    h << "<div class=\"head\" style=\"color:" << method_colour(m) << "\">" << m << "</div>\n<div class=\"row\">";
     for (double b : r.budgets) {
       const auto it = std::find_if(r.entries.begin(), r.entries.end(),
                                    [&](const ReportEntry& e) { return e.method == m && e.budget == b; });
-      if (it == r.entries.end()) {
-        h << "<div></div>";
-        continue;
-      }
-      h << "<div class=\"cell\"><img class=\"render\" src=\"" << it->image_png << "\" alt=\"" << m << " "
-        << number(b) << " s\"><img class=\"error\" src=\"" << it->error_png << "\" alt=\"error of " << m << " "
-        << number(b) << " s\">" << number(it->seconds, "%.2f") << " s, relMSE " << number(it->relmse, "%.3g")
-        << "</div>";
+      if (it == r.entries.end()) continue;
+      h << "<div class=\"cell\"><b>" << number(b) << " s</b><img class=\"render\" src=\"" << it->image_png
+        << "\" alt=\"" << m << " " << number(b) << " s\"><img class=\"error\" src=\"" << it->error_png
+        << "\" alt=\"error of " << m << " " << number(b) << " s\">" << number(it->seconds, "%.2f") << " s, relMSE "
+        << number(it->relmse, "%.3g") << "</div>";
     }
-    h << "\n";
+    h << "</div>\n";
   }
-  h << "</div>\n";
 
-  h << "<h2>Metrics</h2>\n<table id=\"metrics\"><tr><th>method</th><th>budget s</th><th>actual s</th>"
+  h << "<h2>Metrics</h2>\n<div class=\"scroll\"><table id=\"metrics\"><tr><th>method</th><th>budget s</th><th>actual s</th>"
        "<th>spp / iterations</th><th>photons</th><th>shots</th><th>RMSE</th><th>relMSE</th><th>MAE</th>"
        "<th>mean rel. error</th><th>mean / reference</th><th>object-space error</th><th>relMSE against the "
        "reference as it is</th></tr>\n";
@@ -255,7 +251,7 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
       << (e.object_space_error ? number(100 * *e.object_space_error, "%.2f") + " %" : std::string("")) << "</td><td>"
       << number(e.relmse_measured, "%.4g") << "</td></tr>\n";
   }
-  h << "</table>\n<p>relMSE = mean over pixels and channels of (I &minus; R)&sup2; / (R&sup2; + 0.01). Times include "
+  h << "</table></div>\n<p>relMSE = mean over pixels and channels of (I &minus; R)&sup2; / (R&sup2; + 0.01). Times include "
        "each method's preparation (radiosity solve, photon tracing). Mean / reference: the image's sum over pixels and "
        "channels over the reference's, its bias in overall brightness. Object-space error: radiosity vertex radiance "
        "against path-traced estimates at sampled vertices. Files: <a href=\"metrics.json\">metrics.json</a>, "

@@ -132,6 +132,27 @@ TEST_F(Compare, BadInputExitsTwo) {
   }
 }
 
+namespace {
+
+/// Whether `image`, enlarged by the whole factor `scale`, appears as an exact block in `page`
+/// (each image pixel's centre compared; pixelated scaling keeps the values).
+bool shows_block(const rc::Image& page, const rc::Image& image, int scale) {
+  auto at = [&](int x, int y) { return page.pixels[size_t(y) * page.width + x]; };
+  const int w = image.width * scale, h = image.height * scale;
+  for (int y = 0; y + h <= page.height; ++y)
+    for (int x = 0; x + w <= page.width; ++x) {
+      if (!(at(x, y) == image.pixels[0])) continue;
+      bool all = true;
+      for (int j = 0; j < image.height && all; ++j)
+        for (int i = 0; i < image.width && all; ++i)
+          all = at(x + i * scale + scale / 2, y + j * scale + scale / 2) == image.pixels[size_t(j) * image.width + i];
+      if (all) return true;
+    }
+  return false;
+}
+
+}  // namespace
+
 // The page in a real browser. Chromium from Debian renders index.html headless to a PNG; the test
 // then finds (1) the reference image, shown enlarged by a whole factor with pixelated scaling, as
 // an exact block of the screenshot, and (2) each method's line colour in the plot. Without
@@ -153,17 +174,7 @@ TEST_F(Compare, PageShowsImagesAndPlotInChromium) {
   const int scale = 192 / 32;  // report.cpp: enlarged to about 192 pixels by a whole factor
 
   // (1) The reference image: a block where every screenshot pixel equals its source pixel.
-  auto at = [&](int x, int y) { return page.pixels[size_t(y) * page.width + x]; };
-  bool found = false;
-  for (int y = 0; y + 32 * scale <= page.height && !found; ++y)
-    for (int x = 0; x + 32 * scale <= page.width && !found; ++x) {
-      if (!(at(x, y) == ref.pixels[0])) continue;
-      bool all = true;
-      for (int j = 0; j < 32 && all; ++j)
-        for (int i = 0; i < 32 && all; ++i) all = at(x + i * scale + scale / 2, y + j * scale + scale / 2) == ref.pixels[size_t(j) * 32 + i];
-      found = all;
-    }
-  EXPECT_TRUE(found) << "the reference image was not found in the screenshot";
+  EXPECT_TRUE(shows_block(page, ref, scale)) << "the reference image was not found in the screenshot";
 
   // (2) The plot: pixels of each method's line colour (path #0072B2, radiosity #CC79A7).
   const rc::Image swatch = [&] {
@@ -178,5 +189,31 @@ TEST_F(Compare, PageShowsImagesAndPlotInChromium) {
     size_t count = 0;
     for (const rc::Rgb& p : page.pixels) count += p == swatch.pixels[size_t(m)];
     EXPECT_GT(count, 100u) << (m == 0 ? "path" : "radiosity") << " line not found in the plot";
+  }
+}
+
+// On a laptop's 1,280-pixel-wide window, five 256 × 256 images of a method do not fit on one line:
+// the row wraps, and every image is still shown whole at its own size (found pixel for pixel in
+// the screenshot, so none is cut off at the window's edge or hidden past it).
+TEST_F(Compare, PageFitsALaptopScreen) {
+  if (std::system("command -v chromium >/dev/null 2>&1") != 0) {
+    if (std::getenv("GILT_REQUIRE_CHROMIUM")) FAIL() << "chromium is not installed";
+    GTEST_SKIP() << "chromium is not installed";
+  }
+  const fs::path report = dir_ / "wide";
+  const Result r = gilt("compare cornell --methods path --budgets 0.05,0.1,0.2,0.4,0.8 --reference-time 0.5 "
+                        "--width 256 --height 256 -q -o '" + report.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path shot = dir_ / "wide.png";
+  const Result c = run("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --force-device-scale-factor=1 "
+                       "--user-data-dir='" + (dir_ / "profile").string() + "' --window-size=1280,2600 --screenshot='" +
+                       shot.string() + "' 'file://" + (report / "index.html").string() + "'");
+  ASSERT_EQ(c.code, 0) << c.err;
+  const rc::Image page = rc::read_image(shot.string());
+  ASSERT_EQ(page.width, 1280);
+  for (const char* budget : {"0.05s", "0.1s", "0.2s", "0.4s", "0.8s"}) {
+    const rc::Image image = rc::read_image((report / "images" / ("path_" + std::string(budget) + ".png")).string());
+    ASSERT_EQ(image.width, 256);
+    EXPECT_TRUE(shows_block(page, image, 1)) << "the " << budget << " image is not shown whole at 1,280 pixels";
   }
 }
