@@ -23,6 +23,7 @@
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/io/staged_file.h"
+#include "photonmap/photon_map.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;
@@ -35,6 +36,7 @@ struct CompareOptions {
   std::string methods = "path,photon,sppm,radiosity,whitted";
   std::string budgets = "1,2,4,8,16";
   std::string reference;
+  std::string reference_method = "auto";  ///< path, sppm, or auto (sppm where caustics are)
   std::string camera;  ///< --camera N|NAME; empty: the scene's own
   double reference_time = 60.0;
   int width = 256, height = 256;
@@ -67,10 +69,12 @@ struct Hasher {
 
 /// A key for the loaded scene's content (geometry, materials, lights), the camera and the
 /// reference's settings: a second compare of the same thing reuses the reference.
-std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, const CompareOptions& o) {
+std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, const CompareOptions& o,
+                          const std::string& method) {
   Hasher k;
   const std::string version = "gilt-reference-3";
   k.bytes(version.data(), version.size());
+  k.bytes(method.data(), method.size());
   for (const rc::TriangleMesh& m : scene.meshes) k.vector(m.positions), k.vector(m.indices), k.vector(m.normals), k.value(m.material);
   for (const rc::Sphere& s : scene.spheres) k.value(s);
   for (const rc::Material& m : scene.materials) {
@@ -123,8 +127,18 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
     ref.description = "the file " + o.reference;
     return ref;
   }
+  // The method: SPPM where light reaches diffuse surfaces through mirrors or glass (caustics),
+  // which a path tracer finds only by chance (and never from a point light or the sun), the path
+  // tracer elsewhere.
+  std::string method = o.reference_method, why;
+  if (method == "auto") {
+    const photonmap::MapNeeds needs = photonmap::map_needs(scene);
+    method = needs.caustic ? "sppm" : "path";
+    why = needs.caustic ? ", chosen for the scene's caustics (light through mirrors or glass onto diffuse surfaces)"
+                        : ", chosen as the scene has no caustics";
+  }
   const fs::path folder = cache_folder();
-  const std::string key = reference_key(scene, camera, o);
+  const std::string key = reference_key(scene, camera, o, method);
   const fs::path exr = folder / ("reference-" + key + ".exr"), meta = folder / ("reference-" + key + ".json");
   const fs::path variance_exr = folder / ("reference-" + key + "-variance.exr");
   if (!folder.empty() && fs::exists(exr) && fs::exists(meta) && fs::exists(variance_exr)) {
@@ -143,19 +157,25 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
       // A damaged cache entry is rendered again below.
     }
   }
-  // Two independent halves: their difference measures the reference's own noise.
+  // Two independent halves: their difference measures the reference's own noise (for SPPM its
+  // noise alone: the blur of its shrinking radius is the same in both halves).
   rc::RenderSettings s;
   s.width = o.width, s.height = o.height, s.threads = o.threads, s.progress = !o.quiet;
   s.time_limit = o.reference_time / 2.0;
   const rc::PathSettings path;
   auto half = [&](uint64_t seed, rc::RenderStats& stats) {
     s.seed = seed;
+    if (method == "sppm") {
+      MethodResult result = run_method(scene, camera, method, s, MethodOptions{});
+      stats = result.stats;
+      return result.film.pixels();
+    }
     return rc::render_image(scene, camera, s,
                             [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); },
                             &stats)
         .pixels();
   };
-  if (!o.quiet) std::fprintf(stderr, "gilt compare: path-traced reference, %.0f s\n", o.reference_time);
+  if (!o.quiet) std::fprintf(stderr, "gilt compare: %s reference, %.0f s\n", method.c_str(), o.reference_time);
   rc::RenderStats sa, sb;
   const std::vector<rc::Rgb> a = half(o.seed ^ 0x5eed0001ull, sa), b = half(o.seed ^ 0x5eed0002ull, sb);
   const float wa = float(sa.spp) / float(sa.spp + sb.spp);
@@ -166,8 +186,9 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   // Its variance per pixel, when both halves got samples (a budget too short for one leaves the
   // noise unknown, and the errors uncorrected).
   if (wa > 0.0f && wa < 1.0f) ref.variance = rc::reference_variance(a, b, wa);
-  ref.description = "path tracer, " + std::to_string(sa.spp + sb.spp) + " spp in " +
-                    std::to_string(int(std::lround(sa.seconds + sb.seconds))) + " s";
+  ref.description = (method == "sppm" ? "SPPM, " + std::to_string(sa.spp + sb.spp) + " iterations in "
+                                       : "path tracer, " + std::to_string(sa.spp + sb.spp) + " spp in ") +
+                    std::to_string(int(std::lround(sa.seconds + sb.seconds))) + " s" + why;
   if (!folder.empty()) {
     std::error_code ec;
     fs::create_directories(folder, ec);
@@ -353,6 +374,10 @@ std::function<void()> add_compare_command(CLI::App& app) {
                   "Seconds for the path-traced reference (default 60; cached by scene content and camera)")
       ->check(finite_number())
       ->check(CLI::Range(0.1, 1e6))
+      ->excludes(ref);
+  cmd->add_option("--reference-method", o->reference_method,
+                  "How the reference is rendered: path, sppm, or auto (default: sppm when the scene has caustics)")
+      ->check(CLI::IsMember({"auto", "path", "sppm"}))
       ->excludes(ref);
   cmd->add_option("--width", o->width, "Image width (default 256)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", o->height, "Image height (default 256)")->check(CLI::Range(1, 16384));

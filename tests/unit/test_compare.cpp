@@ -112,6 +112,24 @@ TEST_F(Compare, SecondRunReusesTheCachedReference) {
   EXPECT_EQ(slurp(dir_ / "first/images/reference.exr"), slurp(dir_ / "second/images/reference.exr"));
 }
 
+// The reference's method: auto renders it with SPPM where the scene has caustics, which a path
+// tracer finds only by chance, and with the path tracer elsewhere; either way its noise is
+// measured from two halves and taken out of the errors.
+TEST_F(Compare, ReferenceMethodFollowsTheScenesCaustics) {
+  const auto reference_of = [&](const std::string& scene, const std::string& extra) {
+    const fs::path report = dir_ / (extra.empty() ? scene : scene + "-forced");
+    const Result r = gilt("compare " + scene + " --methods path --budgets 0.2 --reference-time 1 --width 16 --height 16 " +
+                          extra + " -q -o '" + report.string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(report / "metrics.json"));
+    EXPECT_TRUE(j["errors_noise_corrected"].get<bool>()) << scene << extra;
+    return j["reference"].get<std::string>();
+  };
+  EXPECT_EQ(reference_of("cornell-caustics", "").rfind("SPPM, ", 0), 0u);
+  EXPECT_EQ(reference_of("cornell", "").rfind("path tracer, ", 0), 0u);
+  EXPECT_EQ(reference_of("cornell-caustics", "--reference-method path").rfind("path tracer, ", 0), 0u);
+}
+
 TEST_F(Compare, BadInputExitsTwo) {
   const std::string out = (dir_ / "r").string();
   const fs::path small = dir_ / "small.exr";
@@ -123,6 +141,8 @@ TEST_F(Compare, BadInputExitsTwo) {
       {"compare cornell --reference " + (dir_ / "none.exr").string() + " -o " + out, "none.exr"},
       {"compare cornell --reference " + small.string() + " --width 8 --height 8 -o " + out, "does not match"},
       {"compare cornell -o " + (dir_ / "no/such/folder").string(), "does not exist"},
+      {"compare cornell --reference-method magic -o " + out, "--reference-method"},
+      {"compare cornell --reference " + small.string() + " --reference-method sppm -o " + out, "excludes"},
   };
   for (const auto& [args, message] : cases) {
     const Result r = gilt(args);
