@@ -30,6 +30,11 @@ if ext in (".glb", ".gltf"):
     bpy.ops.import_scene.gltf(filepath=model)
 elif ext == ".ply":
     bpy.ops.import_mesh.ply(filepath=model)
+    # PLY has no up axis. gilt writes y up, as glTF does and as MeshLab shows it; Blender's PLY
+    # importer (unlike its glTF and OBJ importers) takes z as up and has no option to say
+    # otherwise, so the model is turned +90 degrees about x, as a user would, to be seen the same.
+    for o in bpy.context.selected_objects:
+        o.rotation_euler = (1.5707963267948966, 0.0, 0.0)
 elif ext == ".obj":
     bpy.ops.wm.obj_import(filepath=model)
 else:
@@ -127,6 +132,7 @@ camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
 camera.data.clip_end = 1e6
 scene.collection.objects.link(camera)
 scene.camera = camera
+bpy.context.view_layer.update()  # matrix_world after the PLY's turn
 corners = [o.matrix_world @ mathutils.Vector(c) for o in meshes for c in o.bound_box]
 lo = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
 hi = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
