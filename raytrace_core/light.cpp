@@ -1,14 +1,17 @@
-// Light sampling: area lights by uniform area (triangles) or by the cone they subtend (spheres),
+// Light sampling: area lights by the solid angle they subtend (triangles, where it is neither tiny
+// nor nearly a hemisphere; by area otherwise) or by the cone they subtend (spheres),
 // delta lights directly, the environment uniformly over the sphere (PBRT 4th ed., ch. 12).
 
 #include "raytrace_core/light.h"
 
 #include <algorithm>
 #include <array>
-
 #include <cmath>
+#include <optional>
 
+#include "raytrace_core/closest_point.h"
 #include "raytrace_core/sampling.h"
+#include "raytrace_core/spherical_triangle.h"
 #include "raytrace_core/scene.h"
 
 namespace gilt::raytrace_core {
@@ -122,6 +125,61 @@ Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w) {
   return Rgb(0.0f);
 }
 
+namespace {
+
+/// The corners of a triangle light.
+std::array<DVec3, 3> light_corners(const Scene& scene, const Light& light) {
+  const TriangleMesh& mesh = scene.meshes[light.geom_id];
+  const uint32_t* i = &mesh.indices[3 * size_t(light.prim_id)];
+  return {DVec3(mesh.positions[i[0]]), DVec3(mesh.positions[i[1]]), DVec3(mesh.positions[i[2]])};
+}
+
+/// The spherical triangle a triangle light spans from p, when it is sampled by the solid angle
+/// it subtends there (triangle_light_solid_angle); nothing when it is sampled by area.
+std::optional<SphericalTriangle> solid_angle_sampling(const Scene& scene, const Light& light, const Vec3& p) {
+  if (triangle_light_solid_angle(scene, light, p) == 0.0) return std::nullopt;
+  const std::array<DVec3, 3> c = light_corners(scene, light);
+  return SphericalTriangle::from(DVec3(p), c[0], c[1], c[2]);
+}
+
+/// Barycentric coordinates (of the second and third corners) where the ray from p along w meets
+/// the plane of the triangle, clamped into the triangle against rounding (Möller & Trumbore 1997).
+Vec2 barycentrics_along(const std::array<DVec3, 3>& c, const DVec3& p, const DVec3& w) {
+  const DVec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
+  const DVec3 pv = glm::cross(w, e2);
+  const double det = glm::dot(e1, pv);
+  if (det == 0.0) return Vec2(1.0f / 3.0f);
+  const DVec3 tv = p - c[0];
+  const DVec3 qv = glm::cross(tv, e1);
+  double b1 = std::max(0.0, glm::dot(tv, pv) / det), b2 = std::max(0.0, glm::dot(w, qv) / det);
+  if (b1 + b2 > 1.0) {
+    const double sum = b1 + b2;
+    b1 /= sum, b2 /= sum;
+  }
+  return Vec2(float(b1), float(b2));
+}
+
+}  // namespace
+
+double triangle_light_solid_angle(const Scene& scene, const Light& light, const Vec3& p) {
+  constexpr float kSpread = 2.0f;  // largest ratio of densities left to area sampling
+  const TriangleMesh& mesh = scene.meshes[light.geom_id];
+  const uint32_t* i = &mesh.indices[3 * size_t(light.prim_id)];
+  const Vec3 &a = mesh.positions[i[0]], &b = mesh.positions[i[1]], &c = mesh.positions[i[2]];
+  const Vec2 nb = closest_point_on_triangle(p, a, b, c);
+  const Vec3 nearest = (1.0f - nb.x - nb.y) * a + nb.x * b + nb.y * c;
+  const float r_near2 = glm::dot(nearest - p, nearest - p);
+  const float r_far2 = std::max({glm::dot(a - p, a - p), glm::dot(b - p, b - p), glm::dot(c - p, c - p)});
+  // (r_far / r_near)³ ≤ kSpread, squared to stay with squared distances.
+  if (r_far2 * r_far2 * r_far2 <= kSpread * kSpread * r_near2 * r_near2 * r_near2) return 0.0;
+  const DVec3 da = DVec3(a) - DVec3(p), db = DVec3(b) - DVec3(p), dc = DVec3(c) - DVec3(p);
+  const double la = glm::length(da), lb = glm::length(db), lc = glm::length(dc);
+  if (!(la > 0.0) || !(lb > 0.0) || !(lc > 0.0)) return 0.0;
+  // As SphericalTriangle::from computes it (the same directions into the same formula).
+  const double omega = triangle_solid_angle(da / la, db / lb, dc / lc);
+  return samples_by_solid_angle(omega) ? omega : 0.0;
+}
+
 LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u) {
   LightSample ls;
   switch (light.kind) {
@@ -130,8 +188,15 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
       SurfaceInteraction q;
       float pdf = 0.0f;
       if (light.kind == LightKind::area_triangle) {
-        q = scene.triangle_point(light.geom_id, light.prim_id, sample_uniform_triangle(u));
-        pdf = area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, q);
+        if (const std::optional<SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p)) {
+          // A direction uniform over the solid angle, and the point where it meets the light.
+          const DVec3 w = st->sample(u);
+          q = scene.triangle_point(light.geom_id, light.prim_id, barycentrics_along(light_corners(scene, light), DVec3(ref.p), w));
+          pdf = float(1.0 / st->solid_angle());
+        } else {
+          q = scene.triangle_point(light.geom_id, light.prim_id, sample_uniform_triangle(u));
+          pdf = area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, q);
+        }
       } else {
         const Sphere& s = scene.spheres[light.prim_id];
         if (inside_sphere(s, ref.p)) {
@@ -212,6 +277,8 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
                 const SurfacePoint& on_light) {
   switch (light.kind) {
     case LightKind::area_triangle:
+      if (const std::optional<SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p))
+        return float(1.0 / st->solid_angle());
       return area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, on_light);
     case LightKind::area_sphere: {
       const Sphere& s = scene.spheres[light.prim_id];

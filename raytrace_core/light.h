@@ -56,6 +56,18 @@ struct LightSample {
 /// Samples light `light` from the reference surface point; empty radiance when nothing arrives.
 LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u);
 
+/// Whether a triangle light is sampled from p by the solid angle it subtends, and that angle.
+///
+/// Sampled by area, a direction towards the light has density r² / (A·cos θ) = r³ / (A·h) in
+/// solid angle (h: p's distance from the light's plane), so across the light it varies as the
+/// cube of the distance, between the nearest point of the triangle and its farthest corner.
+/// Where that spread is small (the light small or far, as from most of a room) area sampling
+/// already draws directions almost uniformly over the solid angle, at a fraction of the cost;
+/// where it is large (beside or close to the light) it spikes, and solid-angle sampling is
+/// used, when the angle is in the range samples_by_solid_angle allows. The test depends on p and
+/// the triangle alone, so sample_light and light_pdf decide alike. 0: sampled by area.
+double triangle_light_solid_angle(const Scene& scene, const Light& light, const Vec3& p);
+
 /// Solid-angle density with which sample_light picks direction wi reaching the light at `on_light`
 /// (area lights) from `ref`; environment ignores on_light. Zero for delta lights.
 float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref, const Vec3& wi,

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -26,8 +27,9 @@
 namespace gilt::raytrace_core {
 namespace {
 
-// triangle, near sphere, far sphere, sphere from inside, environment, environment map (turned and not)
-constexpr int kChi2Tests = 7;
+// triangle (solid angle; oblique and close; tiny and far, by area), near sphere, far sphere, sphere
+// from inside, environment, environment map (turned and not)
+constexpr int kChi2Tests = 9;
 constexpr size_t kSamples = 1000000;
 // Silhouette edges cross cells: 2 × 2 sub-cells per cell, each refined adaptively 5 times, leave
 // an integration error of a few 1e-6 of the total (measured against finer settings), i.e. a few
@@ -124,8 +126,42 @@ TEST(LightSampling, EmissiveTriangle) {
   for (const Vec3& v : mesh.positions)
     theta_bound = std::max(
         theta_bound, std::acos(std::clamp(double(frame.to_local(glm::normalize(v - ref.p)).z), -1.0, 1.0)));
+  ASSERT_GT(triangle_light_solid_angle(scene, scene.lights()[0], ref.p), 0.0);  // close: by solid angle
   expect_light_follows_pdf(scene, ref, frame, test::theta_grid(32, 64, 1.05 * theta_bound), 11, true);
   expect_pdf_matches_sample(scene, ref, 12);
+}
+
+/// A one-triangle light with corners `c`, tested from `p` (normal towards the triangle) by chi-square
+/// and by the pdf at traced hits; `by_solid_angle` says which of light.cpp's two strategies the
+/// configuration must exercise.
+void triangle_light_case(const std::array<Vec3, 3>& c, const Vec3& p, bool by_solid_angle, uint64_t seed) {
+  TriangleMesh mesh;
+  mesh.name = "lamp";
+  mesh.positions = {c[0], c[1], c[2]};
+  mesh.indices = {0, 1, 2};
+  const Scene scene = one_light_scene({mesh}, {}, {});
+  const Vec3 centroid = (c[0] + c[1] + c[2]) / 3.0f;
+  ASSERT_EQ(triangle_light_solid_angle(scene, scene.lights()[0], p) > 0.0, by_solid_angle);
+  const SurfacePoint ref = reference_point(p, centroid - p);
+  const Frame frame = frame_towards(ref, centroid);
+  double theta_bound = 0.0;
+  for (const Vec3& v : c)
+    theta_bound = std::max(theta_bound, std::acos(std::clamp(double(frame.to_local(glm::normalize(v - p)).z), -1.0, 1.0)));
+  expect_light_follows_pdf(scene, ref, frame, test::theta_grid(32, 64, 1.05 * theta_bound), seed, true);
+  expect_pdf_matches_sample(scene, ref, seed + 1);
+}
+
+// Beside a ceiling lamp, a little below its plane: the lamp is seen nearly edge on, close by,
+// where area sampling's density d²/cos θ would vary most across it.
+TEST(LightSampling, EmissiveTriangleObliqueAndClose) {
+  triangle_light_case({Vec3(-0.5f, 2.0f, -0.5f), Vec3(0.5f, 2.0f, -0.5f), Vec3(0.0f, 2.0f, 0.6f)}, Vec3(0.9f, 1.8f, 0.1f),
+                      true, 21);
+}
+
+// Small and far: sampled by area, where the two densities agree to rounding.
+TEST(LightSampling, EmissiveTriangleTinyAndFar) {
+  triangle_light_case({Vec3(-0.01f, 20.0f, 0.0f), Vec3(0.01f, 20.0f, 0.0f), Vec3(0.0f, 20.0f, 0.015f)},
+                      Vec3(0.3f, 0.0f, 0.2f), false, 31);
 }
 
 // Sphere light seen from outside: the cone it subtends, half-angle asin(r / d), cap 1% wider.
