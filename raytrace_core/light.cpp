@@ -134,12 +134,30 @@ std::array<DVec3, 3> light_corners(const Scene& scene, const Light& light) {
   return {DVec3(mesh.positions[i[0]]), DVec3(mesh.positions[i[1]]), DVec3(mesh.positions[i[2]])};
 }
 
+/// Whether area sampling's density varies across the triangle (a, b, c) seen from p by more
+/// than a factor of 2 (see triangle_light_solid_angle in light.h): the cube of the farthest
+/// corner's distance over the nearest point's.
+bool density_spreads(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  constexpr float kSpread = 2.0f;  // largest ratio of densities left to area sampling
+  const Vec2 nb = closest_point_on_triangle(p, a, b, c);
+  const Vec3 nearest = (1.0f - nb.x - nb.y) * a + nb.x * b + nb.y * c;
+  const float r_near2 = glm::dot(nearest - p, nearest - p);
+  const float r_far2 = std::max({glm::dot(a - p, a - p), glm::dot(b - p, b - p), glm::dot(c - p, c - p)});
+  // (r_far / r_near)³ > kSpread, squared to stay with squared distances.
+  return r_far2 * r_far2 * r_far2 > kSpread * kSpread * r_near2 * r_near2 * r_near2;
+}
+
 /// The spherical triangle a triangle light spans from p, when it is sampled by the solid angle
-/// it subtends there (triangle_light_solid_angle); nothing when it is sampled by area.
+/// it subtends there; nothing when it is sampled by area. sample_light and light_pdf both
+/// decide through here, from p and the triangle alone.
 std::optional<SphericalTriangle> solid_angle_sampling(const Scene& scene, const Light& light, const Vec3& p) {
-  if (triangle_light_solid_angle(scene, light, p) == 0.0) return std::nullopt;
-  const std::array<DVec3, 3> c = light_corners(scene, light);
-  return SphericalTriangle::from(DVec3(p), c[0], c[1], c[2]);
+  const TriangleMesh& mesh = scene.meshes[light.geom_id];
+  const uint32_t* i = &mesh.indices[3 * size_t(light.prim_id)];
+  const Vec3 &a = mesh.positions[i[0]], &b = mesh.positions[i[1]], &c = mesh.positions[i[2]];
+  if (!density_spreads(p, a, b, c)) return std::nullopt;
+  std::optional<SphericalTriangle> t = SphericalTriangle::from(DVec3(p), DVec3(a), DVec3(b), DVec3(c));
+  if (t && !samples_by_solid_angle(t->solid_angle())) t.reset();
+  return t;
 }
 
 /// Barycentric coordinates (of the second and third corners) where the ray from p along w meets
@@ -162,22 +180,8 @@ Vec2 barycentrics_along(const std::array<DVec3, 3>& c, const DVec3& p, const DVe
 }  // namespace
 
 double triangle_light_solid_angle(const Scene& scene, const Light& light, const Vec3& p) {
-  constexpr float kSpread = 2.0f;  // largest ratio of densities left to area sampling
-  const TriangleMesh& mesh = scene.meshes[light.geom_id];
-  const uint32_t* i = &mesh.indices[3 * size_t(light.prim_id)];
-  const Vec3 &a = mesh.positions[i[0]], &b = mesh.positions[i[1]], &c = mesh.positions[i[2]];
-  const Vec2 nb = closest_point_on_triangle(p, a, b, c);
-  const Vec3 nearest = (1.0f - nb.x - nb.y) * a + nb.x * b + nb.y * c;
-  const float r_near2 = glm::dot(nearest - p, nearest - p);
-  const float r_far2 = std::max({glm::dot(a - p, a - p), glm::dot(b - p, b - p), glm::dot(c - p, c - p)});
-  // (r_far / r_near)³ ≤ kSpread, squared to stay with squared distances.
-  if (r_far2 * r_far2 * r_far2 <= kSpread * kSpread * r_near2 * r_near2 * r_near2) return 0.0;
-  const DVec3 da = DVec3(a) - DVec3(p), db = DVec3(b) - DVec3(p), dc = DVec3(c) - DVec3(p);
-  const double la = glm::length(da), lb = glm::length(db), lc = glm::length(dc);
-  if (!(la > 0.0) || !(lb > 0.0) || !(lc > 0.0)) return 0.0;
-  // As SphericalTriangle::from computes it (the same directions into the same formula).
-  const double omega = triangle_solid_angle(da / la, db / lb, dc / lc);
-  return samples_by_solid_angle(omega) ? omega : 0.0;
+  const std::optional<SphericalTriangle> t = solid_angle_sampling(scene, light, p);
+  return t ? t->solid_angle() : 0.0;
 }
 
 LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u) {
