@@ -50,6 +50,17 @@ class Compare : public ::testing::Test {
     return report;
   }
 
+  /// index.html of `report` as headless Chromium shows it in a window `width` × `height`.
+  rc::Image screenshot(const fs::path& report, int width, int height) {
+    const fs::path shot = dir_ / (report.filename().string() + "-shot.png");
+    const Result r = run("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --force-device-scale-factor=1 "
+                         "--user-data-dir='" + (dir_ / "profile").string() + "' --window-size=" + std::to_string(width) +
+                         "," + std::to_string(height) + " --screenshot='" + shot.string() + "' 'file://" +
+                         (report / "index.html").string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return rc::read_image(shot.string());
+  }
+
   fs::path dir_;
 };
 
@@ -183,12 +194,8 @@ TEST_F(Compare, PageShowsImagesAndPlotInChromium) {
     GTEST_SKIP() << "chromium is not installed";
   }
   const fs::path report = small_report("report");
-  const fs::path shot = dir_ / "shot.png";
-  const Result r = run("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --force-device-scale-factor=1 "
-                       "--user-data-dir='" + (dir_ / "profile").string() + "' --window-size=1200,1600 --screenshot='" +
-                       shot.string() + "' 'file://" + (report / "index.html").string() + "'");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const rc::Image page = rc::read_image(shot.string());
+  const rc::Image page = screenshot(report, 1200, 1600);
+  ASSERT_GT(page.width, 0);
   const rc::Image ref = rc::read_image((report / "images/reference.png").string());
   ASSERT_EQ(ref.width, 32);
   const int scale = 192 / 32;  // report.cpp: enlarged to about 192 pixels by a whole factor
@@ -224,12 +231,7 @@ TEST_F(Compare, PageFitsALaptopScreen) {
   const Result r = gilt("compare cornell --methods path --budgets 0.05,0.1,0.2,0.4,0.8 --reference-time 0.5 "
                         "--width 256 --height 256 -q -o '" + report.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  const fs::path shot = dir_ / "wide.png";
-  const Result c = run("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --force-device-scale-factor=1 "
-                       "--user-data-dir='" + (dir_ / "profile").string() + "' --window-size=1280,2600 --screenshot='" +
-                       shot.string() + "' 'file://" + (report / "index.html").string() + "'");
-  ASSERT_EQ(c.code, 0) << c.err;
-  const rc::Image page = rc::read_image(shot.string());
+  const rc::Image page = screenshot(report, 1280, 2600);
   ASSERT_EQ(page.width, 1280);
   for (const char* budget : {"0.05s", "0.1s", "0.2s", "0.4s", "0.8s"}) {
     const rc::Image image = rc::read_image((report / "images" / ("path_" + std::string(budget) + ".png")).string());
