@@ -16,19 +16,38 @@ namespace gilt::raytrace_core {
 
 namespace {
 
-/// Inverse of the error function on (-1, 1). Starts from Winitzki's closed-form approximation
-/// (relative error ~2e-3) and polishes it with Newton steps on std::erf in double precision.
+/// Inverse of the error function on (-1, 1): Giles' single-precision approximation (M. Giles
+/// 2010, "Approximating the erfinv function", GPU Computing Gems Jade), a polynomial in
+/// w = −log(1 − x²) on two ranges, accurate to float precision (test_film checks that the
+/// filter's CDF at a sample gives its u back within 1e-6). It replaced Newton steps on std::erf, which took a tenth of a
+/// Cornell box sample's time; evaluated in double, it costs one log and nine multiply-adds.
 double erf_inverse(double x) {
-  constexpr double kA = 0.147;
-  constexpr double kTwoOverSqrtPi = 2.0 * std::numbers::inv_sqrtpi;
-  const double log_term = std::log((1.0 - x) * (1.0 + x));
-  const double c = 2.0 / (std::numbers::pi * kA) + 0.5 * log_term;
-  double y = std::copysign(std::sqrt(std::sqrt(c * c - log_term / kA) - c), x);
-  for (int i = 0; i < 3; ++i) {
-    const double slope = kTwoOverSqrtPi * std::exp(-y * y);
-    y -= (std::erf(y) - x) / slope;
+  double w = -std::log((1.0 - x) * (1.0 + x));
+  double p;
+  if (w < 5.0) {
+    w -= 2.5;
+    p = 2.81022636e-08;
+    p = 3.43273939e-07 + p * w;
+    p = -3.5233877e-06 + p * w;
+    p = -4.39150654e-06 + p * w;
+    p = 0.00021858087 + p * w;
+    p = -0.00125372503 + p * w;
+    p = -0.00417768164 + p * w;
+    p = 0.246640727 + p * w;
+    p = 1.50140941 + p * w;
+  } else {
+    w = std::sqrt(w) - 3.0;
+    p = -0.000200214257;
+    p = 0.000100950558 + p * w;
+    p = 0.00134934322 + p * w;
+    p = -0.00367342844 + p * w;
+    p = 0.00573950773 + p * w;
+    p = -0.0076224613 + p * w;
+    p = 0.00943887047 + p * w;
+    p = 1.00167406 + p * w;
+    p = 2.83297682 + p * w;
   }
-  return y;
+  return p * x;
 }
 
 /// Box filter on [-r, r]: uniform.
@@ -47,7 +66,7 @@ float sample_tent(float u, float r) {
 /// so one u always gives the same offset.
 float sample_gaussian(float u, float r) {
   const double sigma_sqrt2 = static_cast<double>(r) / 3.0 * std::sqrt(2.0);
-  const double e = std::erf(3.0 / std::sqrt(2.0));  // r / (σ√2) is 3/√2 for every radius
+  static const double e = std::erf(3.0 / std::sqrt(2.0));  // r / (σ√2) is 3/√2 for every radius
   const double x = sigma_sqrt2 * erf_inverse((2.0 * static_cast<double>(u) - 1.0) * e);
   return std::clamp(static_cast<float>(x), -r, r);
 }

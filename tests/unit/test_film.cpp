@@ -141,7 +141,7 @@ TEST(Filter, ZeroRadiusGivesThePixelCentre) {
 
 // Sampling inverts the CDF, so F(sample(u)) must give u back. Rounding the offset to float moves
 // it by at most 2⁻²⁴·r, which moves F by at most that times the largest density (1.2/r for the
-// gaussian): under 1e-7. The 1e-6 tolerance leaves room for the erf⁻¹ iteration.
+// gaussian): under 1e-7. The 1e-6 tolerance leaves room for the erf⁻¹ approximation's error.
 TEST(Filter, SampleInvertsTheClosedFormCdf) {
   for (FilterKind kind : kKinds) {
     const Filter filter{kind, 1.5f};
