@@ -39,6 +39,7 @@ struct RenderOptions {
   std::string look_from, look_at, up;
   std::optional<float> fov, aperture, focus_distance;
   std::string filter = "gaussian";
+  std::string sampler = "sobol";
   float filter_radius = 1.5f;
   float exposure = 0.0f;
   int max_depth = 0;
@@ -107,6 +108,7 @@ void run_render(const RenderOptions& o) {
   settings.threads = o.threads;
   settings.filter.kind = rc::Filter::parse(o.filter);
   settings.filter.radius = o.filter_radius;
+  settings.sampler = rc::parse_sampler(o.sampler);
   settings.progress = !o.quiet && !o.json;
   const rc::Camera camera = make_camera(scene, o, float(settings.width) / float(settings.height));
 
@@ -151,6 +153,7 @@ void run_render(const RenderOptions& o) {
                         {"height", settings.height},
                         {"spp", stats.spp},
                         {"seed", settings.seed},
+                        {"sampler", rc::sampler_name(settings.sampler)},
                         {"threads", threads},
                         {"triangles", scene.triangle_count()},
                         {"spheres", scene.spheres.size()},
@@ -263,6 +266,9 @@ std::function<void()> add_render_command(CLI::App& app) {
       ->check(finite_number());
   cmd->add_option("--focus-distance", o->focus_distance, "Distance to the plane in focus (default: to --lookat)")
       ->check(finite_number());
+  cmd->add_option("--sampler", o->sampler,
+                  "Camera-sample numbers: sobol (Owen-scrambled Sobol, the default) or independent")
+      ->check(CLI::IsMember({"independent", "sobol"}));
   cmd->add_option("--filter", o->filter, "Pixel filter: box, tent or gaussian")
       ->check(CLI::IsMember({"box", "tent", "gaussian"}));
   cmd->add_option("--filter-radius", o->filter_radius, "Pixel filter radius in pixels")

@@ -67,9 +67,9 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
     rc::parallel_for((count + 1023) / 1024, [&](size_t chunk) {
       for (size_t i = chunk * 1024; i < std::min(count, chunk * 1024 + 1024); ++i) {
         const Photon& p = maps_.global.photons[i * stride];
-        rc::Rng rng = rc::Rng::for_item(settings.photons.seed, i, 0xd000000000ull);
+        rc::Sampler sampler(rc::Rng::for_item(settings.photons.seed, i, 0xd000000000ull));
         points_[i] = {p.position, p.normal,
-                      compute_irradiance(p.position, decode_direction(p.normal), rng, settings.direct_samples)};
+                      compute_irradiance(p.position, decode_direction(p.normal), sampler, settings.direct_samples)};
       }
     });
     std::vector<rc::Vec3> positions(count);
@@ -80,7 +80,7 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
   stats_.precompute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Rng& rng,
+rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler,
                                          int direct_samples) const {
   rc::Rgb e(0.0f);
   const auto& lights = scene_.lights();
@@ -88,9 +88,9 @@ rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& norm
   if (choice.size() > 0) {
     const rc::SurfacePoint at = point_at(p, normal);
     for (int i = 0; i < direct_samples; ++i) {
-      const uint32_t li = choice.sample(rng.uniform());
+      const uint32_t li = choice.sample(sampler.uniform());
       const float pmf = choice.pmf(li);
-      const rc::LightSample ls = rc::sample_light(scene_, lights[li], at, rng.uniform2());
+      const rc::LightSample ls = rc::sample_light(scene_, lights[li], at, sampler.uniform2());
       const float cos_theta = glm::dot(ls.wi, normal);
       if (!(ls.pdf > 0.0f) || !(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
       if (scene_.occluded(ls.shadow_ray)) continue;
@@ -103,7 +103,7 @@ rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& norm
   return e;
 }
 
-rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Rng& rng) const {
+rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler) const {
   if (!points_.empty()) {
     constexpr size_t kCandidates = 8;
     Neighbour near[kCandidates];
@@ -112,13 +112,14 @@ rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::
       if (glm::dot(decode_direction(points_[near[i].index].normal), normal) > 0.9f)
         return points_[near[i].index].irradiance;
   }
-  return compute_irradiance(p, normal, rng, 4);
+  return compute_irradiance(p, normal, sampler, 4);
 }
 
 rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
   rc::Rgb radiance(0.0f), beta(1.0f);
   rc::Ray ray = camera_ray;
   for (int depth = 0; depth < settings_.max_depth; ++depth) {
+    ctx.sampler.start_bounce(depth);
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
     if (!hit) {
@@ -139,7 +140,7 @@ rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx
     }
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     const rc::Vec3 wo = frame.to_local(wo_world);
-    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.rng.uniform(), ctx.rng.uniform2());
+    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.sampler.uniform(), ctx.sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
     const rc::Vec3 wi_world = frame.to_world(bs->wi);
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f, wi_above = glm::dot(wi_world, si.ng) > 0.0f;
@@ -167,7 +168,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   l += estimate_radiance(maps_.caustic, query, m, frame, wo, thread_scratch());
 
   // Direct light: one light sample, MIS-weighted against the gather rays as BSDF samples.
-  if (const rc::DirectSample ds = rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays);
+  if (const rc::DirectSample ds = rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
       !ds.value.is_black())
     l += ds.value * (ds.delta || gather == 0 ? 1.0f : rc::power_heuristic(1.0f, ds.pdf, float(gather), rc::bsdf_pdf(m, wo, ds.wi)));
   if (gather == 0) {
@@ -180,7 +181,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   rc::Rgb gathered(0.0f);
   const bool caustics_in_map = !maps_.caustic.empty();
   for (int j = 0; j < gather; ++j) {
-    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.rng.uniform(), ctx.rng.uniform2());
+    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.sampler.uniform(), ctx.sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) continue;
     const rc::Vec3 wi_world = frame.to_world(bs->wi);
     const bool wi_above = glm::dot(wi_world, si.ng) > 0.0f;
@@ -227,7 +228,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       if (mj.is_traced_through()) {
         const rc::Frame fj = rc::Frame::from_normal(sj.ns);
         const rc::Vec3 woj = fj.to_local(-dir);
-        const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, ctx.rng.uniform(), ctx.rng.uniform2());
+        const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, ctx.sampler.uniform(), ctx.sampler.uniform2());
         if (!bj || !(bj->pdf > 0.0f) || bj->f.is_black()) break;
         g *= bj->f * (std::fabs(bj->wi.z) / bj->pdf);
         ray = rc::spawn_ray(sj, fj.to_world(bj->wi));
@@ -236,7 +237,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       }
       // A diffuse or glossy hit: its reflected light from the precomputed irradiance.
       const rc::Vec3 side = glm::dot(-dir, sj.ng) > 0.0f ? sj.ng : -sj.ng;
-      gathered += g * rc::diffuse_reflectance(mj) * irradiance(sj.p, side, ctx.rng) * rc::kInvPi;
+      gathered += g * rc::diffuse_reflectance(mj) * irradiance(sj.p, side, ctx.sampler) * rc::kInvPi;
       break;
     }
   }

@@ -55,7 +55,7 @@ class PhotonMapper {
 
   /// Irradiance at a point from the precomputed points (nearest with an agreeing normal), or
   /// computed on the spot when none is near (W·m⁻²). `normal` faces the side being lit.
-  rc::Rgb irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Rng& rng) const;
+  rc::Rgb irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler) const;
 
  private:
   struct IrradiancePoint {
@@ -64,7 +64,7 @@ class PhotonMapper {
     rc::Rgb irradiance;
   };
 
-  rc::Rgb compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Rng& rng, int direct_samples) const;
+  rc::Rgb compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler, int direct_samples) const;
   rc::Rgb shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo_world, rc::SampleContext& ctx) const;
 
   const rc::Scene& scene_;

@@ -82,14 +82,15 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
         const uint64_t pixel = uint64_t(y) * width + x;
         PixelState& ps = state[pixel];
         ps.visible = false;
-        rc::Rng rng = rc::Rng::for_item(settings.seed, pixel, uint64_t(iteration));
-        const rc::Vec2 offset = settings.filter.sample(rng.uniform2());
+        rc::Sampler sampler = rc::Sampler::for_pixel_sample(settings.sampler, settings.seed, pixel, uint64_t(iteration));
+        const rc::Vec2 offset = settings.filter.sample(sampler.uniform2());
         const rc::Vec2 film_pos((x + 0.5f + offset.x) / width, (y + 0.5f + offset.y) / height);
-        rc::Ray ray = camera.generate_ray(film_pos, rng.uniform2(), aspect);
+        rc::Ray ray = camera.generate_ray(film_pos, camera.has_lens() ? sampler.uniform2() : rc::Vec2(0.5f), aspect);
         ray.spread = spread;
         rc::Rgb beta(1.0f), direct(0.0f);
         // Mirrors and glass only, without Russian roulette: 64 bounces at most.
         for (int depth = 0; depth < std::min(sppm.max_depth, 64); ++depth) {
+          sampler.start_bounce(depth);
           ++local_rays;
           const std::optional<rc::Hit> hit = scene.intersect(ray);
           if (!hit) {
@@ -107,7 +108,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           const rc::Vec3 wo = frame.to_local(wo_world);
           const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
           if (!m.is_traced_through()) {
-            direct += beta * rc::sample_direct(scene, si, m, frame, wo, wo_above, rng, local_rays).value;
+            direct += beta * rc::sample_direct(scene, si, m, frame, wo, wo_above, sampler, local_rays).value;
             ps.visible = true;
             ps.position = si.p;
             ps.lit_side = wo_above ? si.ng : -si.ng;
@@ -118,7 +119,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
             ps.beta = beta;
             break;
           }
-          const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, rng.uniform(), rng.uniform2());
+          const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, sampler.uniform(), sampler.uniform2());
           if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
           const rc::Vec3 wi_world = frame.to_world(bs->wi);
           if ((glm::dot(wi_world, si.ng) > 0.0f) != (bs->transmission ? !wo_above : wo_above)) break;

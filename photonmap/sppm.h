@@ -39,7 +39,7 @@ struct SppmStats {
 
 /// Renders the scene by SPPM: settings.spp iterations, or whole iterations until
 /// settings.time_limit when it is positive. Iteration i draws pixel samples from
-/// Rng::for_item(seed, pixel, i) and photon j from Rng::for_item(seed, j, i + stream), so the
+/// Sampler::for_pixel_sample(settings.sampler, seed, pixel, i) and photon j from Rng::for_item(seed, j, i + stream), so the
 /// image does not depend on the thread count.
 rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc::RenderSettings& settings,
                      const SppmSettings& sppm, SppmStats* stats = nullptr);

@@ -83,8 +83,8 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
     Rgb sum(0.0f), sum_squares(0.0f);
     int taken = 0;
     for (int s = 0; s < settings.samples; ++s) {
-      rc::SampleContext ctx{rc::Rng::for_item(settings.seed, v, 0xc0ffee0000ull + uint64_t(s)), 0};
-      const rc::Vec2 u = rc::sample_uniform_disk(ctx.rng.uniform2()) * r;
+      rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(settings.seed, v, 0xc0ffee0000ull + uint64_t(s))), 0};
+      const rc::Vec2 u = rc::sample_uniform_disk(ctx.sampler.uniform2()) * r;
       const rc::Ray ray{origin[v] + frame.to_world(Vec3(u.x, u.y, 0.0f)) + r * n, -n, 2.0f * r};
       const std::optional<rc::Hit> hit = scene.intersect(ray);
       if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &m) continue;
@@ -190,7 +190,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     Rgb sum(0.0f), sum_squares(0.0f);
     int taken = 0;
     for (int s = 0; s < settings.samples; ++s) {
-      rc::SampleContext ctx{rc::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s)), 0};
+      rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s))), 0};
       const rc::Ray ray{p + step * n, -n, 2.0f * step};
       const std::optional<rc::Hit> hit = scene.intersect(ray);
       // Something lies on the point, or coincides with its face (a duplicate, facing either way).

@@ -60,7 +60,7 @@ Rgb SolutionAtInput::gathered(const Vec3& p, const Vec3& n) const {
   // The point's own stream, keyed by its position and normal: the same for any thread order.
   const auto bits = [](float x) { return uint64_t(std::bit_cast<uint32_t>(x)); };
   const uint64_t key = rc::mix64(bits(p.x) | bits(p.y) << 32) ^ rc::mix64(bits(p.z) | bits(n.x) << 32);
-  rc::SampleContext ctx{rc::Rng::for_item(gather_.seed, key, bits(n.y) | bits(n.z) << 32), 0};
+  rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(gather_.seed, key, bits(n.y) | bits(n.z) << 32)), 0};
   return view_.gathered_irradiance(mesh_surface_point(p, n), gather_.rays, ctx);
 }
 

@@ -39,9 +39,9 @@ void absorb(const rc::Material& m, const rc::SurfaceInteraction& si, const rc::H
 /// Continues a path through the mirror or glass at si (outgoing direction wo in `frame`):
 /// multiplies beta by the sample's weight and replaces `ray`. False when the path ends there.
 bool scatter_specular(const rc::Material& m, const rc::SurfaceInteraction& si, const rc::Frame& frame, const Vec3& wo,
-                      rc::Rng& rng, Rgb& beta, rc::Ray& ray) {
-  const float u_lobe = rng.uniform();
-  const auto bs = rc::bsdf_sample(m, wo, u_lobe, rng.uniform2());
+                      rc::Sampler& sampler, Rgb& beta, rc::Ray& ray) {
+  const float u_lobe = sampler.uniform();
+  const auto bs = rc::bsdf_sample(m, wo, u_lobe, sampler.uniform2());
   if (!bs || !(bs->pdf > 0.0f)) return false;
   beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
   ray = rc::spawn_ray(si, frame.to_world(bs->wi));
@@ -139,7 +139,7 @@ Rgb RadiosityView::gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::
   const Vec3 wo(0.0f, 0.0f, 1.0f);
   Rgb sum(0.0f);
   for (int r = 0; r < rays; ++r) {
-    sum += rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.rng, ctx.rays) * rc::kPi;
+    sum += rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays) * rc::kPi;
     sum += gather(si, frame, true, ctx);
   }
   return sum / float(std::max(rays, 1));
@@ -150,7 +150,7 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   // One cosine-distributed ray on the lit side: its estimate of the irradiance is the radiance
   // it finds times π.
   const Vec3 side = wo_above ? si.ng : -si.ng;
-  Vec3 wi = frame.to_world(rc::sample_cosine_hemisphere(ctx.rng.uniform2()));
+  Vec3 wi = frame.to_world(rc::sample_cosine_hemisphere(ctx.sampler.uniform2()));
   if (!wo_above) wi = -wi;                            // the frame's z is the front's shading normal
   if (glm::dot(wi, side) <= 0.0f) return Rgb(0.0f);  // the shading normal leans the ray through the surface
   Rgb beta(rc::kPi), out(0.0f);
@@ -185,11 +185,11 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
       const std::optional<Location> at = locate_on(sj, lit);
       if (at && !element_direct_.empty())
         return out + beta * rc::diffuse_reflectance(mj) * (element_direct_[at->element] + indirect_at(*at)) * (1.0f / rc::kPi);
-      out += beta * rc::estimate_direct(scene_, sj, mj, fj, wo, above, ctx.rng, ctx.rays);
+      out += beta * rc::estimate_direct(scene_, sj, mj, fj, wo, above, ctx.sampler, ctx.rays);
       if (at) return out + beta * rc::diffuse_reflectance(mj) * indirect_at(*at) * (1.0f / rc::kPi);
       // No element stands for this side of the surface: one more diffuse bounce from here.
       if (diffuse_left-- == 0) return out;
-      Vec3 next = fj.to_world(rc::sample_cosine_hemisphere(ctx.rng.uniform2()));
+      Vec3 next = fj.to_world(rc::sample_cosine_hemisphere(ctx.sampler.uniform2()));
       if (!above) next = -next;
       if (glm::dot(next, lit) <= 0.0f) return out;
       beta *= rc::diffuse_reflectance(mj);  // Lambertian: f cos / pdf
@@ -197,7 +197,7 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
       via_specular = false;
       continue;
     }
-    if (!scatter_specular(mj, sj, fj, wo, ctx.rng, beta, ray)) return out;
+    if (!scatter_specular(mj, sj, fj, wo, ctx.sampler, beta, ray)) return out;
     via_specular = true;
   }
   return out;
@@ -207,6 +207,7 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
   Rgb beta(1.0f);
   rc::Ray ray = camera_ray;
   for (int depth = 0; depth < 64; ++depth) {
+    ctx.sampler.start_bounce(depth);
     ++ctx.rays;
     const std::optional<rc::Hit> hit = display_.intersect(ray);
     if (!hit) return beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
@@ -222,7 +223,7 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
     const rc::Material& m = display_.materials[si.material];
     absorb(m, si, *hit, ray, beta);
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
-    if (!scatter_specular(m, si, frame, frame.to_local(-glm::normalize(ray.direction)), ctx.rng, beta, ray))
+    if (!scatter_specular(m, si, frame, frame.to_local(-glm::normalize(ray.direction)), ctx.sampler, beta, ray))
       return Rgb(0.0f);
   }
   return Rgb(0.0f);
@@ -232,6 +233,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
   Rgb radiance(0.0f), beta(1.0f);
   rc::Ray ray = camera_ray;
   for (int depth = 0; depth < 64; ++depth) {
+    ctx.sampler.start_bounce(depth);
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
     if (!hit) return radiance + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
@@ -252,7 +254,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
       // solution where it lands. (Gathering everywhere hides the mesh one bounce away, at the
       // price of its noise: on Šibenik's nave at 60 s its relMSE was 1.5 times the reading's,
       // on the Cornell box at 1,600 elements its error 1.2 times.)
-      radiance += beta * rc::estimate_direct(scene_, si, m, frame, wo, wo_above, ctx.rng, ctx.rays);
+      radiance += beta * rc::estimate_direct(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
       if (const std::optional<Rgb> e = indirect_irradiance(si, wo_above ? si.ng : -si.ng)) {
         // The solution's light comes from diffuse surfaces in view (mirrors and glass block it);
         // what arrives through them, the gather ray brings.
@@ -261,7 +263,7 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
       }
       return radiance + beta * rc::diffuse_reflectance(m) * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
     }
-    if (!scatter_specular(m, si, frame, wo, ctx.rng, beta, ray)) return radiance;
+    if (!scatter_specular(m, si, frame, wo, ctx.sampler, beta, ray)) return radiance;
   }
   return radiance;
 }

@@ -24,6 +24,8 @@ struct Camera {
   /// Primary ray through film position `film` ∈ [0,1]² (x right, y down) for an image of the
   /// given aspect ratio (width / height); `lens` ∈ [0,1)² picks the point on the lens.
   Ray generate_ray(Vec2 film, Vec2 lens, float aspect) const;
+  /// Whether generate_ray reads `lens` (a thin lens; pinholes and orthographic cameras do not).
+  bool has_lens() const { return !orthographic && aperture_radius > 0.0f; }
   /// Angle one pixel of an image `height` pixels high subtends at the image centre (Ray::spread);
   /// 0 for an orthographic camera, whose rays do not widen.
   float pixel_spread(int height) const;

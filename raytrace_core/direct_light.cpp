@@ -10,9 +10,9 @@ namespace {
 
 /// One sample of light `li`, chosen with probability `pmf`.
 DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const SurfaceInteraction& si, const Material& m,
-                        const Frame& frame, const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+                        const Frame& frame, const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
   DirectSample out;
-  const LightSample ls = sample_light(scene, scene.lights()[li], si, rng.uniform2());
+  const LightSample ls = sample_light(scene, scene.lights()[li], si, sampler.uniform2());
   // The light must be on wo's side of the geometric surface (no leaks), unless the surface
   // transmits into a lobe (a rough dielectric): then light from behind it counts too.
   if (!(ls.pdf > 0.0f) || ls.radiance.is_black()) return out;
@@ -31,19 +31,19 @@ DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const Surfac
 }  // namespace
 
 DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                           const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+                           const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
   const Distribution1D& choice = scene.light_distribution();
   if (choice.size() == 0) return {};
-  const uint32_t li = choice.sample(rng.uniform());
-  return sample_one(scene, li, choice.pmf(li), si, m, frame, wo, wo_above, rng, rays);
+  const uint32_t li = choice.sample(sampler.uniform());
+  return sample_one(scene, li, choice.pmf(li), si, m, frame, wo, wo_above, sampler, rays);
 }
 
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                    const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays) {
+                    const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
   const size_t count = scene.lights().size();
-  if (count > kEachLightLimit) return sample_direct(scene, si, m, frame, wo, wo_above, rng, rays).value;
+  if (count > kEachLightLimit) return sample_direct(scene, si, m, frame, wo, wo_above, sampler, rays).value;
   Rgb sum(0.0f);
-  for (uint32_t li = 0; li < count; ++li) sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, rng, rays).value;
+  for (uint32_t li = 0; li < count; ++li) sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, sampler, rays).value;
   return sum;
 }
 

@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "raytrace_core/rng.h"
+#include "raytrace_core/sampler.h"
 #include "raytrace_core/scene.h"
 
 namespace gilt::raytrace_core {
@@ -29,7 +29,7 @@ struct DirectSample {
 /// A light on the other side of the geometric surface adds nothing, except through a surface
 /// that transmits into a lobe (a rough dielectric), whose BSDF then gives the transmitted part.
 DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                           const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays);
+                           const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays);
 
 /// Lights up to which estimate_direct samples every light rather than choosing one.
 inline constexpr size_t kEachLightLimit = 8;
@@ -41,6 +41,6 @@ inline constexpr size_t kEachLightLimit = 8;
 /// point's sun reads either 0 or 1/p times its value). With more, one sample of a light chosen by
 /// power, as sample_direct.
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                    const Vec3& wo, bool wo_above, Rng& rng, uint64_t& rays);
+                    const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays);
 
 }  // namespace gilt::raytrace_core

@@ -18,6 +18,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
   SurfacePoint prev;
 
   for (int depth = 0;; ++depth) {
+    ctx.sampler.start_bounce(depth);
     ++ctx.rays;
     const std::optional<Hit> hit = scene.intersect(ray);
     const Vec3 wo_world = -glm::normalize(ray.direction);
@@ -63,14 +64,14 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
 
     // Next-event estimation, MIS-weighted against BSDF sampling.
     if (!m.is_specular()) {
-      const DirectSample ds = sample_direct(scene, si, m, frame, wo, wo_above, ctx.rng, ctx.rays);
+      const DirectSample ds = sample_direct(scene, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
       if (!ds.value.is_black())
         radiance += beta * ds.value * (ds.delta ? 1.0f : power_heuristic(1.0f, ds.pdf, 1.0f, bsdf_pdf(m, wo, ds.wi)));
     }
 
     // Continue the path by sampling the BSDF.
-    const float u_lobe = ctx.rng.uniform();
-    const std::optional<BsdfSample> bs = bsdf_sample(m, wo, u_lobe, ctx.rng.uniform2());
+    const float u_lobe = ctx.sampler.uniform();
+    const std::optional<BsdfSample> bs = bsdf_sample(m, wo, u_lobe, ctx.sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
     const Vec3 wi_world = frame.to_world(bs->wi);
     // A shading normal may send a reflected ray through the geometric surface: end such paths.
@@ -85,7 +86,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     // Russian roulette on the throughput.
     if (depth + 1 >= settings.rr_depth) {
       const float survive = std::min(1.0f, beta.max_component());
-      if (survive <= 0.0f || ctx.rng.uniform() >= survive) break;
+      if (survive <= 0.0f || ctx.sampler.uniform() >= survive) break;
       beta /= survive;
     }
   }

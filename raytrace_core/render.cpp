@@ -56,10 +56,10 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
         for (int x = tile.x0; x < tile.x1; ++x) {
           const uint64_t pixel = uint64_t(y) * settings.width + x;
           for (int s = first; s < first + count; ++s) {
-            SampleContext ctx{Rng::for_item(settings.seed, pixel, uint64_t(s)), 0};
-            const Vec2 offset = settings.filter.sample(ctx.rng.uniform2());
+            SampleContext ctx{Sampler::for_pixel_sample(settings.sampler, settings.seed, pixel, uint64_t(s)), 0};
+            const Vec2 offset = settings.filter.sample(ctx.sampler.uniform2());
             const Vec2 film_pos((x + 0.5f + offset.x) / settings.width, (y + 0.5f + offset.y) / settings.height);
-            const Vec2 lens = ctx.rng.uniform2();
+            const Vec2 lens = camera.has_lens() ? ctx.sampler.uniform2() : Vec2(0.5f);
             Ray ray = camera.generate_ray(film_pos, lens, aspect);
             ray.spread = spread;
             const Rgb value = radiance(ray, ctx);

@@ -7,7 +7,7 @@
 
 #include "raytrace_core/camera.h"
 #include "raytrace_core/film.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/sampler.h"
 #include "raytrace_core/scene.h"
 
 namespace gilt::raytrace_core {
@@ -23,6 +23,7 @@ struct RenderSettings {
   Filter filter;              ///< pixel filter
   bool progress = true;       ///< progress bar on stderr (only drawn on a terminal)
   int tile_size = 16;         ///< tile edge in pixels
+  SamplerKind sampler = SamplerKind::sobol;  ///< how each camera sample draws its numbers
 };
 
 /// What a render did.
@@ -34,9 +35,9 @@ struct RenderStats {
   uint64_t non_finite = 0;  ///< samples discarded because the method returned NaN or infinity
 };
 
-/// State of one camera sample: its random stream and a ray counter.
+/// State of one camera sample: its sampler and a ray counter.
 struct SampleContext {
-  Rng rng;
+  Sampler sampler;
   uint64_t rays = 0;
 };
 
@@ -44,7 +45,7 @@ struct SampleContext {
 using RadianceFunction = std::function<Rgb(const Ray& ray, SampleContext& ctx)>;
 
 /// Renders with the given radiance function. Sample s of pixel (x, y) draws from
-/// Rng::for_item(seed, y·width + x, s) only, so the result is independent of threads and tiles.
+/// Sampler::for_pixel_sample(sampler, seed, y·width + x, s) only, so the result is independent of threads and tiles.
 Film render_image(const Scene& scene, const Camera& camera, const RenderSettings& settings,
                   const RadianceFunction& radiance, RenderStats* stats = nullptr);
 

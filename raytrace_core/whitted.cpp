@@ -10,6 +10,7 @@ namespace gilt::raytrace_core {
 namespace {
 
 Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings, int depth) {
+  ctx.sampler.start_bounce(depth);
   ++ctx.rays;
   const std::optional<Hit> hit = scene.intersect(ray);
   if (!hit) return escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
@@ -28,9 +29,9 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
     const int n = std::max(1, settings.area_light_samples);
     if (choice.size() == 0) return radiance;
     for (int i = 0; i < n; ++i) {
-      const uint32_t li = choice.sample(ctx.rng.uniform());
+      const uint32_t li = choice.sample(ctx.sampler.uniform());
       const float pmf = choice.pmf(li);
-      const LightSample ls = sample_light(scene, scene.lights()[li], si, ctx.rng.uniform2());
+      const LightSample ls = sample_light(scene, scene.lights()[li], si, ctx.sampler.uniform2());
       if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) continue;
       const Vec3 wi = frame.to_local(ls.wi);
       const Rgb f = bsdf_eval(m, wo, wi) * std::fabs(wi.z);

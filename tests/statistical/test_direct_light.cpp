@@ -61,7 +61,7 @@ TEST(DirectLight, EveryLightOfAFewIsSampledAtEachPoint) {
   const rc::Frame frame = rc::Frame::from_normal(si.ns);
   const Vec3 wo = frame.to_local(Vec3(0.0f, 1.0f, 0.0f));
   const float expected = kAlbedo / rc::kPi * (2.0f * 0.8f + 3.0f / 4.0f);
-  rc::Rng rng;
+  rc::Sampler rng(rc::Rng{});
   uint64_t rays = 0;
   for (int i = 0; i < 64; ++i) {
     const Rgb e = rc::estimate_direct(scene, si, scene.materials[si.material], frame, wo, true, rng, rays);
@@ -84,7 +84,7 @@ TEST(DirectLight, SunAndSkyMeanMatchesTheClosedForm) {
   // The floor's 20 × 20 lies below the point: the whole upper hemisphere is open sky.
   const double expected = kAlbedo * (4.0 / rc::kPi + 0.5);
   constexpr int kSamples = 20000;
-  rc::Rng rng(7);
+  rc::Sampler rng(rc::Rng(7));
   uint64_t rays = 0;
   double sum = 0.0, sum2 = 0.0, lowest = 1e30;
   for (int i = 0; i < kSamples; ++i) {

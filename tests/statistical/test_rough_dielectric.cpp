@@ -245,7 +245,7 @@ TEST(RoughDielectric, NextEventEstimationSeesLightsBehindIt) {
     const Vec3 wo = frame.to_local(wo_world);
     const bool above = glm::dot(wo_world, si.ng) > 0.0f;
     constexpr int kN = 400000;
-    Rng rng(17);
+    Sampler rng(Rng(17));
     uint64_t rays = 0;
     const test::MeanEstimate nee = test::estimate_mean(kN, [&] { return double(sample_direct(scene, si, m, frame, wo, above, rng, rays).value.g); });
     const test::MeanEstimate by_bsdf = test::estimate_mean(kN, [&] {

@@ -15,8 +15,10 @@ namespace rc = gilt::raytrace_core;
 
 namespace {
 
-rc::Film render(const rc::Scene& scene, int threads, uint64_t seed) {
+rc::Film render(const rc::Scene& scene, int threads, uint64_t seed,
+                rc::SamplerKind sampler = rc::SamplerKind::sobol) {
   rc::RenderSettings s;
+  s.sampler = sampler;
   s.width = 48;
   s.height = 40;
   s.spp = 8;
@@ -48,6 +50,15 @@ TEST(Determinism, OneAndTwoThreadsGiveIdenticalExr) {
   ASSERT_FALSE(a.empty());
   EXPECT_EQ(a, b) << "EXR files differ between 1 and 2 threads";
   EXPECT_TRUE(one.pixels() == two.pixels());
+}
+
+TEST(Determinism, EachSamplerIsIndependentOfThreads) {
+  const rc::Scene scene = rc::load_scene("cornell");
+  for (rc::SamplerKind kind : {rc::SamplerKind::sobol, rc::SamplerKind::independent}) {
+    EXPECT_TRUE(render(scene, 1, 5, kind).pixels() == render(scene, 2, 5, kind).pixels()) << rc::sampler_name(kind);
+  }
+  EXPECT_FALSE(render(scene, 2, 5, rc::SamplerKind::sobol).pixels() ==
+               render(scene, 2, 5, rc::SamplerKind::independent).pixels());
 }
 
 TEST(Determinism, DifferentSeedsGiveDifferentImages) {

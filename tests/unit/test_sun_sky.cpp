@@ -121,7 +121,7 @@ TEST(SunSky, TheDiskIsSeenByCameraRaysAndThroughMirrors) {
   const double solid_angle = 2.0 * std::numbers::pi * (1.0 - std::cos(double(alpha)));
 
   // A camera ray into the disk sees its radiance; one just outside it sees nothing.
-  SampleContext ctx{Rng(5), 0};
+  SampleContext ctx{Sampler(Rng(5)), 0};
   EXPECT_NEAR(path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), to_sun}, ctx, {}).g, 1.0 / solid_angle, 1e-4);
   const Vec3 outside = glm::normalize(glm::rotate(glm::mat4(1.0f), 1.1f * alpha, Vec3(0, 0, 1)) * glm::vec4(to_sun, 0.0f));
   EXPECT_EQ(path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), outside}, ctx, {}), Rgb(0.0f));
@@ -136,7 +136,7 @@ TEST(SunSky, TheDiskIsSeenByCameraRaysAndThroughMirrors) {
   const int n = 1000000;
   double sum = 0.0, sum2 = 0.0;
   for (int i = 0; i < n; ++i) {
-    SampleContext c{Rng::for_item(9, 0, uint64_t(i)), 0};
+    SampleContext c{Sampler(Rng::for_item(9, 0, uint64_t(i))), 0};
     const double e = std::numbers::pi * path_radiance(scene, Ray{Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0)}, c, probe).g;
     sum += e, sum2 += e * e;
   }
