@@ -180,8 +180,12 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   // Final gather.
   rc::Rgb gathered(0.0f);
   const bool caustics_in_map = !maps_.caustic.empty();
+  // The gather rays of each camera sample are sub-samples: stratified among themselves and with
+  // the other samples' rays in the pixel.
+  const rc::Sampler::SubSamples gather_samples = ctx.sampler.split(uint32_t(gather));
   for (int j = 0; j < gather; ++j) {
-    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.sampler.uniform(), ctx.sampler.uniform2());
+    rc::Sampler sampler = gather_samples[uint32_t(j)];
+    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, sampler.uniform(), sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) continue;
     const rc::Vec3 wi_world = frame.to_world(bs->wi);
     const bool wi_above = glm::dot(wi_world, si.ng) > 0.0f;
@@ -228,7 +232,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       if (mj.is_traced_through()) {
         const rc::Frame fj = rc::Frame::from_normal(sj.ns);
         const rc::Vec3 woj = fj.to_local(-dir);
-        const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, ctx.sampler.uniform(), ctx.sampler.uniform2());
+        const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, sampler.uniform(), sampler.uniform2());
         if (!bj || !(bj->pdf > 0.0f) || bj->f.is_black()) break;
         g *= bj->f * (std::fabs(bj->wi.z) / bj->pdf);
         ray = rc::spawn_ray(sj, fj.to_world(bj->wi));
@@ -237,7 +241,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       }
       // A diffuse or glossy hit: its reflected light from the precomputed irradiance.
       const rc::Vec3 side = glm::dot(-dir, sj.ng) > 0.0f ? sj.ng : -sj.ng;
-      gathered += g * rc::diffuse_reflectance(mj) * irradiance(sj.p, side, ctx.sampler) * rc::kInvPi;
+      gathered += g * rc::diffuse_reflectance(mj) * irradiance(sj.p, side, sampler) * rc::kInvPi;
       break;
     }
   }

@@ -57,10 +57,11 @@ std::optional<Rgb> SolutionAtInput::operator()(const rc::Material& m, const Vec3
 
 Rgb SolutionAtInput::gathered(const Vec3& p, const Vec3& n) const {
   ++gathered_;
-  // The point's own stream, keyed by its position and normal: the same for any thread order.
+  // The point's own sampler, keyed by its position and normal: the same for any thread order.
   const auto bits = [](float x) { return uint64_t(std::bit_cast<uint32_t>(x)); };
   const uint64_t key = rc::mix64(bits(p.x) | bits(p.y) << 32) ^ rc::mix64(bits(p.z) | bits(n.x) << 32);
-  rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(gather_.seed, key, bits(n.y) | bits(n.z) << 32)), 0};
+  const uint64_t point = key ^ rc::mix64(bits(n.y) | bits(n.z) << 32);
+  rc::SampleContext ctx{rc::Sampler::for_pixel_sample(rc::SamplerKind::sobol, gather_.seed, point, 0), 0};
   return view_.gathered_irradiance(mesh_surface_point(p, n), gather_.rays, ctx);
 }
 

@@ -138,9 +138,14 @@ Rgb RadiosityView::gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::
   const rc::Frame frame = rc::Frame::from_normal(p.ng);
   const Vec3 wo(0.0f, 0.0f, 1.0f);
   Rgb sum(0.0f);
+  // The rays are sub-samples of the point's sample: with the Sobol sampler, their shadow rays'
+  // points on each light and their gather directions are each a stratified set.
+  const rc::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(std::max(rays, 1)));
   for (int r = 0; r < rays; ++r) {
-    sum += rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays) * rc::kPi;
-    sum += gather(si, frame, true, ctx);
+    rc::SampleContext sub{samples[uint32_t(r)], 0};
+    sum += rc::estimate_direct(scene_, si, white, frame, wo, true, sub.sampler, sub.rays) * rc::kPi;
+    sum += gather(si, frame, true, sub);
+    ctx.rays += sub.rays;
   }
   return sum / float(std::max(rays, 1));
 }

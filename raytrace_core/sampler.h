@@ -63,6 +63,45 @@ class Sampler {
   /// The independent stream (used past the Sobol dimensions).
   Rng& rng() { return rng_; }
 
+  /// `count` sub-samples taken at one point of the path, such as a final gather's rays.
+  class SubSamples {
+   public:
+    /// Sub-sample j < count. With Sobol, its requests come from point index·count + j of
+    /// dimensions of the set's own (kBounceDimensions of them, then its own PCG stream), so the
+    /// rays of all of a pixel's samples are stratified together, and for a power-of-two count
+    /// each sample's own rays form a net too.
+    Sampler operator[](uint32_t j) const {
+      Sampler s(Rng(mix64(key_ + j), key_));
+      if (sobol_) {
+        s.sobol_ = true;
+        s.reversed_index_ = sobol::reverse_bits(first_ + j);
+        s.pixel_seed_ = key_;
+        s.bounce_end_ = kBounceDimensions;
+      }
+      return s;
+    }
+
+   private:
+    friend class Sampler;
+    uint64_t key_ = 0;
+    uint32_t first_ = 0;
+    bool sobol_ = false;
+  };
+  /// A set of `count` sub-samples; uses up one dimension of this sampler.
+  SubSamples split(uint32_t count) {
+    SubSamples set;
+    const uint32_t index = sobol::reverse_bits(reversed_index_);
+    if (use_sobol() && count > 0 && index <= (UINT32_MAX - count) / count) {
+      set.sobol_ = true;
+      set.key_ = dimension_seed();
+      set.first_ = index * count;
+    } else {
+      set.key_ = mix64(uint64_t(rng_.next_u32()) << 32 | rng_.next_u32());
+      if (sobol_) ++dimension_;
+    }
+    return set;
+  }
+
  private:
   bool use_sobol() const {
     return sobol_ && dimension_ < bounce_end_ && dimension_ < kCameraDimensions + kSobolBounces * kBounceDimensions;
