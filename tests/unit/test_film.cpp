@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "raytrace_core/error.h"
+#include "raytrace_core/render.h"
+#include "raytrace_core/scene.h"
 
 namespace gilt::raytrace_core {
 namespace {
@@ -181,6 +183,41 @@ TEST(Filter, ChiSquareRejectsTheWrongShape) {
   EXPECT_GT(chi_square(Filter{FilterKind::gaussian, 1.5f}, FilterKind::tent, 0, 99), threshold);
   EXPECT_GT(chi_square(Filter{FilterKind::tent, 1.5f}, FilterKind::gaussian, 0, 99), threshold);
   EXPECT_GT(chi_square(Filter{FilterKind::box, 1.5f}, FilterKind::tent, 0, 99), threshold);
+}
+
+// Every sample has weight 1: the filter is importance-sampled, so a pixel is the plain mean of
+// its samples and converges to the filter-weighted mean of the radiance. An orthographic camera
+// over a step (radiance 1 left of x = 0, 0 right of it) gives pixel px, centred 3.5 − px pixels
+// left of the step, the filter's CDF there, F(3.5 − px). With n independent samples the error's
+// standard deviation is √(F(1 − F)/n), and the test allows four; with Sobol samples the film
+// offsets' x coordinates fall one in each 1/n of [0, 1), so the count of samples left of the
+// step is nF rounded up or down, and the error is at most 1/n.
+TEST(Filter, PixelsAreFilterWeightedMeansOfUnitWeightSamples) {
+  Scene scene;
+  scene.commit();
+  Camera camera;
+  camera.look_from = Vec3(0.0f, 0.0f, 1.0f);
+  camera.look_at = Vec3(0.0f);
+  camera.up = Vec3(0.0f, 1.0f, 0.0f);
+  camera.orthographic = true;
+  camera.ortho_height = 1.0f;  // 8 × 1 pixels: one scene unit per pixel, x = px + 0.5 − 4 at the centre
+  constexpr int kSpp = 1024;
+  for (FilterKind kind : kKinds) {
+    for (SamplerKind sampler : {SamplerKind::sobol, SamplerKind::independent}) {
+      RenderSettings settings;
+      settings.width = 8, settings.height = 1, settings.spp = kSpp, settings.progress = false;
+      settings.filter = Filter{kind, 1.5f};
+      settings.sampler = sampler;
+      const Film film = render_image(scene, camera, settings, [](const Ray& ray, SampleContext&) {
+        return Rgb(ray.origin.x < 0.0f ? 1.0f : 0.0f);
+      });
+      for (int px = 1; px <= 6; ++px) {
+        const double f = filter_cdf(kind, 3.5 - px, 1.5);
+        const double bound = sampler == SamplerKind::sobol ? 1.0 / kSpp + 1e-6 : 4.0 * std::sqrt(f * (1.0 - f) / kSpp) + 1e-6;
+        EXPECT_NEAR(film.pixel(px, 0).r, f, bound) << "filter " << int(kind) << ", " << sampler_name(sampler) << ", pixel " << px;
+      }
+    }
+  }
 }
 
 TEST(Filter, ParsesNames) {
