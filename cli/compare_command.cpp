@@ -306,6 +306,7 @@ void run_compare(const CompareOptions& o) {
   Report report;
   report.scene = o.scene;
   report.width = o.width, report.height = o.height, report.exposure = o.exposure;
+  report.sampler = o.sampler;
   report.reference = ref.description;
   report.reference_noise_mre = ref.noise;
   if (!ref.variance.empty()) {

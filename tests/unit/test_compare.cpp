@@ -71,6 +71,7 @@ TEST_F(Compare, WritesReportMetricsAndImages) {
   ASSERT_TRUE(fs::exists(report / "index.html"));
   const nlohmann::json j = nlohmann::json::parse(slurp(report / "metrics.json"));
   ASSERT_EQ(j["entries"].size(), 4u);
+  EXPECT_EQ(j["sampler"], "sobol");  // the default
   // The path-traced reference's noise, from its two halves, is taken out of the squared errors.
   EXPECT_TRUE(j["errors_noise_corrected"].get<bool>());
   const double floor = j["reference_relmse_floor"].get<double>();
