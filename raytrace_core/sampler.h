@@ -10,8 +10,9 @@
 // call start_bounce(depth) at each vertex, so request j of bounce d always lands in dimension
 // kCameraDimensions + d·kBounceDimensions + j whatever happened before it. Past kSobolBounces
 // bounces, or past kBounceDimensions requests in a bounce, the values come from the PCG stream:
-// by then the path's contribution is small and its integrand high-dimensional, where
-// stratifying pairs of dimensions gains nothing measurable (bench/README.md, "Sobol sampler").
+// by then the path's contribution is small and its integrand high-dimensional. On the Cornell
+// box a sample's relMSE was the same with Sobol points for 3 or 4 vertices and about 7 % higher
+// with 2, while each 2D request costs about 12 ns (bench/README.md, "The Sobol sampler").
 
 #include <cstdint>
 #include <string>
