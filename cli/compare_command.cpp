@@ -42,6 +42,7 @@ struct CompareOptions {
   int width = 256, height = 256;
   uint64_t seed = 0;
   std::string sampler = "sobol";  ///< the methods' samplers; the reference always uses Sobol
+  std::string light_sampler = "bvh";  ///< the methods' choice of light; the reference always uses the BVH
   int threads = 0;
   float exposure = 0.0f;
   bool quiet = false;
@@ -73,7 +74,7 @@ struct Hasher {
 std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, const CompareOptions& o,
                           const std::string& method) {
   Hasher k;
-  const std::string version = "gilt-reference-4";  // 4: halves drawn with the Sobol sampler
+  const std::string version = "gilt-reference-5";  // 4: halves drawn with the Sobol sampler; 5: the light BVH
   k.bytes(version.data(), version.size());
   k.bytes(method.data(), method.size());
   for (const rc::TriangleMesh& m : scene.meshes) k.vector(m.positions), k.vector(m.indices), k.vector(m.normals), k.value(m.material);
@@ -307,6 +308,8 @@ void run_compare(const CompareOptions& o) {
   report.scene = o.scene;
   report.width = o.width, report.height = o.height, report.exposure = o.exposure;
   report.sampler = o.sampler;
+  report.light_sampler = o.light_sampler;
+  scene.set_light_sampling(rc::parse_light_sampling(o.light_sampler));  // after the reference
   report.reference = ref.description;
   report.reference_noise_mre = ref.noise;
   if (!ref.variance.empty()) {
@@ -385,6 +388,9 @@ std::function<void()> add_compare_command(CLI::App& app) {
   cmd->add_option("--width", o->width, "Image width (default 256)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", o->height, "Image height (default 256)")->check(CLI::Range(1, 16384));
   cmd->add_option("--seed", o->seed, "Random seed")->check(unsigned_integer());
+  cmd->add_option("--light-sampler", o->light_sampler,
+                  "The methods' choice of light to sample: bvh (default) or power; the reference uses bvh")
+      ->check(CLI::IsMember({"bvh", "power"}));
   cmd->add_option("--sampler", o->sampler, "The methods' camera samples: sobol (default) or independent")
       ->check(CLI::IsMember({"independent", "sobol"}));
   cmd->add_option("--threads", o->threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));

@@ -40,6 +40,7 @@ struct RenderOptions {
   std::optional<float> fov, aperture, focus_distance;
   std::string filter = "gaussian";
   std::string sampler = "sobol";
+  std::string light_sampler = "bvh";
   float filter_radius = 1.5f;
   float exposure = 0.0f;
   int max_depth = 0;
@@ -94,6 +95,7 @@ void run_render(const RenderOptions& o) {
   check_output(o.output);
   rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   if (!o.camera.empty()) rc::select_camera(scene, o.camera);
+  scene.set_light_sampling(rc::parse_light_sampling(o.light_sampler));
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: the image will be black\n";
 
@@ -154,6 +156,7 @@ void run_render(const RenderOptions& o) {
                         {"spp", stats.spp},
                         {"seed", settings.seed},
                         {"sampler", rc::sampler_name(settings.sampler)},
+                        {"light_sampler", rc::light_sampling_name(scene.light_sampler().mode())},
                         {"threads", threads},
                         {"triangles", scene.triangle_count()},
                         {"spheres", scene.spheres.size()},
@@ -269,6 +272,10 @@ std::function<void()> add_render_command(CLI::App& app) {
   cmd->add_option("--sampler", o->sampler,
                   "Camera-sample numbers: sobol (Owen-scrambled Sobol, the default) or independent")
       ->check(CLI::IsMember({"independent", "sobol"}));
+  cmd->add_option("--light-sampler", o->light_sampler,
+                  "Next-event estimation's choice of light: bvh (by power, distance and orientation, the "
+                  "default) or power (by power alone)")
+      ->check(CLI::IsMember({"bvh", "power"}));
   cmd->add_option("--filter", o->filter, "Pixel filter: box, tent or gaussian")
       ->check(CLI::IsMember({"box", "tent", "gaussian"}));
   cmd->add_option("--filter-radius", o->filter_radius, "Pixel filter radius in pixels")

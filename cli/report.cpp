@@ -136,7 +136,7 @@ void error_colour(double relative_error, unsigned char rgb[3]) {
 void write_report(const std::filesystem::path& folder, const Report& r) {
   // metrics.json and metrics.csv.
   nlohmann::json j = {{"scene", r.scene},       {"width", r.width},         {"height", r.height},
-                      {"sampler", r.sampler},     {"reference", r.reference}, {"reference_noise_mean_relative_error", r.reference_noise_mre},
+                      {"sampler", r.sampler}, {"light_sampler", r.light_sampler},     {"reference", r.reference}, {"reference_noise_mean_relative_error", r.reference_noise_mre},
                       {"reference_relmse_floor", r.reference_relmse_floor},
                       {"reference_mse_floor", r.reference_mse_floor},
                       {"errors_noise_corrected", r.reference_relmse_floor > 0.0},
@@ -184,7 +184,7 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
     << ".legend{height:14px;width:300px;background:linear-gradient(to right,rgb(10,10,60),rgb(30,80,220),"
        "rgb(40,200,200),rgb(240,220,40),rgb(220,30,30))}\n</style>\n</head>\n<body>\n";
   h << "<h1>gilt compare: " << escape(r.scene) << "</h1>\n<p>" << r.width << " &times; " << r.height
-    << " pixels, every method on the same camera, " << escape(r.sampler) << " samples. Reference: " << escape(r.reference);
+    << " pixels, every method on the same camera, " << escape(r.sampler) << " samples, lights chosen by " << escape(r.light_sampler) << ". Reference: " << escape(r.reference);
   if (r.reference_noise_mre > 0.0)
     h << " (its own noise: mean relative error " << number(100 * r.reference_noise_mre, "%.2f")
       << " %)";

@@ -40,6 +40,7 @@ struct Report {
   int width = 0, height = 0;
   float exposure = 0.0f;
   std::string sampler = "sobol";   ///< the methods' camera samples (--sampler)
+  std::string light_sampler = "bvh";  ///< the methods' choice of light (--light-sampler)
   std::string reference;            ///< how the reference was made or where it came from
   double reference_noise_mre = 0.0; ///< the reference's own noise in the mre measure (0: unknown)
   /// What a perfect image would measure against the reference, in relMSE and MSE: its noise

@@ -84,13 +84,16 @@ rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& norm
                                          int direct_samples) const {
   rc::Rgb e(0.0f);
   const auto& lights = scene_.lights();
-  const rc::Distribution1D& choice = scene_.light_distribution();
+  const rc::LightSampler& choice = scene_.light_sampler();
   if (choice.size() > 0) {
     const rc::SurfacePoint at = point_at(p, normal);
+    const rc::LightQuery query{p, normal, false};
     for (int i = 0; i < direct_samples; ++i) {
-      const uint32_t li = choice.sample(sampler.uniform());
-      const float pmf = choice.pmf(li);
-      const rc::LightSample ls = rc::sample_light(scene_, lights[li], at, sampler.uniform2());
+      const rc::LightChoice chosen = choice.sample(query, sampler.uniform());
+      const float pmf = chosen.pmf;
+      const rc::Vec2 u_light = sampler.uniform2();
+      if (!(pmf > 0.0f)) continue;
+      const rc::LightSample ls = rc::sample_light(scene_, lights[chosen.light], at, u_light);
       const float cos_theta = glm::dot(ls.wi, normal);
       if (!(ls.pdf > 0.0f) || !(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
       if (scene_.occluded(ls.shadow_ray)) continue;
@@ -160,7 +163,8 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   const rc::Vec3 lit_side = wo_above ? si.ng : -si.ng;
   const EstimateQuery query{si.p, lit_side, size_t(settings_.k), max_radius2_};
   const auto& lights = scene_.lights();
-  const rc::Distribution1D& choice = scene_.light_distribution();
+  const rc::LightSampler& choice = scene_.light_sampler();
+  const rc::LightQuery light_query = rc::light_query(si, m, wo_above);  // sample_direct's, for MIS
   const int gather = settings_.gather_rays;
   rc::Rgb l(0.0f);
 
@@ -198,12 +202,11 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       const std::optional<rc::Hit> hit = scene_.intersect(ray);
       const rc::Vec3 dir = glm::normalize(ray.direction);
       if (!hit) {
-        for (size_t li = 0; li < lights.size(); ++li) {
-          if (lights[li].kind != rc::LightKind::environment) continue;
+        for (const uint32_t li : scene_.environment_lights()) {
           float w = 1.0f;
           if (!through_specular && !bs->delta)
             w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    choice.pmf(uint32_t(li)) * rc::light_pdf(scene_, lights[li], si, dir, si));
+                                    choice.pmf(light_query, li) * rc::light_pdf(scene_, lights[li], si, dir, si));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
           gathered += g * rc::environment_radiance(lights[li], dir) * w;
@@ -223,7 +226,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
           float w = 1.0f;
           if (!through_specular && sj.light >= 0)
             w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    choice.pmf(uint32_t(sj.light)) * rc::light_pdf(scene_, lights[sj.light], si, dir, sj));
+                                    choice.pmf(light_query, uint32_t(sj.light)) * rc::light_pdf(scene_, lights[sj.light], si, dir, sj));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
           gathered += g * le * w;

@@ -30,12 +30,20 @@ DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const Surfac
 
 }  // namespace
 
+LightQuery light_query(const SurfaceInteraction& si, const Material& m, bool wo_above) {
+  return {si.p, wo_above ? si.ng : -si.ng, m.is_rough_dielectric()};
+}
+
 DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
                            const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
-  const Distribution1D& choice = scene.light_distribution();
-  if (choice.size() == 0) return {};
-  const uint32_t li = choice.sample(sampler.uniform());
-  return sample_one(scene, li, choice.pmf(li), si, m, frame, wo, wo_above, sampler, rays);
+  const LightSampler& lights = scene.light_sampler();
+  if (lights.size() == 0) return {};
+  const LightChoice choice = lights.sample(light_query(si, m, wo_above), sampler.uniform());
+  if (!(choice.pmf > 0.0f)) {
+    sampler.uniform2();  // keep the dimensions of the next requests where they would be
+    return {};
+  }
+  return sample_one(scene, choice.light, choice.pmf, si, m, frame, wo, wo_above, sampler, rays);
 }
 
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,

@@ -23,9 +23,15 @@ struct DirectSample {
   bool delta = false;  ///< point, spot or directional light: BSDF sampling cannot reach it
 };
 
+/// The query a light is chosen for at `si` (material m, wo_above: the outgoing direction lies on
+/// the ng side): the lit side of the geometric surface, both sides through a surface that
+/// transmits into a lobe. sample_direct chooses with it; MIS of a BSDF-sampled ray that reaches a
+/// light asks the light sampler's pmf with the same query.
+LightQuery light_query(const SurfaceInteraction& si, const Material& m, bool wo_above);
+
 /// Samples the scene's lights once from `si` (material m, shading frame `frame`, outgoing
 /// direction wo in that frame, wo_above: wo lies on the ng side). Draws one uniform for the light
-/// and two for the point on it, nothing when the scene has no lights; adds the shadow ray to `rays`.
+/// (Scene::light_sampler, with light_query) and two for the point on it, nothing when the scene has no lights; adds the shadow ray to `rays`.
 /// A light on the other side of the geometric surface adds nothing, except through a surface
 /// that transmits into a lobe (a rough dielectric), whose BSDF then gives the transmitted part.
 DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,

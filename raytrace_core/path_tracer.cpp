@@ -10,12 +10,13 @@ namespace gilt::raytrace_core {
 
 Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx, const PathSettings& settings) {
   const auto& lights = scene.lights();
-  const Distribution1D& light_choice = scene.light_distribution();
+  const LightSampler& light_choice = scene.light_sampler();
   Rgb radiance(0.0f), beta(1.0f);
   Ray ray = camera_ray;
   bool specular_bounce = true;  // the camera counts as a delta event: emission seen directly is not weighted
   float bsdf_pdf_prev = 0.0f;
   SurfacePoint prev;
+  LightQuery prev_query;  // what light sampling at prev chose lights for
 
   for (int depth = 0;; ++depth) {
     ctx.sampler.start_bounce(depth);
@@ -27,7 +28,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
       for (const uint32_t li : scene.environment_lights()) {
         float weight = 1.0f;
         if (!specular_bounce) {
-          const float light_pdf_v = light_choice.pmf(li) * light_pdf(scene, lights[li], prev, -wo_world, prev);
+          const float light_pdf_v = light_choice.pmf(prev_query, li) * light_pdf(scene, lights[li], prev, -wo_world, prev);
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
         radiance += beta * environment_radiance(lights[li], -wo_world) * weight;
@@ -50,7 +51,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
         float weight = 1.0f;
         if (!specular_bounce && si.light >= 0) {
           const float light_pdf_v =
-              light_choice.pmf(uint32_t(si.light)) * light_pdf(scene, lights[si.light], prev, -wo_world, si);
+              light_choice.pmf(prev_query, uint32_t(si.light)) * light_pdf(scene, lights[si.light], prev, -wo_world, si);
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
         radiance += beta * le * weight;
@@ -81,6 +82,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     specular_bounce = bs->delta;
     bsdf_pdf_prev = bs->pdf;
     prev = si;
+    prev_query = light_query(si, m, wo_above);
     ray = spawn_ray(si, wi_world);
 
     // Russian roulette on the throughput.

@@ -393,6 +393,7 @@ void Scene::commit() {
   std::vector<float> power(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) power[i] = light_power(*this, lights_[i]).average();
   light_distribution_ = Distribution1D(power);
+  light_sampler_ = LightSampler(*this, lights_, power);
 }
 
 std::optional<Hit> Scene::intersect(const Ray& ray) const {

@@ -15,6 +15,7 @@
 
 #include "raytrace_core/camera.h"
 #include "raytrace_core/light.h"
+#include "raytrace_core/light_sampler.h"
 #include "raytrace_core/material.h"
 #include "raytrace_core/math.h"
 #include "raytrace_core/ray.h"
@@ -139,8 +140,12 @@ class Scene {
   /// Indices into lights() of the environment lights, so that a ray escaping the scene need not
   /// visit every emitting triangle to find them.
   std::span<const uint32_t> environment_lights() const { return environment_lights_; }
-  /// Light chosen with probability proportional to its power.
+  /// Light chosen with probability proportional to its power: where photons start.
   const Distribution1D& light_distribution() const { return light_distribution_; }
+  /// Light chosen for a point to be lit (next-event estimation), and its probability for MIS.
+  const LightSampler& light_sampler() const { return light_sampler_; }
+  /// How light_sampler() chooses: by the light BVH (default) or by power alone. Set before rendering.
+  void set_light_sampling(LightSampling mode) { light_sampler_.set_mode(mode); }
   /// Bounds of all finite geometry.
   const Bounds3& bounds() const { return bounds_; }
   /// Geometry id Embree gives the spheres.
@@ -189,6 +194,7 @@ class Scene {
   std::vector<Light> lights_;
   std::vector<uint32_t> environment_lights_;
   Distribution1D light_distribution_;
+  LightSampler light_sampler_;
   Bounds3 bounds_;
   bool committed_ = false;
   std::vector<int32_t> first_light_of_mesh_;  // light index of triangle 0 of an emissive mesh, or −1

@@ -5,6 +5,7 @@
 #include "raytrace_core/whitted.h"
 
 #include "raytrace_core/bsdf.h"
+#include "raytrace_core/direct_light.h"
 
 namespace gilt::raytrace_core {
 namespace {
@@ -24,21 +25,11 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
   const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
 
   if (!m.is_traced_through()) {
-    // Local shading: the material's diffuse + Phong BSDF lit by shadow rays, lights chosen by power.
-    const Distribution1D& choice = scene.light_distribution();
+    // Local shading: the material's diffuse + Phong BSDF lit by shadow rays, each towards a light
+    // chosen by the scene's light sampler (the path tracer's next-event estimate, unweighted).
     const int n = std::max(1, settings.area_light_samples);
-    if (choice.size() == 0) return radiance;
-    for (int i = 0; i < n; ++i) {
-      const uint32_t li = choice.sample(ctx.sampler.uniform());
-      const float pmf = choice.pmf(li);
-      const LightSample ls = sample_light(scene, scene.lights()[li], si, ctx.sampler.uniform2());
-      if (!(ls.pdf > 0.0f) || ls.radiance.is_black() || (glm::dot(ls.wi, si.ng) > 0.0f) != wo_above) continue;
-      const Vec3 wi = frame.to_local(ls.wi);
-      const Rgb f = bsdf_eval(m, wo, wi) * std::fabs(wi.z);
-      if (f.is_black()) continue;
-      ++ctx.rays;
-      if (!scene.occluded(ls.shadow_ray)) radiance += f * ls.radiance / (ls.pdf * pmf * float(n));
-    }
+    for (int i = 0; i < n; ++i)
+      radiance += sample_direct(scene, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays).value / float(n);
     return radiance;
   }
   if (depth + 1 >= settings.max_depth) return radiance;
