@@ -67,8 +67,6 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
 
   const int width = settings.width, height = settings.height;
   const size_t pixels = size_t(width) * height;
-  const float aspect = float(width) / float(height);
-  const float spread = camera.pixel_spread(height);
   const float r0 = sppm.initial_radius > 0.0f ? sppm.initial_radius : 0.01f * scene.bounds().radius();
   std::vector<PixelState> state(pixels);
   for (PixelState& p : state) p.radius = r0;
@@ -93,10 +91,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
         PixelState& ps = state[pixel];
         ps.visible = false;
         rc::Sampler sampler = rc::Sampler::for_pixel_sample(settings.sampler, settings.seed, pixel, uint64_t(iteration));
-        const rc::Vec2 offset = settings.filter.sample(sampler.uniform2());
-        const rc::Vec2 film_pos((x + 0.5f + offset.x) / width, (y + 0.5f + offset.y) / height);
-        rc::Ray ray = camera.generate_ray(film_pos, camera.has_lens() ? sampler.uniform2() : rc::Vec2(0.5f), aspect);
-        ray.spread = spread;
+        rc::Ray ray = rc::camera_ray(camera, settings, x, y, sampler);
         rc::Rgb beta(1.0f), direct(0.0f);
         // Mirrors and glass only, without Russian roulette: 64 bounces at most.
         for (int depth = 0; depth < std::min(sppm.max_depth, 64); ++depth) {

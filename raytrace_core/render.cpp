@@ -26,6 +26,15 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 
 }  // namespace
 
+Ray camera_ray(const Camera& camera, const RenderSettings& settings, int x, int y, Sampler& sampler) {
+  const Vec2 offset = settings.filter.sample(sampler.uniform2());
+  const Vec2 film_pos((float(x) + 0.5f + offset.x) / float(settings.width), (float(y) + 0.5f + offset.y) / float(settings.height));
+  const Vec2 lens = camera.has_lens() ? sampler.uniform2() : Vec2(0.5f);
+  Ray ray = camera.generate_ray(film_pos, lens, float(settings.width) / float(settings.height));
+  ray.spread = camera.pixel_spread(settings.height);
+  return ray;
+}
+
 Film render_image(const Scene& scene, const Camera& camera, const RenderSettings& settings,
                   const RadianceFunction& radiance, RenderStats* stats) {
   if (!scene.committed()) throw std::logic_error("render_image: the scene was not committed");
@@ -38,8 +47,6 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
 
   Film film(settings.width, settings.height);
   const std::vector<Tile> tiles = make_tiles(settings.width, settings.height, settings.tile_size);
-  const float aspect = float(settings.width) / float(settings.height);
-  const float spread = camera.pixel_spread(settings.height);
   const uint64_t pixels = uint64_t(settings.width) * settings.height;
   std::atomic<uint64_t> rays{0}, non_finite{0};
 
@@ -57,12 +64,7 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
           const uint64_t pixel = uint64_t(y) * settings.width + x;
           for (int s = first; s < first + count; ++s) {
             SampleContext ctx{Sampler::for_pixel_sample(settings.sampler, settings.seed, pixel, uint64_t(s)), 0};
-            const Vec2 offset = settings.filter.sample(ctx.sampler.uniform2());
-            const Vec2 film_pos((x + 0.5f + offset.x) / settings.width, (y + 0.5f + offset.y) / settings.height);
-            const Vec2 lens = camera.has_lens() ? ctx.sampler.uniform2() : Vec2(0.5f);
-            Ray ray = camera.generate_ray(film_pos, lens, aspect);
-            ray.spread = spread;
-            const Rgb value = radiance(ray, ctx);
+            const Rgb value = radiance(camera_ray(camera, settings, x, y, ctx.sampler), ctx);
             tile_rays += ctx.rays;
             if (value.is_finite()) film.add_sample(x, y, value);
             else ++tile_bad;

@@ -44,6 +44,11 @@ struct SampleContext {
 /// Radiance arriving at the camera along a primary ray (W·sr⁻¹·m⁻²).
 using RadianceFunction = std::function<Rgb(const Ray& ray, SampleContext& ctx)>;
 
+/// The camera ray of a sample of pixel (x, y): its position in the pixel drawn by the settings'
+/// filter, then a point on the lens when the camera has one, both from `sampler`'s camera
+/// dimensions; its spread set for texture filtering. render_image and SPPM's camera pass use it.
+Ray camera_ray(const Camera& camera, const RenderSettings& settings, int x, int y, Sampler& sampler);
+
 /// Renders with the given radiance function. Sample s of pixel (x, y) draws from
 /// Sampler::for_pixel_sample(sampler, seed, y·width + x, s) only, so the result is independent of threads and tiles.
 Film render_image(const Scene& scene, const Camera& camera, const RenderSettings& settings,
