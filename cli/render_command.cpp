@@ -52,7 +52,7 @@ struct RenderOptions {
   std::optional<uint64_t> photons, caustic_photons;
   int k = 50;
   float radius = 0.0f;
-  int gather_rays = 16;
+  int gather_rays = 1;
   float alpha = 2.0f / 3.0f;
 };
 
@@ -234,7 +234,7 @@ std::function<void()> add_render_command(CLI::App& app) {
                   "scene's bounding radius)")
       ->check(CLI::PositiveNumber)
       ->check(finite_number());
-  cmd->add_option("--gather-rays", o->gather_rays, "Photon: final-gather rays per sample (default 16; 0 = none)")
+  cmd->add_option("--gather-rays", o->gather_rays, "Photon: final-gather rays per sample (default 1; 0 = none)")
       ->check(CLI::Range(0, 65536));
   cmd->add_option("--alpha", o->alpha, "Sppm: fraction of new photons kept per iteration (default 2/3)")
       ->check(CLI::Range(1e-3f, 0.999f))

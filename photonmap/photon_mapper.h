@@ -23,8 +23,12 @@ struct PhotonMapperSettings {
   PhotonSettings photons;
   int k = 50;                  ///< photons per density estimate
   float max_radius = 0.0f;     ///< largest estimate radius (scene units); 0: 5 % of the scene's bounding radius
-  int gather_rays = 16;        ///< final-gather rays per camera sample (0: no final gather; the global map is
-                               ///< then read directly at x)
+  /// Final-gather rays per camera sample (0: no final gather; the global map is then read
+  /// directly at x). One: a pixel's spp samples then gather spp rays, stratified together, and at
+  /// equal time the camera samples that 16 rays apiece would have cost average the direct light,
+  /// the caustic map and the pixel's area as well: on cornell-caustics at 16 s relMSE fell from
+  /// 0.0021 at 16 rays to 0.00095 at 4, 0.00064 at 2 and 0.00061 at 1 (bench/README.md).
+  int gather_rays = 1;
   int precompute_stride = 4;   ///< irradiance is precomputed at every n-th global photon
   int direct_samples = 16;     ///< shadow rays per precomputed irradiance point
   int max_depth = 32;          ///< specular bounces followed from the camera and along gather rays
