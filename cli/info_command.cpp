@@ -64,9 +64,15 @@ struct MethodPlan {
 std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   std::vector<MethodPlan> plans;
   const bool lit = !scene.lights().empty();
-  const std::string nee = lit ? "next-event estimation over " + std::to_string(scene.lights().size()) +
-                                    " light(s), chosen by power"
-                              : "";
+  // How a shadow ray's light is chosen (raytrace_core/light_sampler.h).
+  const rc::LightSampler& sampler = scene.light_sampler();
+  const std::string choice =
+      sampler.node_count() > 1
+          ? "chosen by a light BVH (" + std::to_string(sampler.node_count()) + " nodes, depth " +
+                std::to_string(sampler.depth()) + ") by power, distance and orientation"
+          : "chosen by power";
+  const std::string nee =
+      lit ? "next-event estimation over " + std::to_string(scene.lights().size()) + " light(s), " + choice : "";
   plans.push_back({"path", lit ? std::vector<std::string>{"camera paths with " + nee + ", MIS, Russian roulette"}
                                : std::vector<std::string>{"camera paths (the image will be black)"},
                    lit ? std::vector<std::string>{} : std::vector<std::string>{"light sampling: no lights"}});
