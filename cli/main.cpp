@@ -1,6 +1,7 @@
 // gilt: command-line front end. Exit codes: 0 success, 2 bad input (flags, files, numbers),
-// 1 an internal failure.
+// 130 stopped by Ctrl-C (no output written), 1 an internal failure.
 
+#include <csignal>
 #include <exception>
 #include <functional>
 #include <iostream>
@@ -9,8 +10,21 @@
 
 #include "cli/commands.h"
 #include "raytrace_core/error.h"
+#include "raytrace_core/parallel.h"
+
+namespace {
+
+/// The first Ctrl-C asks the run to stop at its next work item, so no output is half-written;
+/// a second one ends the process at once.
+extern "C" void on_interrupt(int) {
+  gilt::raytrace_core::request_stop();
+  std::signal(SIGINT, SIG_DFL);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  std::signal(SIGINT, on_interrupt);
   CLI::App app{"gilt: global illumination toolkit (path tracing, radiosity, photon mapping)", "gilt"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "gilt 0.1.0");
@@ -41,6 +55,9 @@ int main(int argc, char** argv) {
   } catch (const gilt::raytrace_core::InputError& e) {
     std::cerr << "gilt: error: " << e.what() << "\n";
     return 2;
+  } catch (const gilt::raytrace_core::Interrupted&) {
+    std::cerr << "gilt: interrupted: nothing was written\n";
+    return 130;
   } catch (const std::exception& e) {
     std::cerr << "gilt: internal error: " << e.what() << "\n";
     return 1;

@@ -1,5 +1,6 @@
 #pragma once
-// The one exception type for bad input: the command-line tool maps it to exit code 2.
+// gilt's exception types: bad input, which the command-line tool maps to exit code 2, and a run
+// stopped on request (raytrace_core/parallel.h), which it maps to 130.
 
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,12 @@ namespace gilt::raytrace_core {
 class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// A run stopped by request_stop() before it finished: its partial results are discarded.
+class Interrupted : public std::runtime_error {
+ public:
+  Interrupted() : std::runtime_error("interrupted") {}
 };
 
 }  // namespace gilt::raytrace_core

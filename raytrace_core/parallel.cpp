@@ -4,11 +4,14 @@
 
 #include "raytrace_core/parallel.h"
 
+#include "raytrace_core/error.h"
+
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include <atomic>
 #include <optional>
 
 #include <pmmintrin.h>
@@ -30,6 +33,10 @@ ThreadLimit::ThreadLimit(int threads) : impl_(std::make_unique<ThreadLimitImpl>(
 ThreadLimit::~ThreadLimit() = default;
 
 namespace {
+
+/// Set by request_stop(). Lock-free, so a signal handler may set it.
+std::atomic<bool> stop_flag{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
 
 /// Sets flush-to-zero and denormals-are-zero for its lifetime, then restores the previous mode.
 /// Embree asks for this mode on every thread that traces rays, and TBB threads that built an
@@ -54,9 +61,18 @@ void parallel_for(size_t count, const std::function<void(size_t)>& body) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1),
                     [&body](const tbb::blocked_range<size_t>& range) {
                       const DenormalsAreZero mode;
-                      for (size_t i = range.begin(); i != range.end(); ++i) body(i);
+                      for (size_t i = range.begin(); i != range.end(); ++i) {
+                        // TBB cancels the loop's other tasks and rethrows in the caller.
+                        if (stop_flag.load(std::memory_order_relaxed)) throw Interrupted();
+                        body(i);
+                      }
                     });
+  if (stop_flag.load(std::memory_order_relaxed)) throw Interrupted();
 }
+
+void request_stop() noexcept { stop_flag.store(true, std::memory_order_relaxed); }
+void clear_stop() noexcept { stop_flag.store(false, std::memory_order_relaxed); }
+bool stop_requested() noexcept { return stop_flag.load(std::memory_order_relaxed); }
 
 int hardware_threads() { return tbb::info::default_concurrency(); }
 
