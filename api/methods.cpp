@@ -1,7 +1,8 @@
-#include "cli/methods.h"
+#include "api/methods.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "radiosity/view.h"
 #include "raytrace_core/error.h"
@@ -9,13 +10,23 @@
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/whitted.h"
 
-namespace gilt::cli {
+namespace gilt::api {
 namespace rc = gilt::raytrace_core;
+
+std::pair<int, int> image_size(const rc::Scene& scene, std::optional<int> width, std::optional<int> height) {
+  for (const std::optional<int>& v : {width, height})
+    if (v && (*v < 1 || *v > 65536)) throw rc::InputError("image width and height: from 1 to 65536 pixels");
+  const double aspect = double(scene.render.width) / double(std::max(scene.render.height, 1));
+  const int w = width.value_or(height ? std::max(1, int(std::lround(*height * aspect))) : scene.render.width);
+  const int h = height.value_or(width ? std::max(1, int(std::lround(*width / aspect))) : scene.render.height);
+  return {std::clamp(w, 1, 65536), std::clamp(h, 1, 65536)};
+}
 
 MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const std::string& method,
                         const rc::RenderSettings& base, const MethodOptions& options) {
   if (std::find(kMethods.begin(), kMethods.end(), method) == kMethods.end())
     throw rc::InputError("--method " + method + ": expected path, whitted, radiosity, photon or sppm");
+  if (base.width <= 0 || base.height <= 0) throw rc::InputError("image size must be positive");
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   rc::RenderSettings settings = base;
@@ -25,6 +36,14 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
   std::optional<photonmap::PhotonMapper> mapper;
   // What is left of a time budget after the preparation: at least one pass gets rendered.
   auto remaining = [&] { return std::max(1e-3, base.time_limit - elapsed()); };
+
+  // A scene that emits nothing is black whatever the method: the image is made at once rather
+  // than after the samples or the time budget have been spent tracing it.
+  if (scene.lights().empty()) {
+    result.film = rc::Film(base.width, base.height);
+    result.notes.push_back("nothing traced: without lights the image is black in every method");
+    return result;
+  }
 
   if (method == "sppm") {
     photonmap::SppmSettings sp = options.sppm;
@@ -74,4 +93,4 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
   return result;
 }
 
-}  // namespace gilt::cli
+}  // namespace gilt::api

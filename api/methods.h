@@ -1,9 +1,10 @@
 #pragma once
 // One image by any of gilt's methods, under a sample count or a time budget that covers the
 // method's preparation (radiosity solve, photon tracing) as well as the image. Shared by
-// `gilt render` and `gilt compare`.
+// `gilt render`, `gilt compare` and the Python module.
 
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,7 @@
 #include "raytrace_core/film.h"
 #include "raytrace_core/render.h"
 
-namespace gilt::cli {
+namespace gilt::api {
 
 /// The methods, in the order reports list them.
 inline const std::vector<std::string> kMethods = {"path", "photon", "sppm", "radiosity", "whitted"};
@@ -39,10 +40,17 @@ struct MethodResult {
   std::vector<std::string> notes;  ///< warnings and skipped passes
 };
 
+/// The image size for a requested width and height: both given, as given; one, the other from the
+/// aspect ratio of the scene's render size (its camera's, if it has one); neither, the scene's.
+/// Throws InputError for a size outside 1–65,536.
+std::pair<int, int> image_size(const raytrace_core::Scene& scene, std::optional<int> width, std::optional<int> height);
+
 /// Renders with `method` ("path", "whitted", "radiosity", "photon" or "sppm"). With a time
 /// limit, a radiosity solve may use 70 % of it (a partial solution is shown with its ambient
-/// term) and photon tracing runs first; the image takes what is left, at least one pass.
+/// term) and photon tracing runs first; the image takes what is left, at least one pass. A scene
+/// without lights gives its black image at once, with a note. Throws InputError for an unknown
+/// method, Interrupted when raytrace_core::request_stop() stops it.
 MethodResult run_method(const raytrace_core::Scene& scene, const raytrace_core::Camera& camera, const std::string& method,
                         const raytrace_core::RenderSettings& settings, const MethodOptions& options);
 
-}  // namespace gilt::cli
+}  // namespace gilt::api

@@ -1,4 +1,4 @@
-#include "cli/report.h"
+#include "api/report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "raytrace_core/io/staged_file.h"
 
-namespace gilt::cli {
+namespace gilt::api {
 namespace {
 
 /// Line colours of the methods in the plot and table (distinct, colour-blind-safe Okabe–Ito).
@@ -133,6 +133,18 @@ void error_colour(double relative_error, unsigned char rgb[3]) {
   for (int c = 0; c < 3; ++c) rgb[c] = static_cast<unsigned char>(std::lround(stops[i][c] * (1 - f) + stops[i + 1][c] * f));
 }
 
+nlohmann::json entry_json(const ReportEntry& e) {
+  nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
+                       {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
+                       {"rmse", e.rmse}, {"relmse", e.relmse}, {"relmse_stderr", e.relmse_stderr},
+                       {"rmse_measured", e.rmse_measured}, {"relmse_measured", e.relmse_measured},
+                       {"mae", e.mae}, {"mean_relative_error", e.mre},
+                       {"mean_ratio", e.mean_ratio}, {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
+                       {"notes", e.notes}};
+  je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
+  return je;
+}
+
 void write_report(const std::filesystem::path& folder, const Report& r) {
   // metrics.json and metrics.csv.
   nlohmann::json j = {{"scene", r.scene},       {"width", r.width},         {"height", r.height},
@@ -145,15 +157,7 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
   csv << "method,budget_seconds,seconds,spp_or_iterations,photons,shots,rmse,relmse,mae,mean_relative_error,"
          "mean_ratio,object_space_error,image,relmse_stderr,rmse_measured,relmse_measured\n";
   for (const ReportEntry& e : r.entries) {
-    nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
-                         {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
-                         {"rmse", e.rmse}, {"relmse", e.relmse}, {"relmse_stderr", e.relmse_stderr},
-                         {"rmse_measured", e.rmse_measured}, {"relmse_measured", e.relmse_measured},
-                         {"mae", e.mae}, {"mean_relative_error", e.mre},
-                         {"mean_ratio", e.mean_ratio}, {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
-                         {"notes", e.notes}};
-    je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
-    j["entries"].push_back(je);
+    j["entries"].push_back(entry_json(e));
     csv << e.method << ',' << e.budget << ',' << number(e.seconds, "%.4f") << ',' << e.spp << ',' << e.photons << ','
         << e.shots << ',' << number(e.rmse, "%.6g") << ',' << number(e.relmse, "%.6g") << ','
         << number(e.mae, "%.6g") << ',' << number(e.mre, "%.6g") << ',' << number(e.mean_ratio, "%.6g") << ','
@@ -259,4 +263,4 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
   write_file(folder / "index.html", h.str());
 }
 
-}  // namespace gilt::cli
+}  // namespace gilt::api

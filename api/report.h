@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
-namespace gilt::cli {
+#include <nlohmann/json.hpp>
+
+namespace gilt::api {
 
 /// One method at one budget.
 struct ReportEntry {
@@ -52,6 +54,10 @@ struct Report {
   std::vector<ReportEntry> entries;
 };
 
+/// One entry as metrics.json lists it (method, budget_seconds, seconds, spp_or_iterations,
+/// photons, shots, the errors, mean_ratio, the image files, notes, object_space_error).
+nlohmann::json entry_json(const ReportEntry& entry);
+
 /// Writes index.html, metrics.json and metrics.csv into `folder` (each file atomically).
 void write_report(const std::filesystem::path& folder, const Report& report);
 
@@ -59,4 +65,4 @@ void write_report(const std::filesystem::path& folder, const Report& report);
 /// dark blue, to 1, red), as 8-bit sRGB.
 void error_colour(double relative_error, unsigned char rgb[3]);
 
-}  // namespace gilt::cli
+}  // namespace gilt::api

@@ -8,6 +8,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 
+#include "api/statistics.h"
 #include "cli/commands.h"
 #include "radiosity/check.h"
 #include "radiosity/export.h"
@@ -142,52 +143,17 @@ void run_radiosity(RadiosityOptions& o) {
   const double secs = std::max(sol.seconds, 1e-9);
   const int threads = o.solver.threads > 0 ? o.solver.threads : rc::hardware_threads();
   if (o.json) {
-    nlohmann::json j = {{"command", "radiosity"},
-                        {"scene", o.scene},
-                        {"elements", sol.mesh.element_count()},
-                        {"vertices", sol.mesh.vertex_count()},
-                        {"max_edge", sol.mesh_report.max_edge},
-                        {"refined_elements", sol.refined_elements},
-                        {"contact_edges", sol.mesh_report.contact_edges},
-                        {"buried_faces", sol.mesh_report.buried_faces},
-                        {"buried_elements", sol.mesh_report.buried_elements},
-                        {"buried_area", sol.mesh_report.buried_area},
-                        {"meshed_area", sol.mesh_report.meshed_area},
-                        {"solver", radiosity::to_string(sol.solver)},
-                        {"solver_reason", sol.solver_reason},
-                        {"patches", sol.patches},
-                        {"nodes", sol.nodes},
-                        {"links", sol.links},
-                        {"iterations", sol.iterations},
-                        {"final_gather", sol.final_gather},
-                        {"final_gather_note", sol.final_gather_note},
-                        {"link_tolerance", sol.link_tolerance},
-                        {"linking_stopped_by_time", sol.linking_stopped},
-                        {"shots", sol.shots},
-                        {"residual", sol.residual},
-                        {"tolerance", o.solver.tolerance},
-                        {"form_factors", sol.form_factors},
-                        {"form_factors_per_second", double(sol.form_factors) / secs},
-                        {"shadow_rays", sol.shadow_rays},
-                        {"pairs_without_visibility_rays", sol.skipped_pairs},
-                        {"convex_enclosure", sol.convex_enclosure},
-                        {"seconds", sol.seconds},
-                        {"phase_seconds",
-                         {{"mesh", sol.mesh_seconds},
-                          {"direct", sol.direct_seconds},
-                          {"links", sol.link_seconds},
-                          {"iterations", sol.iterate_seconds},
-                          {"final_gather", sol.gather_seconds},
-                          {"shooting", sol.shoot_seconds}}},
-                        {"threads", threads},
-                        {"quantity", o.quantity},
-                        {"onto", o.onto},
-                        {"vertices_moved_onto_input_far", snap.moved_far},
-                        {"vertices_left_off_input", snap.not_moved},
-                        {"largest_move_onto_input", snap.largest},
-                        {"coincident_faces_merged", snap.coincident_merged},
-                        {"coincident_back_to_back_pairs", snap.back_to_back},
-                        {"output", o.output}};
+    nlohmann::json j = api::solution_statistics(sol, o.solver);
+    j.update(nlohmann::json{{"command", "radiosity"},
+                            {"scene", o.scene},
+                            {"quantity", o.quantity},
+                            {"onto", o.onto},
+                            {"vertices_moved_onto_input_far", snap.moved_far},
+                            {"vertices_left_off_input", snap.not_moved},
+                            {"largest_move_onto_input", snap.largest},
+                            {"coincident_faces_merged", snap.coincident_merged},
+                            {"coincident_back_to_back_pairs", snap.back_to_back},
+                            {"output", o.output}});
     if (onto)
       j["fit"] = {{"method", o.fit},
                   {"samples", onto->stats.samples},

@@ -7,11 +7,13 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "cli/methods.h"
+#include "api/methods.h"
+#include "api/statistics.h"
 #include "radiosity/solver.h"
 #include "radiosity/view.h"
 #include "raytrace_core/error.h"
@@ -24,6 +26,8 @@
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;
+using api::MethodOptions;
+using api::MethodResult;
 namespace {
 
 struct RenderOptions {
@@ -101,9 +105,7 @@ void run_render(const RenderOptions& o) {
 
   rc::RenderSettings settings;
   // One of --width and --height alone keeps the scene's aspect ratio (its camera's, if it has one).
-  const double aspect = double(scene.render.width) / double(std::max(scene.render.height, 1));
-  settings.width = o.width.value_or(o.height ? std::max(1, int(std::lround(*o.height * aspect))) : scene.render.width);
-  settings.height = o.height.value_or(o.width ? std::max(1, int(std::lround(*o.width / aspect))) : scene.render.height);
+  std::tie(settings.width, settings.height) = api::image_size(scene, o.width, o.height);
   settings.spp = o.spp.value_or(scene.render.spp);
   settings.time_limit = o.time_limit;
   settings.seed = o.seed;
@@ -124,16 +126,7 @@ void run_render(const RenderOptions& o) {
   mo.photon.gather_rays = o.gather_rays;
   mo.sppm.alpha = o.alpha;
   mo.max_depth = o.max_depth;
-  // A scene that emits nothing is black whatever the method: the image is written at once rather
-  // than after the samples or the --time budget have been spent tracing it.
-  MethodResult result;
-  if (scene.lights().empty()) {
-    if (settings.width <= 0 || settings.height <= 0) throw rc::InputError("image size must be positive");
-    result.film = rc::Film(settings.width, settings.height);
-    result.notes.push_back("nothing traced: without lights the image is black in every method");
-  } else {
-    result = run_method(scene, camera, o.method, settings, mo);
-  }
+  const MethodResult result = api::run_method(scene, camera, o.method, settings, mo);
   const rc::Film& film = result.film;
   const rc::RenderStats& stats = result.stats;
   const std::optional<radiosity::Solution>& solution = result.solution;
@@ -148,43 +141,8 @@ void run_render(const RenderOptions& o) {
   const int threads = o.threads > 0 ? o.threads : rc::hardware_threads();
   const double secs = std::max(stats.seconds, 1e-9);
   if (o.json) {
-    nlohmann::json j = {{"command", "render"},
-                        {"scene", o.scene},
-                        {"method", o.method},
-                        {"width", settings.width},
-                        {"height", settings.height},
-                        {"spp", stats.spp},
-                        {"seed", settings.seed},
-                        {"sampler", rc::sampler_name(settings.sampler)},
-                        {"light_sampler", rc::light_sampling_name(scene.light_sampler().mode())},
-                        {"threads", threads},
-                        {"triangles", scene.triangle_count()},
-                        {"spheres", scene.spheres.size()},
-                        {"lights", scene.lights().size()},
-                        {"rays", stats.rays},
-                        {"rays_per_second", double(stats.rays) / secs},
-                        {"samples", stats.samples},
-                        {"samples_per_second", double(stats.samples) / secs},
-                        {"seconds", stats.seconds},
-                        {"non_finite_samples", stats.non_finite},
-                        {"output", o.output}};
-    if (solution) {
-      j["radiosity"] = {{"elements", solution->mesh.element_count()}, {"shots", solution->shots},
-                        {"residual", solution->residual}, {"seconds", solution->seconds}};
-    }
-    if (photon) {
-      const photonmap::PhotonMapperStats& ps = *photon;
-      j["photon"] = {{"global_photons", ps.global_photons},       {"caustic_photons", ps.caustic_photons},
-                     {"paths", ps.paths},                         {"irradiance_points", ps.irradiance_points},
-                     {"trace_seconds", ps.trace_seconds},         {"precompute_seconds", ps.precompute_seconds},
-                     {"max_radius", ps.max_radius},               {"skipped", ps.skipped}};
-    }
-    if (sppm_stats) {
-      j["sppm"] = {{"iterations", sppm_stats->iterations},
-                   {"photons", sppm_stats->photons},
-                   {"initial_radius", sppm_stats->initial_radius},
-                   {"mean_final_radius", sppm_stats->mean_final_radius}};
-    }
+    nlohmann::json j = api::run_statistics(scene, o.method, settings, result);
+    j["command"] = "render", j["scene"] = o.scene, j["output"] = o.output;
     std::cout << j.dump() << std::endl;
   } else {
     std::printf("gilt render: %s, method %s, %dx%d, %d spp, seed %llu, %d thread(s)\n", o.scene.c_str(),

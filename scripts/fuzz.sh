@@ -32,7 +32,7 @@ if ((${#missing[@]})); then
 fi
 
 CC=clang CXX=clang++ cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DGILT_FUZZ=ON -DGILT_BUILD_BENCH=OFF -DGILT_WERROR=OFF >/dev/null
+  -DGILT_FUZZ=ON -DGILT_BUILD_BENCH=OFF -DGILT_WERROR=OFF -DGILT_PYTHON=OFF >/dev/null
 fuzzers=()
 for t in $targets; do fuzzers+=("fuzz_$t"); done
 cmake --build "$build_dir" -j "$jobs" --target "${fuzzers[@]}"

@@ -8,7 +8,9 @@
 #                                (what CI runs; SANITIZE=0 skips the sanitizer stage), then
 #                                fuzzes every scene loader for 10 s with clang's libFuzzer
 #                                (scripts/fuzz.sh; FUZZ=0 skips it)
-#   bash scripts/setup.sh build  install and build only
+#   bash scripts/setup.sh build  install and build only (the gilt tool and the Python module)
+#   bash scripts/setup.sh python install, build, then install the module `gilt` for the system's
+#                                python3 (/usr/bin/python3): `python3 -c "import gilt"`
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -euo pipefail
 
@@ -23,10 +25,13 @@ packages=(
   libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev libboost-dev libopenmesh-dev libflann-dev liblz4-dev
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev libdraco-dev libstb-dev
   libgtest-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy
 )
 # The report test looks at index.html in a real browser; the clients tests open gilt's exports in
 # headless Blender (scripts/blender_check.py, which needs Blender's numpy).
-[ "$job" = test ] && packages+=(chromium blender python3-numpy)
+# The Python module's tests run under Debian's pytest and read the tool's images with
+# OpenImageIO's bindings.
+[ "$job" = test ] && packages+=(chromium blender python3-pytest python3-openimageio)
 # The glTF tests run the Khronos glTF-Validator, an npm package (scripts/gltf_validate.js).
 if [ "$job" = test ] && ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
 
@@ -44,6 +49,8 @@ fi
 
 extra=()
 [ "$job" = test ] && extra+=(-DGILT_WERROR=ON)
+# The module is built for the system's interpreter, whatever python3 comes first on the PATH.
+[ -x /usr/bin/python3 ] && extra+=(-DPython3_EXECUTABLE=/usr/bin/python3)
 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${extra[@]}" ${CMAKE_ARGS:-}
 cmake --build "$build_dir" -j "$jobs"
 
@@ -65,7 +72,7 @@ case "$job" in
       # The fast label again, under AddressSanitizer and UndefinedBehaviorSanitizer.
       asan_dir=${build_dir}-asan
       cmake -S "$root" -B "$asan_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGILT_SANITIZE=ON \
-        -DGILT_BUILD_BENCH=OFF ${CMAKE_ARGS:-}
+        -DGILT_BUILD_BENCH=OFF -DGILT_PYTHON=OFF ${CMAKE_ARGS:-}
       # Only what the unit label runs: the CLI (its tests call it) and the unit test programs.
       unit_targets=(gilt)
       for t in "$root"/tests/unit/test_*.cpp; do unit_targets+=("$(basename "$t" .cpp)"); done
@@ -82,8 +89,12 @@ case "$job" in
     fi
     ;;
   build) ;;
+  python)
+    cmake --install "$build_dir" --component python
+    echo "setup: installed the module gilt for /usr/bin/python3"
+    ;;
   *)
-    echo "setup: unknown job '$job' (expected demo, test or build)" >&2
+    echo "setup: unknown job '$job' (expected demo, test, build or python)" >&2
     exit 2
     ;;
 esac

@@ -1,0 +1,91 @@
+#include "api/statistics.h"
+
+#include <algorithm>
+
+#include "raytrace_core/parallel.h"
+
+namespace gilt::api {
+namespace rc = gilt::raytrace_core;
+
+nlohmann::json run_statistics(const rc::Scene& scene, const std::string& method, const rc::RenderSettings& settings,
+                              const MethodResult& result) {
+  const rc::RenderStats& stats = result.stats;
+  const double secs = std::max(stats.seconds, 1e-9);
+  nlohmann::json j = {{"method", method},
+                      {"width", settings.width},
+                      {"height", settings.height},
+                      {"spp", stats.spp},
+                      {"seed", settings.seed},
+                      {"sampler", rc::sampler_name(settings.sampler)},
+                      {"light_sampler", rc::light_sampling_name(scene.light_sampler().mode())},
+                      {"threads", settings.threads > 0 ? settings.threads : rc::hardware_threads()},
+                      {"triangles", scene.triangle_count()},
+                      {"spheres", scene.spheres.size()},
+                      {"lights", scene.lights().size()},
+                      {"rays", stats.rays},
+                      {"rays_per_second", double(stats.rays) / secs},
+                      {"samples", stats.samples},
+                      {"samples_per_second", double(stats.samples) / secs},
+                      {"seconds", stats.seconds},
+                      {"non_finite_samples", stats.non_finite},
+                      {"notes", result.notes}};
+  if (const auto& solution = result.solution) {
+    j["radiosity"] = {{"elements", solution->mesh.element_count()}, {"shots", solution->shots},
+                      {"residual", solution->residual}, {"seconds", solution->seconds}};
+  }
+  if (const auto& ps = result.photon) {
+    j["photon"] = {{"global_photons", ps->global_photons},       {"caustic_photons", ps->caustic_photons},
+                   {"paths", ps->paths},                         {"irradiance_points", ps->irradiance_points},
+                   {"trace_seconds", ps->trace_seconds},         {"precompute_seconds", ps->precompute_seconds},
+                   {"max_radius", ps->max_radius},               {"skipped", ps->skipped}};
+  }
+  if (const auto& sp = result.sppm) {
+    j["sppm"] = {{"iterations", sp->iterations},
+                 {"photons", sp->photons},
+                 {"initial_radius", sp->initial_radius},
+                 {"mean_final_radius", sp->mean_final_radius}};
+  }
+  return j;
+}
+
+nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosity::SolverSettings& settings) {
+  const double secs = std::max(sol.seconds, 1e-9);
+  return {{"elements", sol.mesh.element_count()},
+          {"vertices", sol.mesh.vertex_count()},
+          {"max_edge", sol.mesh_report.max_edge},
+          {"refined_elements", sol.refined_elements},
+          {"contact_edges", sol.mesh_report.contact_edges},
+          {"buried_faces", sol.mesh_report.buried_faces},
+          {"buried_elements", sol.mesh_report.buried_elements},
+          {"buried_area", sol.mesh_report.buried_area},
+          {"meshed_area", sol.mesh_report.meshed_area},
+          {"solver", radiosity::to_string(sol.solver)},
+          {"solver_reason", sol.solver_reason},
+          {"patches", sol.patches},
+          {"nodes", sol.nodes},
+          {"links", sol.links},
+          {"iterations", sol.iterations},
+          {"final_gather", sol.final_gather},
+          {"final_gather_note", sol.final_gather_note},
+          {"link_tolerance", sol.link_tolerance},
+          {"linking_stopped_by_time", sol.linking_stopped},
+          {"shots", sol.shots},
+          {"residual", sol.residual},
+          {"tolerance", settings.tolerance},
+          {"form_factors", sol.form_factors},
+          {"form_factors_per_second", double(sol.form_factors) / secs},
+          {"shadow_rays", sol.shadow_rays},
+          {"pairs_without_visibility_rays", sol.skipped_pairs},
+          {"convex_enclosure", sol.convex_enclosure},
+          {"seconds", sol.seconds},
+          {"phase_seconds",
+           {{"mesh", sol.mesh_seconds},
+            {"direct", sol.direct_seconds},
+            {"links", sol.link_seconds},
+            {"iterations", sol.iterate_seconds},
+            {"final_gather", sol.gather_seconds},
+            {"shooting", sol.shoot_seconds}}},
+          {"threads", settings.threads > 0 ? settings.threads : rc::hardware_threads()}};
+}
+
+}  // namespace gilt::api
