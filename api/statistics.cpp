@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;
@@ -19,6 +20,7 @@ nlohmann::json run_statistics(const rc::Scene& scene, const std::string& method,
                       {"sampler", rc::sampler_name(settings.sampler)},
                       {"light_sampler", rc::light_sampling_name(scene.light_sampler().mode())},
                       {"threads", settings.threads > 0 ? settings.threads : rc::hardware_threads()},
+                      {"ranks", rc::processes().count()},
                       {"triangles", scene.triangle_count()},
                       {"spheres", scene.spheres.size()},
                       {"lights", scene.lights().size()},

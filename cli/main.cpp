@@ -1,5 +1,6 @@
 // gilt: command-line front end. Exit codes: 0 success, 2 bad input (flags, files, numbers),
-// 130 stopped by Ctrl-C (no output written), 1 an internal failure.
+// 130 stopped by Ctrl-C (no output written), 1 an internal failure. Under `mpirun -np N` (a build
+// with GILT_MPI) `gilt render` splits its work across the ranks and rank 0 writes the image.
 
 #include <csignal>
 #include <exception>
@@ -9,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "cli/mpi_processes.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 
@@ -25,6 +27,7 @@ extern "C" void on_interrupt(int) {
 
 int main(int argc, char** argv) {
   std::signal(SIGINT, on_interrupt);
+  const gilt::cli::MpiSession mpi(argc, argv);
   CLI::App app{"gilt: global illumination toolkit (path tracing, radiosity, photon mapping)", "gilt"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "gilt 0.1.0");
@@ -51,15 +54,20 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    if (mpi.ranks() > 1 && !app.got_subcommand("render"))
+      throw gilt::raytrace_core::InputError("under mpirun only `gilt render` splits its work across ranks: run " +
+                                            app.get_subcommands().front()->get_name() + " as one process");
     action();
   } catch (const gilt::raytrace_core::InputError& e) {
     std::cerr << "gilt: error: " << e.what() << "\n";
     return 2;
   } catch (const gilt::raytrace_core::Interrupted&) {
     std::cerr << "gilt: interrupted: nothing was written\n";
+    if (mpi.ranks() > 1) mpi.abort(130);  // the other ranks may be waiting in a collective
     return 130;
   } catch (const std::exception& e) {
     std::cerr << "gilt: internal error: " << e.what() << "\n";
+    if (mpi.ranks() > 1) mpi.abort(1);
     return 1;
   }
   return 0;

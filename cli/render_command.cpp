@@ -19,6 +19,7 @@
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/image_io.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
 #include "raytrace_core/io/scene_io.h"
@@ -134,7 +135,8 @@ void run_render(const RenderOptions& o) {
   const std::optional<photonmap::SppmStats>& sppm_stats = result.sppm;
   for (const std::string& n : result.notes)
     if (!o.json) std::cerr << "gilt: " << n << "\n";
-  rc::write_image(o.output, rc::Image{film.width(), film.height(), film.pixels()}, o.exposure);
+  if (rc::processes().rank() == 0)  // under mpirun, rank 0 alone writes
+    rc::write_image(o.output, rc::Image{film.width(), film.height(), film.pixels()}, o.exposure);
   if (stats.non_finite > 0)
     std::cerr << "gilt: warning: " << stats.non_finite << " sample(s) were NaN or infinite and were discarded\n";
 

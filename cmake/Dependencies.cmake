@@ -46,3 +46,8 @@ endif()
 if(GILT_BUILD_BENCH)
   find_package(benchmark CONFIG REQUIRED)
 endif()
+
+# MPI for `mpirun -np N gilt render` (GILT_MPI): Debian's Open MPI (libopenmpi-dev, openmpi-bin).
+if(GILT_MPI)
+  find_package(MPI REQUIRED COMPONENTS CXX)
+endif()

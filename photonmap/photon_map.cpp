@@ -9,6 +9,7 @@
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/rng.h"
 
 namespace gilt::photonmap {
@@ -30,8 +31,8 @@ std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t first, uint64_t c
   const rc::Distribution1D& choice = scene.light_distribution();
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   std::vector<std::vector<Photon>> stored(chunks);
-  rc::parallel_for(chunks, [&](size_t c) {
-    std::vector<Photon>& out = stored[c];
+  // Under several processes each traces the chunks it owns; they are joined in chunk order.
+  rc::distributed_chunks<Photon>(stored, [&](size_t c, std::vector<Photon>& out) {
     for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
       rc::Rng rng = rc::Rng::for_item(settings.seed, first + i, stream);
       const uint32_t li = choice.sample(rng.uniform());

@@ -11,6 +11,7 @@
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/sampling.h"
 
 namespace gilt::photonmap {
@@ -63,15 +64,19 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
   if (settings_.gather_rays > 0 && !maps_.global.empty()) {
     const size_t stride = size_t(settings.precompute_stride);
     const size_t count = (maps_.global.photons.size() + stride - 1) / stride;
-    points_.resize(count);
-    rc::parallel_for((count + 1023) / 1024, [&](size_t chunk) {
+    // Chunks of 1,024 points; under several processes each computes those it owns.
+    std::vector<std::vector<IrradiancePoint>> chunks((count + 1023) / 1024);
+    rc::distributed_chunks<IrradiancePoint>(chunks, [&](size_t chunk, std::vector<IrradiancePoint>& out) {
       for (size_t i = chunk * 1024; i < std::min(count, chunk * 1024 + 1024); ++i) {
         const Photon& p = maps_.global.photons[i * stride];
         rc::Sampler sampler(rc::Rng::for_item(settings.photons.seed, i, 0xd000000000ull));
-        points_[i] = {p.position, p.normal,
-                      compute_irradiance(p.position, decode_direction(p.normal), sampler, settings.direct_samples)};
+        out.push_back({p.position, p.normal,
+                       compute_irradiance(p.position, decode_direction(p.normal), sampler, settings.direct_samples)});
       }
     });
+    points_.clear();
+    points_.reserve(count);
+    for (const auto& c : chunks) points_.insert(points_.end(), c.begin(), c.end());
     std::vector<rc::Vec3> positions(count);
     for (size_t i = 0; i < count; ++i) positions[i] = points_[i].position;
     point_index_ = PhotonIndex(positions, settings.index);

@@ -15,6 +15,7 @@
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/progress.h"
 
 namespace gilt::photonmap {
@@ -74,17 +75,27 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
   const rc::Distribution1D& choice = scene.light_distribution();
   std::atomic<uint64_t> rays{0};
   const bool timed = settings.time_limit > 0.0;
+  // Under several processes each owns the rows y mod N (their camera pass and gather) and the
+  // photon chunks c mod N; the photons are joined in chunk order, so every process builds the
+  // index one process would.
+  const rc::Processes& group = rc::processes();
+  std::vector<size_t> rows;
+  for (size_t y = 0; y < size_t(height); ++y)
+    if (group.owns(y)) rows.push_back(y);
   rc::Progress progress(timed ? "sppm (time budget)" : "sppm", timed ? 0 : uint64_t(settings.spp), "iterations",
-                        settings.progress);
+                        settings.progress && group.rank() == 0);
 
   int iteration = 0;
   std::vector<Photon> photons;
   std::vector<rc::Vec3> positions;
   for (;; ++iteration) {
-    if (timed ? elapsed() >= settings.time_limit && iteration > 0 : iteration >= settings.spp) break;
+    // Rank 0's clock decides for every process.
+    if (timed ? group.broadcast_value(elapsed() >= settings.time_limit) && iteration > 0 : iteration >= settings.spp)
+      break;
 
     // 1. Camera pass: a visible point per pixel.
-    rc::parallel_for(size_t(height), [&](size_t y) {
+    rc::parallel_for(rows.size(), [&](size_t k) {
+      const size_t y = rows[k];
       uint64_t local_rays = 0;
       for (int x = 0; x < width; ++x) {
         const uint64_t pixel = uint64_t(y) * width + x;
@@ -143,7 +154,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
     const size_t chunks = size_t((count + kChunk - 1) / kChunk);
     std::vector<std::vector<Photon>> stored(chunks);
     if (choice.size() > 0) {
-      rc::parallel_for(chunks, [&](size_t c) {
+      rc::distributed_chunks<Photon>(stored, [&](size_t c, std::vector<Photon>& out) {
         uint64_t local_rays = 0;
         for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
           rc::Rng rng = rc::Rng::for_item(settings.seed, i, kPhotonStream + uint64_t(iteration));
@@ -154,7 +165,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           if (es.power.is_black() || !(pmf > 0.0f)) continue;
           local_rays += trace_photon_path(scene, es.ray, es.power / pmf, rng, sppm.max_depth,
                                           [&](const Photon& p, int depth, bool) {
-                                            if (depth > 0) stored[c].push_back(p);
+                                            if (depth > 0) out.push_back(p);
                                             return true;
                                           });
         }
@@ -166,11 +177,13 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
     positions.resize(photons.size());
     for (size_t i = 0; i < photons.size(); ++i) positions[i] = photons[i].position;
     float max_radius = 0.0f;
-    for (const PixelState& p : state) max_radius = std::max(max_radius, p.radius);
-    const PhotonIndex index(positions, sppm.index, max_radius);
+    for (size_t y : rows)
+      for (int x = 0; x < width; ++x) max_radius = std::max(max_radius, state[y * width + x].radius);
+    const PhotonIndex index(positions, sppm.index, group.max(max_radius));
 
     // 3. Gather at the visible points and shrink the radii.
-    rc::parallel_for(size_t(height), [&](size_t y) {
+    rc::parallel_for(rows.size(), [&](size_t k) {
+      const size_t y = rows[k];
       for (int x = 0; x < width; ++x) {
         PixelState& ps = state[size_t(y) * width + x];
         if (!ps.visible) continue;
@@ -200,26 +213,40 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
   }
   progress.finish();
 
-  // 4. The image: mean direct light plus τ / (π R² · photons emitted).
-  rc::Film film(width, height);
+  // 4. The image: mean direct light plus τ / (π R² · photons emitted), each row made by its
+  //    owner and joined.
   const double emitted = double(iteration) * double(sppm.photons_per_iteration);
+  struct PixelOut {
+    rc::Rgb value;
+    float radius = 0.0f;  ///< 0: no photon ever reached the pixel
+  };
+  std::vector<std::vector<PixelOut>> out(static_cast<size_t>(height));
+  for (size_t y : rows)
+    for (int x = 0; x < width; ++x) {
+      const PixelState& ps = state[y * width + x];
+      PixelOut o{ps.direct_sum / float(std::max(iteration, 1))};
+      if (ps.n > 0.0f) {
+        o.value += ps.tau * float(1.0 / (rc::kPi * double(ps.radius) * ps.radius * emitted));
+        o.radius = ps.radius;
+      }
+      out[y].push_back(o);
+    }
+  rc::join_chunks(out);
+  rc::Film film(width, height);
   double radius_sum = 0.0;
   size_t radius_count = 0;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
-      const PixelState& ps = state[size_t(y) * width + x];
-      rc::Rgb value = ps.direct_sum / float(std::max(iteration, 1));
-      if (ps.n > 0.0f) {
-        value += ps.tau * float(1.0 / (rc::kPi * double(ps.radius) * ps.radius * emitted));
-        radius_sum += ps.radius;
-        ++radius_count;
-      }
-      film.add_sample(x, y, value);
+      const PixelOut& o = out[y][x];
+      if (o.radius > 0.0f) radius_sum += o.radius, ++radius_count;
+      film.add_sample(x, y, o.value);
     }
+  uint64_t total_rays = rays;
+  group.sum(std::span(&total_rays, 1));
   if (stats) {
     stats->iterations = iteration;
     stats->photons = uint64_t(emitted);
-    stats->rays = rays;
+    stats->rays = total_rays;
     stats->seconds = elapsed();
     stats->initial_radius = r0;
     stats->mean_final_radius = radius_count ? float(radius_sum / double(radius_count)) : r0;

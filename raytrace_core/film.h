@@ -41,6 +41,14 @@ class Film {
     sum_[i] += radiance;
     count_[i] += 1;
   }
+  /// A pixel's sum of samples and their count (pixel = y · width + x), for joining the films of
+  /// several processes.
+  struct Accumulated {
+    Rgb sum;
+    uint32_t count = 0;
+  };
+  Accumulated accumulated(size_t pixel) const { return {sum_[pixel], count_[pixel]}; }
+  void set_accumulated(size_t pixel, const Accumulated& a) { sum_[pixel] = a.sum, count_[pixel] = a.count; }
   /// Mean of the samples of pixel (x, y); black with no samples.
   Rgb pixel(int x, int y) const;
   /// The whole image, row-major from the top-left.

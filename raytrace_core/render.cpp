@@ -8,6 +8,7 @@
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/progress.h"
 
 namespace gilt::raytrace_core {
@@ -51,13 +52,18 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
   std::atomic<uint64_t> rays{0}, non_finite{0};
 
   const bool timed = settings.time_limit > 0.0;
+  // Under several processes each renders the tiles it owns, and rank 0 shows the progress.
+  const Processes& group = processes();
+  std::vector<size_t> owned;
+  for (size_t ti = 0; ti < tiles.size(); ++ti)
+    if (group.owns(ti)) owned.push_back(ti);
   Progress progress(timed ? "render (time budget)" : "render", timed ? 0 : pixels * settings.spp, "samples",
-                    settings.progress);
+                    settings.progress && group.rank() == 0);
 
   // One pass renders samples [first, first + count) of every pixel.
   auto run_pass = [&](int first, int count) {
-    parallel_for(tiles.size(), [&](size_t ti) {
-      const Tile& tile = tiles[ti];
+    parallel_for(owned.size(), [&](size_t k) {
+      const Tile& tile = tiles[owned[k]];
       uint64_t tile_rays = 0, tile_bad = 0;
       for (int y = tile.y0; y < tile.y1; ++y) {
         for (int x = tile.x0; x < tile.x1; ++x) {
@@ -73,7 +79,7 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
       }
       rays += tile_rays;
       non_finite += tile_bad;
-      progress.advance(uint64_t(tile.x1 - tile.x0) * (tile.y1 - tile.y0) * count);
+      progress.advance(uint64_t(tile.x1 - tile.x0) * (tile.y1 - tile.y0) * count * group.count());
     });
   };
 
@@ -84,7 +90,7 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
     for (; done < settings.spp; done += std::min(step, settings.spp - done)) run_pass(done, std::min(step, settings.spp - done));
   } else {
     // Whole passes until the budget is spent; a pass that would overrun it by more than half
-    // its own length is not started.
+    // its own length is not started. Rank 0's clock decides for every process.
     int count = 1;
     while (true) {
       const double before = elapsed();
@@ -93,20 +99,37 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
       done += count;
       const double pass_time = elapsed() - before;
       const double left = settings.time_limit - elapsed();
-      if (left <= 0.0) break;
       const double per_sample = pass_time / count;
       count = std::max(1, std::min(count * 2, int(left / std::max(per_sample, 1e-9))));
-      if (per_sample * count > left * 1.5) break;
+      count = group.broadcast_value(left <= 0.0 || per_sample * count > left * 1.5 ? 0 : count);
+      if (count == 0) break;
     }
   }
   progress.finish();
 
+  if (group.count() > 1) {
+    // Every process gets every tile's sums, copied from the process that rendered it.
+    std::vector<std::vector<Film::Accumulated>> sums(tiles.size());
+    auto for_pixels = [&](size_t ti, auto&& f) {
+      const Tile& t = tiles[ti];
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x) f(size_t(y) * settings.width + x);
+    };
+    for (size_t ti : owned) for_pixels(ti, [&](size_t i) { sums[ti].push_back(film.accumulated(i)); });
+    join_chunks(sums);
+    for (size_t ti = 0; ti < tiles.size(); ++ti) {
+      size_t k = 0;
+      for_pixels(ti, [&](size_t i) { film.set_accumulated(i, sums[ti][k++]); });
+    }
+  }
+  uint64_t counts[2] = {rays, non_finite};
+  group.sum(counts);
   if (stats) {
     stats->spp = done;
     stats->samples = pixels * done;
-    stats->rays = rays;
+    stats->rays = counts[0];
     stats->seconds = elapsed();
-    stats->non_finite = non_finite;
+    stats->non_finite = counts[1];
   }
   return film;
 }

@@ -32,6 +32,8 @@ packages=(
 # The Python module's tests run under Debian's pytest and read the tool's images with
 # OpenImageIO's bindings.
 [ "$job" = test ] && packages+=(chromium blender python3-pytest python3-openimageio)
+# CI builds the tool with MPI and runs the mpi label (mpirun -np 2 against one process).
+[ "$job" = test ] && packages+=(libopenmpi-dev openmpi-bin)
 # The glTF tests run the Khronos glTF-Validator, an npm package (scripts/gltf_validate.js).
 if [ "$job" = test ] && ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
 
@@ -48,7 +50,7 @@ if ((${#missing[@]})); then
 fi
 
 extra=()
-[ "$job" = test ] && extra+=(-DGILT_WERROR=ON)
+[ "$job" = test ] && extra+=(-DGILT_WERROR=ON -DGILT_MPI=ON)
 # The module is built for the system's interpreter, whatever python3 comes first on the PATH.
 [ -x /usr/bin/python3 ] && extra+=(-DPython3_EXECUTABLE=/usr/bin/python3)
 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${extra[@]}" ${CMAKE_ARGS:-}
