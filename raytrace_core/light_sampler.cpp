@@ -282,6 +282,10 @@ int LightSampler::build(std::vector<uint32_t>& order, std::vector<Node>& leaves,
 
   const Vec3 extent = hi - lo;
   const auto centre = [&](uint32_t light, int axis) { return 0.5f * (leaves[light].lo[axis] + leaves[light].hi[axis]); };
+  // The bin of a light's centre along an axis, for both the search and the partition.
+  const auto bin_of = [&](uint32_t light, int axis) {
+    return std::clamp(int(kBins * (centre(light, axis) - lo[axis]) / extent[axis]), 0, kBins - 1);
+  };
   size_t middle = begin;
   if (depth < kCostDepth) {
     // Binned search over the three axes for the split of least power × orientation × area,
@@ -294,10 +298,10 @@ int LightSampler::build(std::vector<uint32_t>& order, std::vector<Node>& leaves,
     for (int axis = 0; axis < 3; ++axis) {
       if (!(extent[axis] > 0.0f)) continue;
       std::array<Node, kBins> bins{};
-      const auto bin_of = [&](uint32_t light) {
-        return std::clamp(int(kBins * (centre(light, axis) - lo[axis]) / extent[axis]), 0, kBins - 1);
-      };
-      for (size_t k = begin; k < end; ++k) bins[bin_of(order[k])] = merge(bins[bin_of(order[k])], leaves[order[k]]);
+      for (size_t k = begin; k < end; ++k) {
+        Node& bin = bins[bin_of(order[k], axis)];
+        bin = merge(bin, leaves[order[k]]);
+      }
       std::array<double, kBins> below{};
       Node acc;
       for (int b = 0; b < kBins - 1; ++b) {
@@ -318,10 +322,8 @@ int LightSampler::build(std::vector<uint32_t>& order, std::vector<Node>& leaves,
     }
     if (best_axis >= 0) {
       const int axis = best_axis;
-      middle = size_t(std::partition(order.begin() + begin, order.begin() + end, [&](uint32_t light) {
-                        return std::clamp(int(kBins * (centre(light, axis) - lo[axis]) / extent[axis]), 0,
-                                          kBins - 1) < best_bin;
-                      }) -
+      middle = size_t(std::partition(order.begin() + begin, order.begin() + end,
+                                     [&](uint32_t light) { return bin_of(light, axis) < best_bin; }) -
                       order.begin());
     }
   }
