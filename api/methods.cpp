@@ -13,6 +13,15 @@
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;
 
+void PhotonOptions::apply(MethodOptions& mo) const {
+  if (photons) mo.photon.photons.global_photons = mo.sppm.photons_per_iteration = *photons;
+  if (caustic_photons) mo.photon.photons.caustic_photons = *caustic_photons;
+  mo.photon.k = k;
+  mo.photon.max_radius = mo.sppm.initial_radius = radius;
+  mo.photon.gather_rays = gather_rays;
+  mo.sppm.alpha = alpha;
+}
+
 std::pair<int, int> image_size(const rc::Scene& scene, std::optional<int> width, std::optional<int> height) {
   for (const std::optional<int>& v : {width, height})
     if (v && (*v < 1 || *v > 65536)) throw rc::InputError("image width and height: from 1 to 65536 pixels");

@@ -30,6 +30,21 @@ struct MethodOptions {
   int max_depth = 0;
 };
 
+/// The photon methods' options as `gilt render` and gilt.render() take them: --photons (the
+/// photon method's global photons, SPPM's per iteration), --caustic-photons, --k, --radius (the
+/// photon method's largest radius, SPPM's first), --gather-rays and --alpha. 0 or empty: the
+/// default.
+struct PhotonOptions {
+  std::optional<uint64_t> photons, caustic_photons;
+  int k = 50;
+  float radius = 0.0f;
+  int gather_rays = 1;
+  float alpha = 2.0f / 3.0f;
+
+  /// Sets them in the methods' own settings.
+  void apply(MethodOptions& options) const;
+};
+
 /// What one run produced.
 struct MethodResult {
   raytrace_core::Film film;

@@ -53,12 +53,7 @@ struct RenderOptions {
   bool quiet = false;
   radiosity::SolverSettings solver;
   radiosity::ViewMode radiosity_view = radiosity::ViewMode::two_pass;
-  // Photon mapping (photon, sppm).
-  std::optional<uint64_t> photons, caustic_photons;
-  int k = 50;
-  float radius = 0.0f;
-  int gather_rays = 1;
-  float alpha = 2.0f / 3.0f;
+  api::PhotonOptions photon;  ///< photon mapping (photon, sppm)
 };
 
 /// Parses "x,y,z" into a vector; `flag` names the option in the error.
@@ -120,12 +115,7 @@ void run_render(const RenderOptions& o) {
   MethodOptions mo;
   mo.solver = o.solver;
   mo.radiosity_view = o.radiosity_view;
-  if (o.photons) mo.photon.photons.global_photons = mo.sppm.photons_per_iteration = *o.photons;
-  if (o.caustic_photons) mo.photon.photons.caustic_photons = *o.caustic_photons;
-  mo.photon.k = o.k;
-  mo.photon.max_radius = mo.sppm.initial_radius = o.radius;
-  mo.photon.gather_rays = o.gather_rays;
-  mo.sppm.alpha = o.alpha;
+  o.photon.apply(mo);
   mo.max_depth = o.max_depth;
   const MethodResult result = api::run_method(scene, camera, o.method, settings, mo);
   const rc::Film& film = result.film;
@@ -183,20 +173,20 @@ std::function<void()> add_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output image (.exr, .hdr linear; .png sRGB)")->required();
   cmd->add_option("--method", o->method, "Rendering method: path (reference), whitted, radiosity, photon or sppm")
       ->check(CLI::IsMember({"path", "whitted", "radiosity", "photon", "sppm"}));
-  cmd->add_option("--photons", o->photons,
+  cmd->add_option("--photons", o->photon.photons,
                   "Photon: global photons emitted (default 200000); sppm: photons per iteration (default 100000)")
       ->check(CLI::Range(uint64_t(1), uint64_t(1) << 34));
-  cmd->add_option("--caustic-photons", o->caustic_photons, "Photon: caustic photons emitted (default 200000; 0 = none)")
+  cmd->add_option("--caustic-photons", o->photon.caustic_photons, "Photon: caustic photons emitted (default 200000; 0 = none)")
       ->check(CLI::Range(uint64_t(0), uint64_t(1) << 34));
-  cmd->add_option("--k", o->k, "Photon: photons per density estimate (default 50)")->check(CLI::Range(1, 100000));
-  cmd->add_option("--radius", o->radius,
+  cmd->add_option("--k", o->photon.k, "Photon: photons per density estimate (default 50)")->check(CLI::Range(1, 100000));
+  cmd->add_option("--radius", o->photon.radius,
                   "Photon: largest estimate radius; sppm: initial radius (scene units; default 5 % / 1 % of the "
                   "scene's bounding radius)")
       ->check(CLI::PositiveNumber)
       ->check(finite_number());
-  cmd->add_option("--gather-rays", o->gather_rays, "Photon: final-gather rays per sample (default 1; 0 = none)")
+  cmd->add_option("--gather-rays", o->photon.gather_rays, "Photon: final-gather rays per sample (default 1; 0 = none)")
       ->check(CLI::Range(0, 65536));
-  cmd->add_option("--alpha", o->alpha, "Sppm: fraction of new photons kept per iteration (default 2/3)")
+  cmd->add_option("--alpha", o->photon.alpha, "Sppm: fraction of new photons kept per iteration (default 2/3)")
       ->check(CLI::Range(1e-3f, 0.999f))
       ->check(finite_number());
   add_solver_options(*cmd, o->solver);

@@ -148,7 +148,8 @@ rc::Camera make_camera(py::sequence look_from, py::sequence look_at, py::sequenc
 
 py::tuple render(PyScene& s, const std::string& method, std::optional<int> spp, std::optional<double> time,
                  std::optional<int> width, std::optional<int> height, uint64_t seed, int threads,
-                 const std::string& sampler, const std::string& light_sampler, int max_depth) {
+                 const std::string& sampler, const std::string& light_sampler, int max_depth,
+                 const api::PhotonOptions& photon, std::optional<int> elements, const std::string& radiosity_view) {
   rc::RenderSettings settings;
   const auto [w, h] = api::image_size(s.scene, width, height);
   settings.width = w, settings.height = h;
@@ -167,6 +168,14 @@ py::tuple render(PyScene& s, const std::string& method, std::optional<int> spp, 
   const rc::Camera camera = s.scene.effective_camera(float(settings.width) / float(settings.height));
   api::MethodOptions options;
   options.max_depth = max_depth;
+  photon.apply(options);
+  if (elements) {
+    if (*elements < 1) throw rc::InputError("elements: must be at least 1");
+    options.solver.mesh.elements = *elements;
+  }
+  if (radiosity_view != "two-pass" && radiosity_view != "mesh")
+    throw rc::InputError("radiosity_view " + radiosity_view + ": expected two-pass or mesh");
+  options.radiosity_view = radiosity_view == "mesh" ? radiosity::ViewMode::mesh : radiosity::ViewMode::two_pass;
   const api::MethodResult result =
       run_interruptible([&] { return api::run_method(s.scene, camera, method, settings, options); });
   nlohmann::json stats = api::run_statistics(s.scene, method, settings, result);
@@ -290,13 +299,28 @@ PYBIND11_MODULE(gilt, m) {
                std::to_string(s.scene.lights().size()) + " lights>";
       });
 
-  m.def("render", &render, py::arg("scene"), py::kw_only(), py::arg("method") = "path", py::arg("spp") = py::none(),
-        py::arg("time") = py::none(), py::arg("width") = py::none(), py::arg("height") = py::none(),
-        py::arg("seed") = 0, py::arg("threads") = 0, py::arg("sampler") = "sobol", py::arg("light_sampler") = "bvh",
-        py::arg("max_depth") = 0,
-        "Renders with one of gilt.METHODS for spp samples per pixel or time seconds (preparation included).\n"
-        "Returns (image, stats): an H x W x 3 float32 array of linear RGB and the statistics of\n"
-        "`gilt render --json` as a dict. The same arguments give the same image, whatever `threads`.");
+  m.def(
+      "render",
+      [](PyScene& s, const std::string& method, std::optional<int> spp, std::optional<double> time,
+         std::optional<int> width, std::optional<int> height, uint64_t seed, int threads, const std::string& sampler,
+         const std::string& light_sampler, int max_depth, std::optional<uint64_t> photons,
+         std::optional<uint64_t> caustic_photons, int k, float radius, int gather_rays, float alpha,
+         std::optional<int> elements, const std::string& radiosity_view) {
+        const api::PhotonOptions photon{photons, caustic_photons, k, radius, gather_rays, alpha};
+        return render(s, method, spp, time, width, height, seed, threads, sampler, light_sampler, max_depth, photon,
+                      elements, radiosity_view);
+      },
+      py::arg("scene"), py::kw_only(), py::arg("method") = "path", py::arg("spp") = py::none(),
+      py::arg("time") = py::none(), py::arg("width") = py::none(), py::arg("height") = py::none(), py::arg("seed") = 0,
+      py::arg("threads") = 0, py::arg("sampler") = "sobol", py::arg("light_sampler") = "bvh", py::arg("max_depth") = 0,
+      py::arg("photons") = py::none(), py::arg("caustic_photons") = py::none(), py::arg("k") = 50,
+      py::arg("radius") = 0.0f, py::arg("gather_rays") = 1, py::arg("alpha") = 2.0f / 3.0f,
+      py::arg("elements") = py::none(), py::arg("radiosity_view") = "two-pass",
+      "Renders with one of gilt.METHODS for spp samples per pixel or time seconds (preparation included).\n"
+      "photons, caustic_photons, k, radius, gather_rays, alpha: the photon methods' options, elements\n"
+      "and radiosity_view the radiosity method's, as on the command line. Returns (image, stats): an\n"
+      "H x W x 3 float32 array of linear RGB and the statistics of `gilt render --json` as a dict. The\n"
+      "same arguments give the same image, whatever `threads`.");
   m.def("radiosity", &solve_radiosity, py::arg("scene"), py::kw_only(), py::arg("elements") = py::none(),
         py::arg("time") = py::none(), py::arg("tolerance") = 1e-3, py::arg("solver") = "auto", py::arg("seed") = 0,
         py::arg("threads") = 0,

@@ -44,7 +44,8 @@ def test_every_method_and_the_camera_override():
     scene.camera = gilt.Camera(look_from=(278, 273, -600), look_at=(278, 273, 0), vfov=50)
     assert scene.camera.look_from == (278.0, 273.0, -600.0) and default.look_from != scene.camera.look_from
     for method in gilt.METHODS:
-        image, stats = gilt.render(scene, method=method, spp=1, width=16, height=16, threads=2)
+        image, stats = gilt.render(scene, method=method, spp=1, width=16, height=16, threads=2, photons=20000,
+                                   elements=500)
         assert image.shape == (16, 16, 3) and np.isfinite(image).all(), method
         assert image.mean() > 0.0, method
 
@@ -90,6 +91,10 @@ def test_bad_input_raises_value_error():
         gilt.Camera(look_from=(0, 0), look_at=(0, 0, 1))
     with pytest.raises(ValueError, match="methods"):
         gilt.compare(scene, methods=["nope"], budgets=[1])
+    with pytest.raises(ValueError, match="alpha"):
+        gilt.render(scene, method="sppm", spp=1, width=8, height=8, alpha=1.5)
+    with pytest.raises(ValueError, match="radiosity_view"):
+        gilt.render(scene, method="radiosity", spp=1, width=8, height=8, radiosity_view="wireframe")
 
 
 def test_the_gil_is_released_during_a_render():
