@@ -138,10 +138,11 @@ PyScene load(const std::string& path, std::optional<std::string> env, float env_
 }
 
 rc::Camera make_camera(py::sequence look_from, py::sequence look_at, py::sequence up, float vfov, float aperture,
-                       float focus_distance) {
+                       float focus_distance, float ortho_height) {
   rc::Camera c;
   c.look_from = to_vec3(look_from, "look_from"), c.look_at = to_vec3(look_at, "look_at"), c.up = to_vec3(up, "up");
   c.vfov_degrees = vfov, c.aperture_radius = aperture, c.focus_distance = focus_distance;
+  c.orthographic = ortho_height > 0.0f, c.ortho_height = ortho_height;
   c.validate();
   return c;
 }
@@ -259,12 +260,17 @@ PYBIND11_MODULE(gilt, m) {
 
   py::class_<rc::Camera>(m, "Camera", "A pinhole or thin-lens camera")
       .def(py::init(&make_camera), py::arg("look_from"), py::arg("look_at"), py::arg("up") = py::make_tuple(0, 1, 0),
-           py::arg("vfov") = 40.0f, py::arg("aperture") = 0.0f, py::arg("focus_distance") = 0.0f)
+           py::arg("vfov") = 40.0f, py::arg("aperture") = 0.0f, py::arg("focus_distance") = 0.0f,
+           py::arg("ortho_height") = 0.0f,
+           "A camera at look_from looking at look_at. vfov in degrees; aperture (lens radius) and\n"
+           "focus_distance for depth of field; ortho_height > 0 makes it orthographic, the film that many\n"
+           "scene units high.")
       .def_property_readonly("look_from", [](const rc::Camera& c) { return to_tuple(c.look_from); })
       .def_property_readonly("look_at", [](const rc::Camera& c) { return to_tuple(c.look_at); })
       .def_property_readonly("up", [](const rc::Camera& c) { return to_tuple(c.up); })
       .def_readonly("vfov", &rc::Camera::vfov_degrees)
       .def_readonly("orthographic", &rc::Camera::orthographic)
+      .def_readonly("ortho_height", &rc::Camera::ortho_height)
       .def("__repr__", [](const rc::Camera& c) {
         return "gilt.Camera(look_from=" + py::repr(to_tuple(c.look_from)).cast<std::string>() +
                ", look_at=" + py::repr(to_tuple(c.look_at)).cast<std::string>() +

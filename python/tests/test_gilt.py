@@ -43,6 +43,12 @@ def test_every_method_and_the_camera_override():
     default = scene.camera
     scene.camera = gilt.Camera(look_from=(278, 273, -600), look_at=(278, 273, 0), vfov=50)
     assert scene.camera.look_from == (278.0, 273.0, -600.0) and default.look_from != scene.camera.look_from
+    ortho = gilt.Camera(look_from=(278, 273, -800), look_at=(278, 273, 0), ortho_height=600)
+    assert ortho.orthographic and ortho.ortho_height == 600
+    scene.camera = ortho
+    image, _ = gilt.render(scene, spp=1, width=16, height=16, threads=2)
+    assert image.mean() > 0.0
+    scene.camera = gilt.Camera(look_from=(278, 273, -600), look_at=(278, 273, 0), vfov=50)
     for method in gilt.METHODS:
         image, stats = gilt.render(scene, method=method, spp=1, width=16, height=16, threads=2, photons=20000,
                                    elements=500)
