@@ -66,6 +66,22 @@ float segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3
 
 }  // namespace
 
+/// The point of input mesh s nearest to q within `reach`, facing within 60 degrees of n, as a
+/// surface point whose normal is the input triangle's, turned to n's side; none when there is none.
+std::optional<rc::SurfacePoint> input_point(const rc::Scene& scene, uint32_t s, const Vec3& q, float reach,
+                                            const Vec3& n) {
+  if (s >= scene.meshes.size()) return std::nullopt;
+  const auto near = scene.nearest_triangle(s, q, reach, n, 0.5f);
+  if (!near) return std::nullopt;
+  const rc::TriangleMesh& tm = scene.meshes[s];
+  const Vec3 a = tm.positions[tm.indices[3 * near->prim_id]], b = tm.positions[tm.indices[3 * near->prim_id + 1]],
+             c = tm.positions[tm.indices[3 * near->prim_id + 2]];
+  const Vec3 p_in = (1 - near->u - near->v) * a + near->u * b + near->v * c;
+  Vec3 n_in = glm::normalize(glm::cross(b - a, c - a));
+  if (glm::dot(n_in, n) < 0) n_in = -n_in;
+  return rad::mesh_surface_point(p_in, n_in);
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: crack_probe SCENE [ELEMENTS] [CSV]\n");
@@ -181,23 +197,16 @@ int main(int argc, char** argv) {
         const bool elem_blocked = geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh_surface_point(q, n), wi));
         // The input point: nearest on the element's own input mesh, facing within 60 degrees.
         const uint32_t s = mesh.element_surface[e];
-        std::optional<rc::Hit> near;
-        if (s < scene.meshes.size()) near = scene.nearest_triangle(s, q, 2.0f * L, n, 0.5f);
-        if (!near) {
+        const std::optional<rc::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
+        if (!found) {
           ++n_noinput;
           continue;
         }
-        const rc::TriangleMesh& tm = scene.meshes[s];
-        const Vec3 a = tm.positions[tm.indices[3 * near->prim_id]], bb = tm.positions[tm.indices[3 * near->prim_id + 1]],
-                   c = tm.positions[tm.indices[3 * near->prim_id + 2]];
-        const Vec3 p_in = (1 - near->u - near->v) * a + near->u * bb + near->v * c;
-        Vec3 n_in = glm::normalize(glm::cross(bb - a, c - a));
-        if (glm::dot(n_in, n) < 0) n_in = -n_in;
-        const rc::SurfacePoint at_in = rad::mesh_surface_point(p_in, n_in);
+        const rc::SurfacePoint& at_in = *found;
         std::optional<rc::Hit> hit;
         const rc::Ray ray_in = rc::spawn_shadow_ray_to_infinity(at_in, wi);
-        if (glm::dot(n_in, wi) > 0.0f) hit = scene.intersect(ray_in);
-        const bool input_blocked = glm::dot(n_in, wi) <= 0.0f || hit.has_value();
+        if (glm::dot(at_in.ng, wi) > 0.0f) hit = scene.intersect(ray_in);
+        const bool input_blocked = glm::dot(at_in.ng, wi) <= 0.0f || hit.has_value();
         // As the README's experiment did: the element's own point traced against the input.
         const bool raw_blocked = scene.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh_surface_point(q, n), wi));
         // Interior: under a roof (an upward ray from the input point meets the input).
@@ -296,19 +305,13 @@ int main(int argc, char** argv) {
       for (int r = 0; r < 4; ++r) {
         const rc::Vec2 b = rc::sample_uniform_triangle(rng.uniform2());
         const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
-        const auto near = scene.nearest_triangle(s, q, 2.0f * L, n, 0.5f);
-        if (!near) continue;
-        const rc::TriangleMesh& tm = scene.meshes[s];
-        const Vec3 a = tm.positions[tm.indices[3 * near->prim_id]], bb = tm.positions[tm.indices[3 * near->prim_id + 1]],
-                   c = tm.positions[tm.indices[3 * near->prim_id + 2]];
-        const Vec3 p_in = (1 - near->u - near->v) * a + near->u * bb + near->v * c;
-        Vec3 n_in = glm::normalize(glm::cross(bb - a, c - a));
-        if (glm::dot(n_in, n) < 0) n_in = -n_in;
-        const rc::SurfacePoint at_in = rad::mesh_surface_point(p_in, n_in);
+        const std::optional<rc::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
+        if (!found) continue;
+        const rc::SurfacePoint& at_in = *found;
         if (!scene.occluded(rc::spawn_shadow_ray_to_infinity(at_in, Vec3(0, 1, 0)))) continue;  // interior only
         const Vec3 wl = rc::sample_cosine_hemisphere(rng.uniform2());
         const Vec3 w = rc::Frame::from_normal(n).to_world(wl);
-        if (!(glm::dot(w, n_in) > 0.0f)) continue;
+        if (!(glm::dot(w, at_in.ng) > 0.0f)) continue;
         rays += 1;
         const rc::Ray ray_e = rc::spawn_ray(rad::mesh_surface_point(q, n), w);
         const rc::Ray ray_i = rc::spawn_ray(at_in, w);
