@@ -52,7 +52,8 @@ nlohmann::json run_statistics(const rc::Scene& scene, const std::string& method,
 
 nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosity::SolverSettings& settings) {
   const double secs = std::max(sol.seconds, 1e-9);
-  return {{"elements", sol.mesh.element_count()},
+  return {{"ranks", rc::processes().count()},
+          {"elements", sol.mesh.element_count()},
           {"vertices", sol.mesh.vertex_count()},
           {"max_edge", sol.mesh_report.max_edge},
           {"refined_elements", sol.refined_elements},

@@ -1,6 +1,7 @@
 // gilt: command-line front end. Exit codes: 0 success, 2 bad input (flags, files, numbers),
 // 130 stopped by Ctrl-C (no output written), 1 an internal failure. Under `mpirun -np N` (a build
-// with GILT_MPI) `gilt render` splits its work across the ranks and rank 0 writes the image.
+// with GILT_MPI) `gilt render` and `gilt radiosity` split their work across the ranks, and rank 0
+// writes the output.
 
 #include <csignal>
 #include <exception>
@@ -54,8 +55,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    if (mpi.ranks() > 1 && !app.got_subcommand("render"))
-      throw gilt::raytrace_core::InputError("under mpirun only `gilt render` splits its work across ranks: run " +
+    if (mpi.ranks() > 1 && !app.got_subcommand("render") && !app.got_subcommand("radiosity"))
+      throw gilt::raytrace_core::InputError("under mpirun only `gilt render` and `gilt radiosity` split their work across ranks: run " +
                                             app.get_subcommands().front()->get_name() + " as one process");
     action();
   } catch (const gilt::raytrace_core::InputError& e) {

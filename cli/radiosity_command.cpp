@@ -17,6 +17,7 @@
 #include "radiosity/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {
@@ -98,6 +99,8 @@ void run_radiosity(RadiosityOptions& o) {
     o.solver.time_limit = std::max(1e-3, o.bake_gather > 0 ? (1.0 - kBakeGatherShare) * left : left);
   }
   const radiosity::Solution sol = radiosity::solve(scene, o.solver);
+  // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
+  if (rc::processes().rank() > 0) return;
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
   const radiosity::VertexFit fit =
       o.fit == "point" ? radiosity::VertexFit::point : radiosity::VertexFit::least_squares;

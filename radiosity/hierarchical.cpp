@@ -36,6 +36,7 @@
 #include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sampling.h"
 #include "raytrace_core/scene.h"
@@ -348,6 +349,13 @@ class Linker {
         settings_(settings),
         counters_(counters) {}
 
+  /// Under several processes: the owner of each node (owners_of), and this process's rank.
+  Linker& owned_by(std::span<const int> owner, int rank) {
+    owner_ = owner;
+    rank_ = rank;
+    return *this;
+  }
+
   /// Whether to keep the accepted far pairs (`LinkLevel::open`) for a finer level to refine.
   Linker& keeping_open_pairs(bool keep) {
     keep_open_ = keep;
@@ -359,12 +367,31 @@ class Linker {
   std::optional<LinkLevel> link(std::span<const OpenPair> start) {
     LinkLevel level;
     if (tree_.nodes.empty()) return level;
-    // Breadth-first until there are enough pairs to share out, then each chunk of pairs is
-    // refined on its own, its output appended in chunk order (deterministic).
+    const rc::Processes& group = rc::processes();
+    const uint64_t rays_before = counters_.rays, form_factors_before = counters_.form_factors;
+    // Under several processes each refines only the pairs whose receiver is its own or above
+    // the cut (see owners_of), and keeps only the links and pairs that land there. A pair's
+    // refinements receive within its receiver's subtree, so each process makes, in the same
+    // order, the subsequence of one process's links that it gathers over.
+    const auto own = [&](std::vector<OpenPair>& pairs) {
+      if (!owner_.empty())
+        std::erase_if(pairs, [&](const OpenPair& p) { return !mine(p.receiver); });
+    };
+    // Breadth-first until there are enough pairs to share out (counted as one process would:
+    // the pairs above the cut once), then each chunk of pairs is refined depth-first on its own,
+    // its output appended in chunk order: the order of one depth-first pass, deterministic.
     std::vector<OpenPair> frontier(start.begin(), start.end()), next;
-    while (!frontier.empty() && frontier.size() < 4096) {
+    own(frontier);
+    const auto pairs_in_all = [&] {
+      if (owner_.empty()) return frontier.size();
+      const size_t shared = size_t(std::count_if(frontier.begin(), frontier.end(),
+                                                 [&](const OpenPair& p) { return owner_[p.receiver] < 0; }));
+      return shared + size_t(group.total(frontier.size() - shared));
+    };
+    for (size_t all = pairs_in_all(); all > 0 && all < 4096; all = pairs_in_all()) {
       next.clear();
       for (const OpenPair& p : frontier) refine(p, level, next);
+      own(next);
       frontier.swap(next);
     }
     const size_t per_chunk = (frontier.size() + 4095) / 4096;
@@ -382,10 +409,17 @@ class Linker {
           if (stopped.load(std::memory_order_relaxed)) return;
           const OpenPair p = stack.back();
           stack.pop_back();
-          refine(p, parts[i], stack);
+          if (mine(p.receiver)) refine(p, parts[i], stack);
         }
       }
+      keep_mine(parts[i]);
     });
+    keep_mine(level);
+    if (group.count() > 1) {
+      counters_.rays = rays_before + group.total(counters_.rays - rays_before);
+      counters_.form_factors = form_factors_before + group.total(counters_.form_factors - form_factors_before);
+      if (group.any(stopped)) return std::nullopt;
+    }
     if (stopped) return std::nullopt;
     for (auto& part : parts) {
       level.exact.insert(level.exact.end(), part.exact.begin(), part.exact.end());
@@ -396,6 +430,20 @@ class Linker {
   }
 
  private:
+  /// Whether this process refines pairs, and keeps links, that receive at `node`.
+  bool mine(uint32_t node) const { return owner_.empty() || owner_[node] < 0 || owner_[node] == rank_; }
+  /// Where the work on a pair receiving at `node` is counted: the counts are summed over
+  /// processes, and the pairs above the cut, refined by every process, are counted by rank 0.
+  Counters& count_for(uint32_t node) {
+    return owner_.empty() || owner_[node] == rank_ || (owner_[node] < 0 && rank_ == 0) ? counters_ : uncounted_;
+  }
+  void keep_mine(LinkLevel& level) const {
+    if (owner_.empty()) return;
+    std::erase_if(level.exact, [&](const Link& l) { return !mine(l.receiver); });
+    std::erase_if(level.far, [&](const Link& l) { return !mine(l.receiver); });
+    std::erase_if(level.open, [&](const OpenPair& p) { return !mine(p.receiver); });
+  }
+
   /// Accepts, drops or splits the pair (r, s): links go to `out` (with the accepted far pairs,
   /// which a finer tolerance may split), halves to `pending`. A known visible fraction (≥ 0)
   /// saves the pair's shadow rays.
@@ -414,7 +462,7 @@ class Linker {
     if (!(R.albedo > 0.0f) || !(power_[s] > 0.0f) || behind(R, S) || behind(S, R)) return;
     if (R.leaf() && S.leaf()) {
       const uint32_t er = tree_.element(R), es = tree_.element(S);
-      ++counters_.form_factors;
+      ++count_for(r).form_factors;
       const float f = float(tree_.triangles[es].form_factor(R.center, in_.mesh.element_normal[er]));
       if (f > 0.0f) {
         const float visible = visibility(r, s);
@@ -486,7 +534,7 @@ class Linker {
         const rc::SurfacePoint b = sample_point(tree_, in_.mesh, s, sends, rng);
         open += !in_.geometry.occluded(rc::spawn_shadow_ray(a, b));
       }
-      counters_.rays += uint64_t(n);
+      count_for(r).rays += uint64_t(n);
       visible = float(open) / float(n);
     }
     return visible;
@@ -523,6 +571,9 @@ class Linker {
   double epsilon_;
   const HierarchicalSettings& settings_;
   Counters& counters_;
+  Counters uncounted_;
+  std::span<const int> owner_;
+  int rank_ = 0;
   bool keep_open_ = false;
 };
 
@@ -650,6 +701,42 @@ struct TreeWalk {
   }
 };
 
+/// A node and the nodes of its subtree, [root, end).
+struct Subtree {
+  uint32_t root, end;
+};
+
+/// The tree cut for several processes: subtrees of at most 1/256 of the nodes each, in node
+/// order, and each node's owner: the rank of its subtree (subtree i is rank i mod count's), or
+/// −1 above the cut.
+struct SubtreeCut {
+  std::vector<Subtree> subtrees;
+  std::vector<int> owner;
+};
+
+SubtreeCut cut_tree(const Tree& tree, int count) {
+  const size_t n = tree.nodes.size(), most = std::max<size_t>(1, n / 256);
+  SubtreeCut cut;
+  cut.owner.assign(n, -1);
+  if (n == 0) return cut;
+  std::vector<uint32_t> end(n);
+  for (size_t i = n; i-- > 0;) end[i] = tree.nodes[i].leaf() ? uint32_t(i + 1) : end[tree.nodes[i].right];
+  std::vector<uint32_t> stack{0};
+  while (!stack.empty()) {
+    const uint32_t i = stack.back();
+    stack.pop_back();
+    if (tree.nodes[i].leaf() || end[i] - i <= most) {
+      const int rank = int(cut.subtrees.size() % size_t(count));
+      cut.subtrees.push_back({i, end[i]});
+      std::fill(cut.owner.begin() + i, cut.owner.begin() + end[i], rank);
+    } else {
+      stack.push_back(tree.nodes[i].right);
+      stack.push_back(i + 1);
+    }
+  }
+  return cut;
+}
+
 }  // namespace
 
 std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const Rgb> emitted,
@@ -673,7 +760,7 @@ std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const
   const double epsilon = settings.gather_tolerance * total / area;
   std::atomic<uint64_t> ray_count{0};
   const size_t count = nv - first_vertex;
-  rc::parallel_for((count + 63) / 64, [&](size_t chunk) {
+  rc::parallel_for_owned((count + 63) / 64, [&](size_t chunk) {
     WalkCounts walk;
     std::vector<uint32_t> stack;
     for (size_t v = first_vertex + chunk * 64; v < std::min(nv, first_vertex + chunk * 64 + 64); ++v) {
@@ -682,7 +769,8 @@ std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const
     }
     ray_count += walk.rays;
   });
-  if (shadow_rays) *shadow_rays += ray_count;
+  rc::join_ranges(std::span(out), 64, first_vertex);
+  if (shadow_rays) *shadow_rays += rc::processes().total(ray_count);
   return out;
 }
 
@@ -692,7 +780,9 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   HierarchicalResult result;
   result.vertex_irradiance.assign(nv, Rgb(0.0f));
   if (ne == 0) return result;
-  auto out_of_time = [&] { return in.out_of_time && in.out_of_time(); };
+  // Under several processes rank 0's clock decides for all, so that they stay in step.
+  const rc::Processes& group = rc::processes();
+  auto out_of_time = [&] { return group.broadcast_value(in.out_of_time && in.out_of_time()); };
   Counters counters;
 
   const auto start = std::chrono::steady_clock::now();
@@ -704,6 +794,18 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   };
   const Tree tree = TreeBuilder(mesh, in.albedo).build();
   result.nodes = tree.nodes.size();
+  // Under several processes the tree is cut into subtrees of at most 1/256 of its nodes (a
+  // node's subtree is the range of nodes that follows it), dealt out round-robin. Each process
+  // links and gathers at the receivers in its subtrees, and all of them at the few hundred nodes
+  // above the cut; it pushes down into its own subtrees, and the elements' irradiance is joined,
+  // 12 bytes an element per gather. Every value is summed in one process's order.
+  const SubtreeCut cut = group.count() > 1 ? cut_tree(tree, group.count()) : SubtreeCut{};
+  const auto shared_and_total = [&](const auto& items) {
+    if (group.count() == 1) return items.size();
+    const size_t shared = size_t(std::count_if(items.begin(), items.end(),
+                                               [&](const auto& x) { return cut.owner[x.receiver] < 0; }));
+    return shared + size_t(group.total(items.size() - shared));
+  };
 
   // Direct irradiance per element (mean of its vertices) and the first reflected radiosity.
   std::vector<Rgb> direct(ne), radiosity(ne);
@@ -761,29 +863,50 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   std::vector<Rgb> power, indirect(ne, Rgb(0.0f));
   std::vector<Moments> moment;
   std::vector<Gathered> gathered(tree.nodes.size());
+  // Gathers at the receivers [lo, hi) over their links.
+  auto gather_receivers = [&](size_t lo, size_t hi) {
+    for (size_t g = lo; g < hi; ++g) {
+      const Node& R = tree.nodes[receivers[g]];
+      Gathered& acc = gathered[receivers[g]];
+      for (uint32_t l = first_link[g]; l < first_link[g + 1]; ++l) {
+        const Link& link = links[l];
+        const Node& S = tree.nodes[link.source];
+        const Rgb j = link.exact ? power[link.source] * (link.factor / S.area)
+                                 : intensity(moment[link.source], -link.dir) * link.factor;
+        const Facing side = facing(R, link.dir);
+        if (side == Facing::front) {
+          acc.flat.add(j, link.dir);
+        } else if (side == Facing::mixed) {
+          acc.sum += j;
+          acc.band1.add(j, link.dir);
+        }
+      }
+    }
+  };
   auto gather = [&](std::span<const Rgb> from, std::vector<Rgb>& out) {
     pull(tree, mesh, from, power, moment);
     std::fill(gathered.begin(), gathered.end(), Gathered{});
-    rc::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
-      for (size_t g = chunk * 64; g < std::min(receivers.size(), chunk * 64 + 64); ++g) {
-        const Node& R = tree.nodes[receivers[g]];
-        Gathered& acc = gathered[receivers[g]];
-        for (uint32_t l = first_link[g]; l < first_link[g + 1]; ++l) {
-          const Link& link = links[l];
-          const Node& S = tree.nodes[link.source];
-          const Rgb j = link.exact
-                            ? power[link.source] * (link.factor / S.area)
-                            : intensity(moment[link.source], -link.dir) * link.factor;
-          const Facing side = facing(R, link.dir);
-          if (side == Facing::front) {
-            acc.flat.add(j, link.dir);
-          } else if (side == Facing::mixed) {
-            acc.sum += j;
-            acc.band1.add(j, link.dir);
-          }
-        }
+    if (group.count() == 1) {
+      rc::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
+        gather_receivers(chunk * 64, std::min(receivers.size(), chunk * 64 + 64));
+      });
+    } else {
+      // Receivers are sorted by node: a subtree's are a range of them.
+      auto first_at = [&](uint32_t node) {
+        return size_t(std::lower_bound(receivers.begin(), receivers.end(), node) - receivers.begin());
+      };
+      const std::vector<Subtree>& parts = cut.subtrees;
+      std::vector<size_t> above;  // receivers above the cut
+      for (size_t c = 0, g = 0; c <= parts.size(); ++c) {
+        const size_t to = c < parts.size() ? first_at(parts[c].root) : receivers.size();
+        for (; g < to; ++g) above.push_back(g);
+        if (c < parts.size()) g = first_at(parts[c].end);
       }
-    });
+      rc::parallel_for((above.size() + 63) / 64, [&](size_t chunk) {
+        for (size_t i = chunk * 64; i < std::min(above.size(), chunk * 64 + 64); ++i) gather_receivers(above[i], above[i] + 1);
+      });
+      rc::parallel_for_owned(parts.size(), [&](size_t c) { gather_receivers(first_at(parts[c].root), first_at(parts[c].end)); });
+    }
     for (size_t i = 0; i < tree.nodes.size(); ++i) {
       const Node& node = tree.nodes[i];
       if (node.leaf()) continue;
@@ -793,9 +916,26 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         gathered[c].band1.add(gathered[i].band1);
       }
     }
-    for (const Node& node : tree.nodes)
-      if (node.leaf())
-        out[tree.element(node)] = irradiance_at(gathered[&node - tree.nodes.data()], mesh.element_normal[tree.element(node)]);
+    auto leaf_irradiance = [&](size_t i) {
+      return irradiance_at(gathered[i], mesh.element_normal[tree.element(tree.nodes[i])]);
+    };
+    if (group.count() == 1) {
+      for (size_t i = 0; i < tree.nodes.size(); ++i)
+        if (tree.nodes[i].leaf()) out[tree.element(tree.nodes[i])] = leaf_irradiance(i);
+      return;
+    }
+    const std::vector<Subtree>& parts = cut.subtrees;
+    std::vector<std::vector<Rgb>> values(parts.size());
+    rc::parallel_for_owned(parts.size(), [&](size_t c) {
+      for (uint32_t i = parts[c].root; i < parts[c].end; ++i)
+        if (tree.nodes[i].leaf()) values[c].push_back(leaf_irradiance(i));
+    });
+    rc::join_chunks(values);
+    for (size_t c = 0; c < parts.size(); ++c) {
+      size_t k = 0;
+      for (uint32_t i = parts[c].root; i < parts[c].end; ++i)
+        if (tree.nodes[i].leaf()) out[tree.element(tree.nodes[i])] = values[c][k++];
+    }
   };
 
   // Under a unit radiosity everywhere an element gathers at most 1 (a closed room's white
@@ -863,7 +1003,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       const double foretold = level == 1 || links_before == 0
                                   ? last_iterate
                                   : last_cost * std::max(1.0, double(last_links) / double(links_before));
-      if (foretold > in.seconds_left()) {
+      if (group.broadcast_value(foretold > in.seconds_left())) {
         result.linking_stopped = true;
         break;
       }
@@ -872,12 +1012,13 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     const bool last = level + 1 == ladder.size();
     std::optional<LinkLevel> made = Linker(in, tree, power_estimate, moment_estimate,
                                            ladder[level] * total_estimate, settings, counters)
+                                        .owned_by(cut.owner, group.rank())
                                         .keeping_open_pairs(!last)
                                         .link(open_pairs);
     result.link_seconds += seconds_since(link_start);
     // Sorting the links and bounding their gains cost about what an iteration does: a level that
     // finished linking without that much time left is dropped too.
-    if (!made || (level > 0 && last_iterate > in.seconds_left())) {
+    if (!made || (level > 0 && group.broadcast_value(last_iterate > in.seconds_left()))) {
       result.linking_stopped = true;
       break;
     }
@@ -896,7 +1037,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       if (i == 0 || links[i].receiver != links[i - 1].receiver)
         receivers.push_back(links[i].receiver), first_link.push_back(i);
     first_link.push_back(uint32_t(links.size()));
-    result.links = links.size();
+    result.links = shared_and_total(links);
     result.link_tolerance = ladder[level];
     result.link_rays = counters.rays;
     const auto iterate_start = std::chrono::steady_clock::now();
@@ -906,7 +1047,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     result.iterate_seconds += last_iterate;
     last_cost = seconds_since(link_start);
     links_before = last_links;
-    last_links = links.size();
+    last_links = result.links;
   }
   pull(tree, mesh, radiosity, power, moment);
   lap();
@@ -943,12 +1084,14 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   }
   const TreeWalk walker{in, tree, radiosity, power, moment};
   std::vector<Rgb> gathered_at(nv);
-  std::vector<char> done(nv, 0);
-  // Gathers at the listed vertices in parallel; false when time ran out first.
+  // Gathers at the listed vertices in parallel, each process at the chunks of 64 it owns; false
+  // when time ran out first on any process.
   auto gather_at = [&](const std::vector<uint32_t>& list) {
     std::atomic<bool> stopped{false};
-    rc::parallel_for((list.size() + 63) / 64, [&](size_t chunk) {
-      if (stopped.load(std::memory_order_relaxed) || out_of_time()) {
+    const uint64_t rays_before = counters.rays, nodes_before = counters.gather_nodes,
+                   form_factors_before = counters.form_factors;
+    rc::parallel_for_owned((list.size() + 63) / 64, [&](size_t chunk) {
+      if (stopped.load(std::memory_order_relaxed) || (in.out_of_time && in.out_of_time())) {
         stopped = true;
         return;
       }
@@ -960,13 +1103,20 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
                                std::max(double(result.vertex_irradiance[v].average()), 0.05 * mean_indirect);
         rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5200000000ull);
         gathered_at[v] = walker.irradiance(v, epsilon, 1, rng, stack, walk);
-        done[v] = 1;
       }
       counters.rays += walk.rays;
       counters.gather_nodes += walk.nodes;
       counters.form_factors += walk.form_factors;
     });
-    return !stopped;
+    if (group.count() == 1) return !stopped;
+    std::vector<Rgb> values(list.size());
+    for (size_t i = 0; i < list.size(); ++i) values[i] = gathered_at[list[i]];
+    rc::join_ranges(std::span(values), 64);
+    for (size_t i = 0; i < list.size(); ++i) gathered_at[list[i]] = values[i];
+    counters.rays = rays_before + group.total(counters.rays - rays_before);
+    counters.gather_nodes = nodes_before + group.total(counters.gather_nodes - nodes_before);
+    counters.form_factors = form_factors_before + group.total(counters.form_factors - form_factors_before);
+    return !group.any(stopped);
   };
   // A probe of every kGatherProbeStride-th vertex (at most about 1,024 of them) predicts what the whole gather costs. `auto`
   // skips it when it would trace more than kGatherRayShare times the links' shadow rays: on a
@@ -982,14 +1132,14 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   bool complete = gather_at(probe);
   const double scale = double(nv) / double(std::max<size_t>(1, probe.size()));
   result.final_gather_predicted_rays = uint64_t(double(counters.rays - rays_before) * scale);
-  const double predicted_seconds = seconds_since(probe_start) * (scale - 1.0);
+  const double predicted_seconds = group.broadcast_value(seconds_since(probe_start) * (scale - 1.0));
   if (complete && settings.final_gather == FinalGather::automatic &&
       double(result.final_gather_predicted_rays) > kGatherRayShare * double(std::max<uint64_t>(1, result.link_rays))) {
     result.final_gather_note = "skipped: it would trace about " + std::to_string(result.final_gather_predicted_rays) +
                                " shadow rays, more than " + std::to_string(int(kGatherRayShare)) +
                                " times the links' " + std::to_string(result.link_rays);
     complete = false;
-  } else if (complete && timed && predicted_seconds > in.seconds_left()) {
+  } else if (complete && timed && group.broadcast_value(predicted_seconds > in.seconds_left())) {
     char note[160];
     std::snprintf(note, sizeof note, "skipped: it would take about %.3g s, %.3g s were left", predicted_seconds,
                   std::max(0.0, in.seconds_left()));

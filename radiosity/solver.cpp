@@ -27,6 +27,7 @@
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/processes.h"
 #include "raytrace_core/progress.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sampling.h"
@@ -92,7 +93,7 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<Vec3> origin(mesh.positions);
-  rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+  rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
     for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
       const Vec3 p = mesh.positions[v], n = mesh.normals[v];
       int fewest = std::numeric_limits<int>::max();
@@ -117,6 +118,7 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
       }
     }
   });
+  rc::join_ranges(std::span(origin), 256);
   return origin;
 }
 
@@ -125,7 +127,7 @@ std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, cons
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<rc::SurfacePoint> out(kVisibilityOrigins * nv);
-  rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+  rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
     for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
       const Vec3 p = mesh.positions[v];
       const size_t count = offsets[v + 1] - offsets[v];
@@ -151,6 +153,7 @@ std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, cons
       for (size_t k = taken; k < kVisibilityOrigins; ++k) out[kVisibilityOrigins * v + k] = out[kVisibilityOrigins * v + k % taken];
     }
   });
+  rc::join_ranges(std::span(out), 256 * kVisibilityOrigins);
   return out;
 }
 
@@ -339,7 +342,7 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
   if (scene.punctual_lights.empty()) return out;
   const int side = std::max(1, int(std::lround(std::sqrt(double(std::max(1, samples))))));
   std::atomic<uint64_t> traced{0};
-  rc::parallel_for((ne + 255) / 256, [&](size_t chunk) {
+  rc::parallel_for_owned((ne + 255) / 256, [&](size_t chunk) {
     uint64_t count = 0;
     std::vector<int> pairing(size_t(side * side));
     for (size_t e = chunk * 256; e < std::min(ne, chunk * 256 + 256); ++e) {
@@ -379,7 +382,8 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
     }
     traced += count;
   });
-  rays += traced;
+  rc::join_ranges(std::span(out), 256);
+  rays += rc::processes().total(traced);
   return out;
 }
 
@@ -637,6 +641,17 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     rays += c.rays;
     skipped += c.skipped;
   };
+  // Under several processes (mpirun) each computes the chunks of vertices or elements it owns
+  // and the results are joined, so every process holds one process's arrays. The counts of such
+  // a loop are summed over the processes, and rank 0's clock makes every decision about time.
+  const rc::Processes& group = rc::processes();
+  auto joined_counts = [&](uint64_t rays_before, uint64_t form_factors_before, uint64_t skipped_before) {
+    if (group.count() == 1) return;
+    uint64_t own[3] = {rays - rays_before, form_factors - form_factors_before, skipped - skipped_before};
+    group.sum(own);
+    rays = rays_before + own[0], form_factors = form_factors_before + own[1], skipped = skipped_before + own[2];
+  };
+  auto over_budget = [&](double seconds) { return group.broadcast_value(settings.time_limit > 0.0 && seconds > settings.time_limit); };
 
   // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
   sol.solver = choose_solver(settings, mesh.element_count(), &sol.solver_reason);
@@ -674,7 +689,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     direct_delta.resize(nv, Rgb(0.0f));
     direct_emitted.resize(nv, Rgb(0.0f));
     const size_t count = nv - first_vertex;
-    rc::parallel_for((count + 127) / 128, [&](size_t chunk) {
+    const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
+    rc::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
       Counts counts;
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv, first_vertex + chunk * 128 + 128); ++v) {
         for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
@@ -693,6 +709,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       }
       add_counts(counts);
     });
+    for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::join_ranges(std::span(*values), 128, first_vertex);
+    joined_counts(rays_before, form_factors_before, skipped_before);
     if (hierarchical) {
       // Emitting elements by the tree walk: the patches above would make this pass cost the
       // vertex count times the emitter count.
@@ -714,7 +732,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   const float min_edge = base_edge * std::ldexp(1.0f, -settings.subdivision_levels);
   for (int round = 0; round < 2 * settings.subdivision_levels; ++round) {
     // With a time budget, refinement stops once it has used its share, so shooting gets the rest.
-    if (settings.time_limit > 0.0 && elapsed() > kRefinementShare * settings.time_limit) break;
+    if (over_budget(elapsed() / kRefinementShare)) break;
     // Mark elements whose vertices' direct irradiance spreads by more than the threshold times
     // the brightest of them (plus a floor of 1 % of the mean, so that darkness does not refine).
     double mean = 0.0, area = 0.0;
@@ -800,7 +818,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
       if (sol.residual < settings.tolerance) break;
       // A shot takes about as long as the last one: stop before one would end past the budget.
-      if (settings.time_limit > 0.0 && elapsed() + last_shot > settings.time_limit) break;
+      if (over_budget(elapsed() + last_shot)) break;
       const double shot_start = elapsed();
 
       // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
@@ -810,7 +828,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       source.probe = std::min(settings.reflected_visibility_probe, strata);
       source.strata = source.probe;
       const uint64_t shot_index = sol.shots++;
-      rc::parallel_for((nv + 255) / 256, [&](size_t chunk) {
+      const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
+      rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
         Counts counts;
         for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
           rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
@@ -818,6 +837,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
         }
         add_counts(counts);
       });
+      rc::join_ranges(std::span(received), 256);
+      joined_counts(rays_before, form_factors_before, skipped_before);
       // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
       for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
       for (size_t e = 0; e < ne; ++e) {

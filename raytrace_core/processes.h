@@ -8,6 +8,7 @@
 // would compute it, and joins copy results rather than add them, so a run on N ranks gives the
 // bits of a run on one.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -48,6 +49,17 @@ class Processes {
   }
   /// The largest `value` over processes.
   float max(float value) const;
+  /// Whether `value` is true on any process.
+  bool any(bool value) const {
+    uint64_t n = value ? 1 : 0;
+    sum(std::span(&n, 1));
+    return n > 0;
+  }
+  /// The sum of `value` over processes (a count of work each did on its own items).
+  uint64_t total(uint64_t value) const {
+    sum(std::span(&value, 1));
+    return value;
+  }
 };
 
 /// The processes of this run: one process unless set_processes installed others.
@@ -96,6 +108,43 @@ void join_chunks(std::vector<std::vector<T>>& chunks) {
       chunks[c].resize(size);
       if (size) std::memcpy(chunks[c].data(), at, size * sizeof(T));
       at += size * sizeof(T);
+    }
+}
+
+/// Calls body(i) for the items i of [0, count) this process owns, in parallel; join their
+/// results with join_ranges or join_owned.
+inline void parallel_for_owned(size_t count, const std::function<void(size_t)>& body) {
+  const Processes& p = processes();
+  const size_t n = size_t(p.count()), first = size_t(p.rank());
+  if (n == 1) return parallel_for(count, body);
+  const size_t owned = count > first ? (count - first + n - 1) / n : 0;
+  parallel_for(owned, [&](size_t k) { body(first + k * n); });
+}
+
+/// Joins values[first + c·size, first + (c + 1)·size) computed by the owner of chunk c (c mod N),
+/// the last chunk cut at the end: afterwards every process holds all of them.
+template <class T>
+void join_ranges(std::span<T> values, size_t size, size_t first = 0) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const Processes& p = processes();
+  const size_t n = size_t(p.count());
+  if (n == 1 || values.size() <= first) return;
+  const size_t count = values.size() - first, chunks = (count + size - 1) / size;
+  auto range = [&](size_t c) {
+    return values.subspan(first + c * size, std::min(size, count - c * size));
+  };
+  std::vector<std::byte> mine;
+  for (size_t c = size_t(p.rank()); c < chunks; c += n) {
+    const auto bytes = std::as_bytes(range(c));
+    mine.insert(mine.end(), bytes.begin(), bytes.end());
+  }
+  const std::vector<std::byte> all = p.all_gather(mine);
+  const std::byte* at = all.data();
+  for (size_t r = 0; r < n; ++r)
+    for (size_t c = r; c < chunks; c += n) {
+      const auto out = range(c);
+      std::memcpy(out.data(), at, out.size_bytes());
+      at += out.size_bytes();
     }
 }
 
