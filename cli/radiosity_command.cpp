@@ -81,9 +81,10 @@ void run_radiosity(RadiosityOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
-  if (lightmap)
+  if (lightmap) {
     radiosity::check_lightmap_output(o.output, scene);
-  else if (onto_input)
+    radiosity::check_lightmap_layout(scene, o.lightmap);  // before the solve, not after it
+  } else if (onto_input)
     radiosity::check_onto_output(o.output, scene);
   o.solver.progress = !o.quiet && !o.json;
   if (o.bake_gather > 0 && !onto_input)

@@ -447,6 +447,49 @@ InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked
   return out;
 }
 
+/// gilt's own charts over the baked meshes, packed into a size × size atlas at the highest
+/// density that fits (returned in `density`, texels per scene unit). Throws InputError when the
+/// charts do not fit even at one texel each.
+std::vector<Chart> lay_out_charts(const rc::Scene& scene, const std::vector<uint32_t>& baked_meshes, int size,
+                                  double& density) {
+  std::vector<Chart> charts;
+  for (uint32_t m : baked_meshes) grow_charts(scene.meshes[m], m, charts);
+  rc::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
+  std::stable_sort(charts.begin(), charts.end(), [](const Chart& a, const Chart& b) { return a.extent.y > b.extent.y; });
+  double chart_area = 0.0;
+  for (const Chart& c : charts) chart_area += double(c.extent.x) * double(c.extent.y);
+  // The densest layout that packs: bisection between one that fits and one that does not.
+  // The sparsest layout gives every chart one texel (and its border); at density 0 the charts
+  // would fit as points, with no texel inside any face: an atlas of nothing.
+  const auto top_density = [&](int atlas) { return double(atlas) / std::sqrt(std::max(chart_area, 1e-30)); };
+  double lo = 1e-9 * top_density(size), hi = top_density(size);
+  if (!pack(charts, size, lo)) {
+    int enough = size;
+    while (enough < 16384 && !pack(charts, enough, 1e-9 * top_density(enough))) enough *= 2;
+    throw InputError("--lightmap " + std::to_string(size) + ": " + std::to_string(charts.size()) +
+                     " charts do not fit in the atlas even at one texel each: give a larger size" +
+                     (enough > size && enough <= 16384 ? " (" + std::to_string(enough) + " holds them)" : std::string()));
+  }
+  for (int i = 0; i < 40 && hi > lo * (1.0 + 1e-4); ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (pack(charts, size, mid) ? lo : hi) = mid;
+  }
+  pack(charts, size, lo);
+  density = lo;
+  return charts;
+}
+
+/// The meshes of the scene's model file that a lightmap bakes: all but mirrors and glass.
+std::vector<uint32_t> lightmap_meshes(const rc::Scene& scene) {
+  const int32_t file = onto_input_file(scene);
+  std::vector<uint32_t> baked;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+    if (scene.meshes[m].origin.file == file && !scene.materials[scene.meshes[m].material].is_traced_through())
+      baked.push_back(m);
+  if (baked.empty()) throw InputError("--lightmap: " + scene.name + " has no faces to bake (all are mirrors or glass)");
+  return baked;
+}
+
 }  // namespace
 
 Rgb Lightmap::at(size_t mesh, size_t face, float u, float v) const {
@@ -463,6 +506,15 @@ Rgb Lightmap::at(size_t mesh, size_t face, float u, float v) const {
          (texel(x0, y0 + 1) * (1.0f - fx) + texel(x0 + 1, y0 + 1) * fx) * fy;
 }
 
+void check_lightmap_layout(const rc::Scene& scene, int size) {
+  if (size < 16 || size > 16384)
+    throw InputError("--lightmap " + std::to_string(size) + ": the atlas's size must be 16 to 16384 texels");
+  const std::vector<uint32_t> baked = lightmap_meshes(scene);
+  if (input_uv_set(scene, baked, size).set >= 0) return;
+  double density = 0.0;
+  lay_out_charts(scene, baked, size, density);
+}
+
 Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size,
                        BakeGather gather) {
   if (size < 16 || size > 16384)
@@ -474,18 +526,14 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
   out.corner_uv.resize(scene.meshes.size());
 
   // Layout: the input's own UV set where it can hold a lightmap, else charts of gilt's own.
-  std::vector<uint32_t> baked_meshes;
+  const std::vector<uint32_t> baked_meshes = lightmap_meshes(scene);
   std::vector<std::vector<char>> buried(scene.meshes.size());
-  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+  for (uint32_t m : baked_meshes) {
     const rc::TriangleMesh& mesh = scene.meshes[m];
-    if (mesh.origin.file != out.file || scene.materials[mesh.material].is_traced_through()) continue;
-    baked_meshes.push_back(m);
     out.stats.faces += mesh.triangle_count();
     buried[m] = input_faces_buried(scene, mesh.positions, mesh.indices);
     for (char b : buried[m]) out.stats.buried_faces += size_t(b);
   }
-  if (baked_meshes.empty())
-    throw InputError("--lightmap: " + scene.name + " has no faces to bake (all are mirrors or glass)");
   // Groups of faces that own disjoint texels, rasterised in parallel: charts; or, with the
   // input's UVs, whose charts gilt did not place, all faces in one group.
   std::vector<std::pair<uint32_t, std::vector<uint32_t>>> groups;
@@ -500,24 +548,9 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
       groups.emplace_back(m, std::move(faces));
     }
   } else {
-    std::vector<Chart> charts;
-    for (uint32_t m : baked_meshes) grow_charts(scene.meshes[m], m, charts);
-    rc::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
-    std::stable_sort(charts.begin(), charts.end(),
-                     [](const Chart& a, const Chart& b) { return a.extent.y > b.extent.y; });
-    double chart_area = 0.0;
-    for (const Chart& c : charts) chart_area += double(c.extent.x) * double(c.extent.y);
+    double lo = 0.0;
+    const std::vector<Chart> charts = lay_out_charts(scene, baked_meshes, size, lo);
     out.stats.charts = charts.size();
-    // The densest layout that packs: bisection between one that fits and one that does not.
-    double lo = 0.0, hi = double(size) / std::sqrt(std::max(chart_area, 1e-30));
-    if (!pack(charts, size, 0.0))
-      throw InputError("--lightmap " + std::to_string(size) + ": " + std::to_string(charts.size()) +
-                       " charts do not fit in the atlas even at one texel each: give a larger size");
-    for (int i = 0; i < 40 && hi > lo * (1.0 + 1e-4); ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (pack(charts, size, mid) ? lo : hi) = mid;
-    }
-    pack(charts, size, lo);
     out.stats.texels_per_metre = lo;
     for (const Chart& c : charts) {
       std::vector<Vec2>& uv = out.corner_uv[c.mesh];

@@ -72,6 +72,10 @@ struct Lightmap {
 Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size,
                        BakeGather gather = {});
 
+/// Throws InputError when bake_lightmap could not lay out a size × size atlas for the scene
+/// (size outside 16..16384, nothing to bake, more charts than fit): called before solving.
+void check_lightmap_layout(const rc::Scene& scene, int size);
+
 /// The atlas's file for a model output: `<folder>/<stem>_lightmap.exr`.
 std::string lightmap_image_path(const std::string& model_output);
 

@@ -21,6 +21,7 @@
 #include "radiosity/check.h"
 #include "radiosity/lightmap.h"
 #include "radiosity/solver.h"
+#include "raytrace_core/error.h"
 #include "raytrace_core/io/image_io.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/cli_run.h"
@@ -611,6 +612,45 @@ TEST(Lightmap, BadRequestsAreRefusedBeforeSolving) {
   EXPECT_EQ(slurp(dir / "model.gltf"), before);
   EXPECT_FALSE(fs::exists(dir / "x.glb"));
   EXPECT_FALSE(fs::exists(dir / "x_lightmap.exr"));
+  fs::remove_all(dir);
+}
+
+TEST(Lightmap, AnAtlasTooSmallForItsChartsIsRefusedNotLeftEmpty) {
+  // Six separate triangles: six charts. In 16² each needs, at any texel density above 0, a cell
+  // of 2 texels and 2 × kLightmapPad of border (6 × 6: four fit); as points, cells of 5 × 5 (nine
+  // fit), which once gave a layout at density 0 where no face held a texel and an empty atlas
+  // was written. Now 16 is refused, before the solve, and 32 bakes.
+  const fs::path dir = fresh_dir("too-small");
+  std::string obj;
+  for (int i = 0; i < 6; ++i) {
+    const float x = 3.0f * float(i);
+    obj += "v " + std::to_string(x) + " 0 0\nv " + std::to_string(x + 1) + " 0 0\nv " + std::to_string(x) + " 0 -1\n";
+    obj += "f " + std::to_string(3 * i + 1) + " " + std::to_string(3 * i + 2) + " " + std::to_string(3 * i + 3) + "\n";
+  }
+  write_file(dir / "tiles.obj", obj);
+  write_file(dir / "scene.json", R"({"meshes": [{"file": "tiles.obj"}],
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}]})");
+  const rc::Scene scene = rc::load_scene((dir / "scene.json").string());
+  try {
+    rad::check_lightmap_layout(scene, 16);
+    ADD_FAILURE() << "a 16-texel atlas cannot hold six charts";
+  } catch (const rc::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("32 holds them"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(rad::check_lightmap_layout(scene, 32));
+  const CliResult r = run_command(kGilt + " radiosity " + quoted(dir / "scene.json") + " --lightmap 16 -q -o " +
+                                      quoted(dir / "x.glb"),
+                                  dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("give a larger size (32 holds them)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  rad::SolverSettings settings;
+  settings.mesh.elements = 50;
+  const rad::Lightmap lm = rad::bake_lightmap(scene, rad::solve(scene, settings), rad::Quantity::irradiance, 32);
+  EXPECT_EQ(lm.stats.charts, 6u);
+  // Each face holds texels: at least its one texel of density, of the 32² atlas.
+  EXPECT_GE(lm.stats.texels, 6u);
+  EXPECT_GT(lm.stats.texels_per_metre, 0.0);
   fs::remove_all(dir);
 }
 
