@@ -477,17 +477,25 @@ struct Receivers {
   }
 
   /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
-  /// factor times its radiosity, times the patch's visible fraction seen from v.
-  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts) const {
+  /// factor times its radiosity, times the patch's visible fraction seen from v. `kept`, when
+  /// given, holds the patch's form factors at v (one per element): read when `known`, else
+  /// computed and stored there.
+  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts, float* kept = nullptr,
+              bool known = false) const {
     const Vec3& p = origin[v];
     const Vec3& n = mesh.normals[v];
-    counts.form_factors += src.elements.size();
     if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
     // Per source element: its share of what v receives, as a running sum for sampling. Elements
     // that send nothing get empty intervals, which sampling never picks.
     const size_t m = src.elements.size();
-    std::array<float, SourceBatch::kMaxBatch> factor;
-    src.batch.form_factors(p, n, factor.data());
+    std::array<float, SourceBatch::kMaxBatch> computed;
+    const float* factor = kept;
+    if (!kept || !known) {
+      counts.form_factors += m;
+      src.batch.form_factors(p, n, computed.data());
+      if (kept) std::copy_n(computed.data(), m, kept);
+      factor = computed.data();
+    }
     std::array<float, kMaxPatchElements> cdf;
     float r = 0.0f, g = 0.0f, b = 0.0f, total = 0.0f;
     for (size_t k = 0; k < m; ++k) {
@@ -556,6 +564,11 @@ struct Receivers {
     return gathered * visible;
   }
 };
+
+/// Memory for progressive refinement's kept form factors (a patch's at every vertex; about
+/// elements × vertices × 4 bytes in all, 31 MB at 3,660 elements): past it, later patches'
+/// factors are computed at every shot.
+constexpr size_t kFactorCacheBytes = size_t(512) << 20;
 
 /// Share of a time budget that adaptive subdivision may use before it stops refining.
 constexpr double kRefinementShare = 0.3;
@@ -797,6 +810,11 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
 
     const Patches patches = build_patches(mesh, settings.patch_elements);
     sol.patches = patches.count();
+    // Each patch's form factors at every vertex, kept from its first shot for its later ones
+    // while they fit in kFactorCacheBytes: they depend on the geometry alone, and a patch
+    // shoots several times (about four on cornell), so its later shots trace only visibility.
+    std::vector<std::vector<float>> factor_rows(patches.count());
+    size_t cached_bytes = 0;
     // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
     rc::Progress progress("radiosity", 1000, "‰", settings.progress);
     uint64_t shown = 0;
@@ -829,11 +847,18 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       source.strata = source.probe;
       const uint64_t shot_index = sol.shots++;
       const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
+      std::vector<float>& row = factor_rows[src];
+      const bool known = !row.empty();
+      const size_t width = source.elements.size(), row_bytes = nv * width * sizeof(float);
+      if (!known && cached_bytes + row_bytes <= kFactorCacheBytes) {
+        row.resize(nv * width);
+        cached_bytes += row_bytes;
+      }
       rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
         Counts counts;
         for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
           rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
-          received[v] = receivers.receive(source, v, rng, counts);
+          received[v] = receivers.receive(source, v, rng, counts, row.empty() ? nullptr : &row[v * width], known);
         }
         add_counts(counts);
       });
