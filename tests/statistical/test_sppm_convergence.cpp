@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include "raytrace_core/io/image_error.h"
@@ -35,6 +36,41 @@ rc::RenderSettings settings(int spp, uint64_t seed) {
   s.seed = seed;
   s.progress = false;
   return s;
+}
+
+/// Image means over four independent seeds each: the path tracer at 256 spp (seeds path_seed +
+/// 0..3) and SPPM at `iterations` with 20,000 photons each and the initial radius `radius`
+/// (seeds sppm_seed + 0..3). Returns the two means and the standard error of their difference.
+struct MeanComparison {
+  double path, sppm, standard_error;
+};
+
+MeanComparison compare_means(const rc::Scene& scene, const rc::Camera& camera, uint64_t path_seed, uint64_t sppm_seed,
+                             int iterations, float radius) {
+  double path[4], photons[4];
+  for (int s = 0; s < 4; ++s) {
+    const rc::PathSettings ps;
+    path[s] = gilt::test::film_mean(rc::render_image(scene, camera, settings(256, path_seed + s),
+                                                      [&](const rc::Ray& ray, rc::SampleContext& ctx) {
+                                                        return rc::path_radiance(scene, ray, ctx, ps);
+                                                      }));
+    pm::SppmSettings sppm;
+    sppm.photons_per_iteration = 20000;
+    sppm.initial_radius = radius;
+    photons[s] = gilt::test::film_mean(pm::render_sppm(scene, camera, settings(iterations, sppm_seed + s), sppm));
+  }
+  auto mean_and_variance = [](const double* v) {
+    const double m = (v[0] + v[1] + v[2] + v[3]) / 4.0;
+    double var = 0.0;
+    for (int i = 0; i < 4; ++i) var += (v[i] - m) * (v[i] - m) / 3.0;
+    return std::pair{m, var / 4.0};  // variance of the mean
+  };
+  const auto [pm_mean, pm_var] = mean_and_variance(path);
+  const auto [sp_mean, sp_var] = mean_and_variance(photons);
+  const MeanComparison c{pm_mean, sp_mean, std::sqrt(pm_var + sp_var)};
+  std::printf("path %.5f, SPPM %.5f: ratio %.4f (standard error of the difference %.5f)\n", c.path, c.sppm,
+              c.sppm / c.path, c.standard_error);
+  return c;
 }
 
 }  // namespace
@@ -113,29 +149,8 @@ TEST(Sppm, KeepsThePhotonsOfACurvedSurface) {
   camera.look_at = rc::Vec3(0.0f, 0.0f, -1.0f);
   camera.vfov_degrees = 60.0f;
 
-  double path[4], photons[4];
-  for (int s = 0; s < 4; ++s) {
-    const rc::PathSettings ps;
-    path[s] = gilt::test::film_mean(rc::render_image(scene, camera, settings(256, 40 + s),
-                                                      [&](const rc::Ray& ray, rc::SampleContext& ctx) {
-                                                        return rc::path_radiance(scene, ray, ctx, ps);
-                                                      }));
-    pm::SppmSettings sppm;
-    sppm.photons_per_iteration = 20000;
-    sppm.initial_radius = 0.7f;
-    photons[s] = gilt::test::film_mean(pm::render_sppm(scene, camera, settings(16, 50 + s), sppm));
-  }
-  auto mean_and_variance = [](const double* v) {
-    const double m = (v[0] + v[1] + v[2] + v[3]) / 4.0;
-    double var = 0.0;
-    for (int i = 0; i < 4; ++i) var += (v[i] - m) * (v[i] - m) / 3.0;
-    return std::pair{m, var / 4.0};  // variance of the mean
-  };
-  const auto [pm_mean, pm_var] = mean_and_variance(path);
-  const auto [sp_mean, sp_var] = mean_and_variance(photons);
-  std::printf("path %.5f, SPPM %.5f: ratio %.4f (standard error of the difference %.5f)\n", pm_mean, sp_mean,
-              sp_mean / pm_mean, std::sqrt(pm_var + sp_var));
-  EXPECT_NEAR(sp_mean, pm_mean, 4.0 * std::sqrt(pm_var + sp_var) + 0.03 * pm_mean);
+  const MeanComparison c = compare_means(scene, camera, 40, 50, 16, 0.7f);
+  EXPECT_NEAR(c.sppm, c.path, 4.0 * c.standard_error + 0.03 * c.path);
 }
 
 // A plank 0.1 wide inside a closed sphere lit by a point light, seen from just above, gathered
@@ -172,27 +187,6 @@ TEST(Sppm, DividesByTheSurfaceTheDiskHolds) {
   camera.up = rc::Vec3(0.0f, 0.0f, -1.0f);
   camera.vfov_degrees = 8.0f;  // ±0.021 of the plank's ±0.05: every pixel sees it
 
-  double path[4], photons[4];
-  for (int s = 0; s < 4; ++s) {
-    const rc::PathSettings ps;
-    path[s] = gilt::test::film_mean(rc::render_image(scene, camera, settings(256, 60 + s),
-                                                      [&](const rc::Ray& ray, rc::SampleContext& ctx) {
-                                                        return rc::path_radiance(scene, ray, ctx, ps);
-                                                      }));
-    pm::SppmSettings sppm;
-    sppm.photons_per_iteration = 20000;
-    sppm.initial_radius = 0.3f;
-    photons[s] = gilt::test::film_mean(pm::render_sppm(scene, camera, settings(64, 70 + s), sppm));
-  }
-  auto mean_and_variance = [](const double* v) {
-    const double m = (v[0] + v[1] + v[2] + v[3]) / 4.0;
-    double var = 0.0;
-    for (int i = 0; i < 4; ++i) var += (v[i] - m) * (v[i] - m) / 3.0;
-    return std::pair{m, var / 4.0};  // variance of the mean
-  };
-  const auto [pm_mean, pm_var] = mean_and_variance(path);
-  const auto [sp_mean, sp_var] = mean_and_variance(photons);
-  std::printf("path %.5f, SPPM %.5f: ratio %.4f (standard error of the difference %.5f)\n", pm_mean, sp_mean,
-              sp_mean / pm_mean, std::sqrt(pm_var + sp_var));
-  EXPECT_NEAR(sp_mean, pm_mean, 4.0 * std::sqrt(pm_var + sp_var) + 0.01 * pm_mean);
+  const MeanComparison c = compare_means(scene, camera, 60, 70, 64, 0.3f);
+  EXPECT_NEAR(c.sppm, c.path, 4.0 * c.standard_error + 0.01 * c.path);
 }
