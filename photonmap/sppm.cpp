@@ -41,7 +41,7 @@ struct PixelState {
   rc::Rgb phi{0.0f};
   uint32_t m = 0;
   // Coverage probes over the iterations with a visible point: how many fell on surface that
-  // can hold the disk's photons (see disk_coverage).
+  // can hold the disk's photons (see probe_coverage).
   uint32_t probes = 0;
   float covered = 0.0f;
 };

@@ -334,6 +334,17 @@ struct LinkLevel {
   std::vector<OpenPair> open;
 };
 
+/// How many of `items` (links or pairs, each with a receiver node) one process would hold, when
+/// each process holds those receiving at its own nodes and all hold those above the cut (owner
+/// −1): the ones above the cut once, the rest summed over processes. Empty `owner`: one process.
+template <class Items>
+size_t count_as_one_process(const Items& items, std::span<const int> owner) {
+  if (owner.empty()) return items.size();
+  const size_t shared =
+      size_t(std::count_if(items.begin(), items.end(), [&](const auto& x) { return owner[x.receiver] < 0; }));
+  return shared + size_t(rc::processes().total(items.size() - shared));
+}
+
 class Linker {
  public:
   bool out_of_time() const { return in_.out_of_time && in_.out_of_time(); }
@@ -373,25 +384,16 @@ class Linker {
     // the cut (see owners_of), and keeps only the links and pairs that land there. A pair's
     // refinements receive within its receiver's subtree, so each process makes, in the same
     // order, the subsequence of one process's links that it gathers over.
-    const auto own = [&](std::vector<OpenPair>& pairs) {
-      if (!owner_.empty())
-        std::erase_if(pairs, [&](const OpenPair& p) { return !mine(p.receiver); });
-    };
     // Breadth-first until there are enough pairs to share out (counted as one process would:
     // the pairs above the cut once), then each chunk of pairs is refined depth-first on its own,
     // its output appended in chunk order: the order of one depth-first pass, deterministic.
     std::vector<OpenPair> frontier(start.begin(), start.end()), next;
-    own(frontier);
-    const auto pairs_in_all = [&] {
-      if (owner_.empty()) return frontier.size();
-      const size_t shared = size_t(std::count_if(frontier.begin(), frontier.end(),
-                                                 [&](const OpenPair& p) { return owner_[p.receiver] < 0; }));
-      return shared + size_t(group.total(frontier.size() - shared));
-    };
+    keep_mine(frontier);
+    const auto pairs_in_all = [&] { return count_as_one_process(frontier, owner_); };
     for (size_t all = pairs_in_all(); all > 0 && all < 4096; all = pairs_in_all()) {
       next.clear();
       for (const OpenPair& p : frontier) refine(p, level, next);
-      own(next);
+      keep_mine(next);
       frontier.swap(next);
     }
     const size_t per_chunk = (frontier.size() + 4095) / 4096;
@@ -437,11 +439,15 @@ class Linker {
   Counters& count_for(uint32_t node) {
     return owner_.empty() || owner_[node] == rank_ || (owner_[node] < 0 && rank_ == 0) ? counters_ : uncounted_;
   }
+  /// Drops the links or pairs that receive at another process's nodes.
+  template <class T>
+  void keep_mine(std::vector<T>& items) const {
+    if (!owner_.empty()) std::erase_if(items, [&](const T& x) { return !mine(x.receiver); });
+  }
   void keep_mine(LinkLevel& level) const {
-    if (owner_.empty()) return;
-    std::erase_if(level.exact, [&](const Link& l) { return !mine(l.receiver); });
-    std::erase_if(level.far, [&](const Link& l) { return !mine(l.receiver); });
-    std::erase_if(level.open, [&](const OpenPair& p) { return !mine(p.receiver); });
+    keep_mine(level.exact);
+    keep_mine(level.far);
+    keep_mine(level.open);
   }
 
   /// Accepts, drops or splits the pair (r, s): links go to `out` (with the accepted far pairs,
@@ -800,12 +806,6 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // above the cut; it pushes down into its own subtrees, and the elements' irradiance is joined,
   // 12 bytes an element per gather. Every value is summed in one process's order.
   const SubtreeCut cut = group.count() > 1 ? cut_tree(tree, group.count()) : SubtreeCut{};
-  const auto shared_and_total = [&](const auto& items) {
-    if (group.count() == 1) return items.size();
-    const size_t shared = size_t(std::count_if(items.begin(), items.end(),
-                                               [&](const auto& x) { return cut.owner[x.receiver] < 0; }));
-    return shared + size_t(group.total(items.size() - shared));
-  };
 
   // Direct irradiance per element (mean of its vertices) and the first reflected radiosity.
   std::vector<Rgb> direct(ne), radiosity(ne);
@@ -1037,7 +1037,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       if (i == 0 || links[i].receiver != links[i - 1].receiver)
         receivers.push_back(links[i].receiver), first_link.push_back(i);
     first_link.push_back(uint32_t(links.size()));
-    result.links = shared_and_total(links);
+    result.links = count_as_one_process(links, cut.owner);
     result.link_tolerance = ladder[level];
     result.link_rays = counters.rays;
     const auto iterate_start = std::chrono::steady_clock::now();

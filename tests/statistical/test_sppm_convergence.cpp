@@ -38,6 +38,22 @@ rc::RenderSettings settings(int spp, uint64_t seed) {
   return s;
 }
 
+/// A closed icosphere of radius 1 (1,280 facets, facing in), diffuse 0.5, lit by a point light
+/// of intensity 1 at `lamp`; not yet committed, so that a test can add to it.
+rc::Scene lit_sphere_room(const rc::Vec3& lamp_position) {
+  rc::Scene scene;
+  scene.materials = {rc::Material::make_diffuse("wall", rc::Rgb(0.5f))};
+  rc::TriangleMesh sphere = gilt::test::icosphere(3);
+  for (size_t i = 0; i < sphere.indices.size(); i += 3) std::swap(sphere.indices[i + 1], sphere.indices[i + 2]);
+  scene.meshes.push_back(std::move(sphere));
+  rc::Light lamp;
+  lamp.kind = rc::LightKind::point;
+  lamp.position = lamp_position;
+  lamp.intensity = rc::Rgb(1.0f);
+  scene.punctual_lights.push_back(lamp);
+  return scene;
+}
+
 /// Image means over four independent seeds each: the path tracer at 256 spp (seeds path_seed +
 /// 0..3) and SPPM at `iterations` with 20,000 photons each and the initial radius `radius`
 /// (seeds sppm_seed + 0..3). Returns the two means and the standard error of their difference.
@@ -133,16 +149,7 @@ TEST(Sppm, ApproachesThePathTracedReference) {
 //   the BSDF is zero, with probability (β − sin β cos β) / π for cosine-distributed directions:
 //   about 3 % of the flux over the initial disk (β up to 41°), less as the radius shrinks.
 TEST(Sppm, KeepsThePhotonsOfACurvedSurface) {
-  rc::Scene scene;
-  scene.materials = {rc::Material::make_diffuse("wall", rc::Rgb(0.5f))};
-  rc::TriangleMesh sphere = gilt::test::icosphere(3);
-  for (size_t i = 0; i < sphere.indices.size(); i += 3) std::swap(sphere.indices[i + 1], sphere.indices[i + 2]);
-  scene.meshes.push_back(std::move(sphere));
-  rc::Light lamp;
-  lamp.kind = rc::LightKind::point;
-  lamp.position = rc::Vec3(0.0f);
-  lamp.intensity = rc::Rgb(1.0f);
-  scene.punctual_lights.push_back(lamp);
+  rc::Scene scene = lit_sphere_room(rc::Vec3(0.0f));
   scene.commit();
   rc::Camera camera;
   camera.look_from = rc::Vec3(0.0f, 0.0f, 0.5f);
@@ -165,21 +172,12 @@ TEST(Sppm, KeepsThePhotonsOfACurvedSurface) {
 // reciprocal is biased up by its relative variance (at 16 iterations, 16 probes, the image came
 // out 2 % bright).
 TEST(Sppm, DividesByTheSurfaceTheDiskHolds) {
-  rc::Scene scene;
-  scene.materials = {rc::Material::make_diffuse("wall", rc::Rgb(0.5f))};
-  rc::TriangleMesh room = gilt::test::icosphere(3);
-  for (size_t i = 0; i < room.indices.size(); i += 3) std::swap(room.indices[i + 1], room.indices[i + 2]);
-  scene.meshes.push_back(std::move(room));
+  rc::Scene scene = lit_sphere_room(rc::Vec3(0.0f, 0.6f, 0.0f));
   rc::TriangleMesh plank;
   const float w = 0.05f, l = 0.8f;
   plank.positions = {{-w, 0.0f, -l}, {-w, 0.0f, l}, {w, 0.0f, l}, {w, 0.0f, -l}};
   plank.indices = {0, 1, 2, 0, 2, 3};  // facing +y
   scene.meshes.push_back(std::move(plank));
-  rc::Light lamp;
-  lamp.kind = rc::LightKind::point;
-  lamp.position = rc::Vec3(0.0f, 0.6f, 0.0f);
-  lamp.intensity = rc::Rgb(1.0f);
-  scene.punctual_lights.push_back(lamp);
   scene.commit();
   rc::Camera camera;
   camera.look_from = rc::Vec3(0.0f, 0.3f, 0.0f);
