@@ -37,7 +37,7 @@ fuzzers=()
 for t in $targets; do fuzzers+=("fuzz_$t"); done
 cmake --build "$build_dir" -j "$jobs" --target "${fuzzers[@]}"
 
-# OpenMesh (the PLY reader) leaks a few bytes per file by design: see tests/lsan.supp.
+# Third-party leaks by design (OpenMesh, OpenImageIO): see tests/lsan.supp.
 export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 artifacts="$build_dir/fuzz-artifacts"
 mkdir -p "$artifacts"

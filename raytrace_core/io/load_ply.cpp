@@ -1,9 +1,12 @@
-// PLY meshes (ascii and binary) through OpenMesh, with one default diffuse material.
+// PLY meshes (ascii and binary), read by gilt's own strict parser, with one default diffuse
+// material.
 //
-// OpenMesh skips faces whose indices are out of range and reads "nan" in ascii files as garbage,
-// saying so only on its own error stream. So the header and body are walked here first, checking
-// that coordinates are finite and face indices name a vertex, with messages that give the line
-// (ascii) or the element (binary); then OpenMesh reads the mesh, its error stream captured.
+// OpenMesh's PLY reader was used before. It parses the header token by token, unlike the line by
+// line format, and loops on a stream it has failed: an `obj_info` line that holds "element vertex
+// 99999999999" made it allocate without end, and a value too many on an ascii line shifted every
+// later one. The body is already walked here to check it (coordinates finite, face indices naming
+// a vertex, with the line or element in the message), so the mesh is built from that same walk:
+// one parser decides what the file says.
 
 #include <algorithm>
 #include <array>
@@ -13,16 +16,11 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <iostream>
+#include <istream>
 #include <iterator>
-#include <map>
-#include <mutex>
-#include <sstream>
+#include <limits>
 #include <string>
 #include <vector>
-
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/loaders.h"
@@ -33,8 +31,6 @@ namespace gilt::raytrace_core {
 namespace fs = std::filesystem;
 
 namespace {
-
-using PlyMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
 
 /// The values of a PLY body one by one, ascii or binary, with where() naming the position.
 class PlyValues {
@@ -57,6 +53,13 @@ class PlyValues {
     } while (line.find_first_not_of(" \t\r") == std::string::npos);
     tokens_ = tokens_of(line);
     next_token_ = 0;
+  }
+
+  /// Ends an item: an ascii line must hold exactly the values its element declares.
+  void end_item() {
+    if (format_ == "ascii" && next_token_ != tokens_.size())
+      fail(std::to_string(tokens_.size()) + " values on the line, " + std::to_string(next_token_) +
+           " declared");
   }
 
   double next(const std::string& type) {
@@ -105,139 +108,114 @@ class PlyValues {
   size_t offset_ = 0;
 };
 
-/// Checks every vertex coordinate is finite and every face index names a vertex.
-void check_body(std::istream& in, const PlyHeader& header, const std::string& file) {
+/// What a PLY body holds for gilt: vertex positions (and normals, when the file has all three),
+/// and the faces fanned into triangles.
+struct PlyBody {
+  std::vector<Vec3> positions, normals;
+  std::vector<uint32_t> indices;
+  size_t faces_with_repeats = 0;  // faces that name a vertex twice: their degenerate fans dropped
+  bool colours = false;
+};
+
+/// Walks the body value by value: checks every coordinate is finite and every face index names a
+/// vertex (throwing InputError at the line or element), and keeps what the mesh needs.
+PlyBody read_body(std::istream& in, const PlyHeader& header, const std::string& file) {
   size_t vertex_count = 0;
-  for (const PlyElement& e : header.elements)
-    if (e.name == "vertex") vertex_count = e.count;
+  bool has_normals = false;
+  for (const PlyElement& e : header.elements) {
+    if (e.name != "vertex") continue;
+    vertex_count = e.count;
+    int normal_axes = 0;
+    for (const PlyProperty& p : e.properties)
+      normal_axes += p.count_type.empty() && (p.name == "nx" || p.name == "ny" || p.name == "nz");
+    has_normals = normal_axes == 3;
+  }
+  if (vertex_count > size_t(std::numeric_limits<uint32_t>::max()))
+    throw InputError(file + ": " + std::to_string(vertex_count) + " vertices: more than 32-bit indices reach");
+  PlyBody body;
   PlyValues values(in, header, file);
+  std::vector<uint32_t> loop;
   for (const PlyElement& element : header.elements) {
+    // An item without properties holds nothing to walk, however many the header declares.
+    if (element.properties.empty()) continue;
+    const bool vertex = element.name == "vertex", face = element.name == "face";
     for (size_t item = 0; item < element.count; ++item) {
       values.begin_item(element.name, item);
+      Vec3 position(0.0f), normal(0.0f);
       for (const PlyProperty& p : element.properties) {
         const bool is_list = !p.count_type.empty();
         const double length = is_list ? values.next(p.count_type) : 1.0;
         if (!(length >= 0.0 && length <= 1e6 && length == std::floor(length))) values.fail("bad list length");
-        const bool coordinate = element.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z");
-        const bool indices =
-            element.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+        const int axis = !vertex || is_list ? -1 : p.name == "x" ? 0 : p.name == "y" ? 1 : p.name == "z" ? 2 : -1;
+        const int normal_axis =
+            !vertex || is_list ? -1 : p.name == "nx" ? 0 : p.name == "ny" ? 1 : p.name == "nz" ? 2 : -1;
+        const bool indices = face && is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
         if (indices && length < 3) values.fail("a face needs at least 3 vertices");
+        if (indices) loop.clear();
         for (size_t j = 0; j < size_t(length); ++j) {
           const double v = values.next(p.type);
-          if (coordinate && !std::isfinite(float(v)))
-            values.fail("coordinate " + p.name + " is not a finite number");
-          if (indices && !(v >= 0.0 && v < double(vertex_count) && v == std::floor(v))) {
-            // Printed as the number it is: 2e62 does not fit a long long, and casting it is undefined.
-            char shown[32];
-            std::snprintf(shown, sizeof shown, "%.15g", v);
-            values.fail("face refers to vertex " + std::string(shown) + " of " + std::to_string(vertex_count));
+          if (axis >= 0) {
+            if (!std::isfinite(float(v))) values.fail("coordinate " + p.name + " is not a finite number");
+            position[axis] = float(v);
+          }
+          if (normal_axis >= 0) normal[normal_axis] = std::isfinite(float(v)) ? float(v) : 0.0f;
+          if (indices) {
+            if (!(v >= 0.0 && v < double(vertex_count) && v == std::floor(v))) {
+              // Printed as the number it is: 2e62 does not fit a long long, and casting it is undefined.
+              char shown[32];
+              std::snprintf(shown, sizeof shown, "%.15g", v);
+              values.fail("face refers to vertex " + std::string(shown) + " of " + std::to_string(vertex_count));
+            }
+            loop.push_back(uint32_t(v));
           }
         }
+        if (indices) {
+          // A fan triangle that names a vertex twice has no area: it is left out, the rest kept.
+          bool repeats = false;
+          for (size_t i = 1; i + 1 < loop.size(); ++i) {
+            const uint32_t a = loop[0], b = loop[i], c = loop[i + 1];
+            if (a == b || b == c || a == c) {
+              repeats = true;
+              continue;
+            }
+            body.indices.insert(body.indices.end(), {a, b, c});
+          }
+          body.faces_with_repeats += repeats;
+        }
+      }
+      values.end_item();
+      if (vertex) {
+        body.positions.push_back(position);
+        if (has_normals) body.normals.push_back(normal);
       }
     }
   }
+  return body;
 }
-
-/// Routes OpenMesh's global error stream into a string while alive (one reader at a time).
-class CaptureOpenMeshErrors {
- public:
-  CaptureOpenMeshErrors() : lock_(mutex()) {
-    ::omerr().connect(captured_);
-    to_cerr_ = ::omerr().disconnect(std::cerr);
-  }
-  ~CaptureOpenMeshErrors() {
-    ::omerr().flush();
-    ::omerr().disconnect(captured_);
-    if (to_cerr_) ::omerr().connect(std::cerr);
-  }
-  std::string text() {
-    ::omerr().flush();
-    return captured_.str();
-  }
-
- private:
-  static std::mutex& mutex() {
-    static std::mutex m;
-    return m;
-  }
-  std::lock_guard<std::mutex> lock_;
-  std::ostringstream captured_;
-  bool to_cerr_ = false;
-};
 
 }  // namespace
 
 void load_ply(const fs::path& path, Scene& scene) {
   const std::string file = path.string();
-  size_t declared_faces = 0, declared_vertices = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file + ": cannot open file");
+  const PlyHeader header = read_header(in, file);
+  PlyBody body = read_body(in, header, file);
   bool has_colours = false;
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(file + ": cannot open file");
-    const PlyHeader header = read_header(in, file);
-    check_body(in, header, file);
-    for (const PlyElement& e : header.elements) {
-      if (e.name == "face") declared_faces = e.count;
-      if (e.name == "vertex") declared_vertices = e.count;
-      for (const PlyProperty& p : e.properties)
-        has_colours = has_colours || (e.name == "vertex" && (p.name == "red" || p.name == "diffuse_red"));
-    }
-  }
-
-  PlyMesh om;
-  om.request_vertex_normals();
-  OpenMesh::IO::Options options = OpenMesh::IO::Options::VertexNormal;
-  {
-    CaptureOpenMeshErrors capture;
-    if (!OpenMesh::IO::read_mesh(om, file, options)) {
-      const std::string errors = capture.text();
-      const std::string first = errors.substr(0, errors.find('\n'));
-      throw InputError(file + ": cannot read PLY file" + (first.empty() ? "" : " (" + first + ")"));
-    }
-  }
-  // Indices were checked above, so the faces OpenMesh could not add repeat a vertex. (It keeps
-  // non-manifold faces, giving them copies of their vertices.)
-  if (om.n_faces() < declared_faces)
-    scene.warnings.push_back(file + ": " + std::to_string(declared_faces - om.n_faces()) +
-                             " face(s) with a repeated vertex dropped");
+  for (const PlyElement& e : header.elements)
+    for (const PlyProperty& p : e.properties)
+      has_colours = has_colours || (e.name == "vertex" && (p.name == "red" || p.name == "diffuse_red"));
+  if (body.faces_with_repeats > 0)
+    scene.warnings.push_back(file + ": " + std::to_string(body.faces_with_repeats) +
+                             " face(s) name a vertex twice: their triangles without area dropped");
 
   TriangleMesh mesh;
   mesh.name = path.stem().string();
   mesh.origin.file = int32_t(scene.model_files.size());
   scene.model_files.push_back(file);
-  mesh.positions.reserve(om.n_vertices());
-  for (const auto& v : om.vertices()) {
-    const auto& p = om.point(v);
-    mesh.positions.emplace_back(p[0], p[1], p[2]);
-  }
-  // OpenMesh reads the file's vertices in order and appends the copies it makes for non-manifold
-  // faces; each copy is traced back to the file's vertex at the same position.
-  if (mesh.positions.size() > declared_vertices) {
-    std::map<std::array<float, 3>, uint32_t> file_vertex;
-    for (uint32_t v = 0; v < declared_vertices && v < mesh.positions.size(); ++v)
-      file_vertex.try_emplace({mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z}, v);
-    mesh.origin.vertex.resize(mesh.positions.size());
-    for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
-      if (v < declared_vertices) {
-        mesh.origin.vertex[v] = v;
-        continue;
-      }
-      const auto it = file_vertex.find({mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z});
-      mesh.origin.vertex[v] = it != file_vertex.end() ? it->second : 0;  // a copy always has an original
-    }
-  }
-  if (options.check(OpenMesh::IO::Options::VertexNormal))
-    for (const auto& v : om.vertices()) {
-      const auto& n = om.normal(v);
-      mesh.normals.emplace_back(n[0], n[1], n[2]);  // copies of non-manifold vertices read 0: ng is used
-    }
-  for (const auto& f : om.faces()) {
-    std::vector<uint32_t> loop;
-    for (const auto& v : om.fv_range(f)) loop.push_back(static_cast<uint32_t>(v.idx()));
-    for (size_t i = 1; i + 1 < loop.size(); ++i)
-      mesh.indices.insert(mesh.indices.end(), {loop[0], loop[i], loop[i + 1]});
-  }
-
+  mesh.positions = std::move(body.positions);
+  mesh.normals = std::move(body.normals);  // a zero normal (or none) makes the geometric one used
+  mesh.indices = std::move(body.indices);
   mesh.material = static_cast<uint32_t>(scene.materials.size());
   scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
   std::string note = file + ": a PLY holds geometry only: diffuse albedo 0.8, no lights";

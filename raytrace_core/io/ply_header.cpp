@@ -6,6 +6,7 @@
 #include <cctype>
 #include <charconv>
 #include <sstream>
+#include <system_error>
 
 #include "raytrace_core/error.h"
 
@@ -59,9 +60,13 @@ PlyHeader read_header(std::istream& in, const std::string& file) {
       header.format = t[1];
     } else if (t[0] == "element") {
       size_t count = 0;
-      if (t.size() != 3 || !is_identifier(t[1]) ||
-          std::from_chars(t[2].data(), t[2].data() + t[2].size(), count).ptr != t[2].data() + t[2].size())
-        fail("malformed 'element' line");
+      if (t.size() != 3 || !is_identifier(t[1])) fail("malformed 'element' line");
+      const auto [end, error] = std::from_chars(t[2].data(), t[2].data() + t[2].size(), count);
+      if (error != std::errc() || end != t[2].data() + t[2].size())
+        fail("malformed 'element' line (the count must be a whole number below 2^64)");
+      if (std::any_of(header.elements.begin(), header.elements.end(),
+                      [&](const PlyElement& e) { return e.name == t[1]; }))
+        fail("element '" + t[1] + "' declared twice");
       header.elements.push_back({t[1], count, {}});
     } else if (t[0] == "property") {
       if (header.elements.empty()) fail("'property' before any 'element'");
@@ -78,7 +83,7 @@ PlyHeader read_header(std::istream& in, const std::string& file) {
   }
   if (in.eof()) throw InputError(file + ": the header has no 'end_header'");
   if (header.format.empty()) fail("no 'format' line in the header");
-  // OpenMesh needs vertices with x, y, z, and faces (if any) with a list of vertex indices.
+  // A mesh needs vertices with x, y, z, and faces (if any) with a list of vertex indices.
   const auto has = [](const PlyElement& e, std::initializer_list<const char*> names, bool list) {
     return std::any_of(e.properties.begin(), e.properties.end(), [&](const PlyProperty& p) {
       return (p.count_type.empty() != list) && std::find(names.begin(), names.end(), p.name) != names.end();

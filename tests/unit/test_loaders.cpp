@@ -698,6 +698,53 @@ TEST_F(Loaders, PlyBadInput) {
   EXPECT_CONTAINS(error_of([&] { load_scene(binary_path); }), "bad_binary.ply");
 }
 
+// Inputs found by fuzzing, each of which once made the reader run out of memory or time (OpenMesh's
+// token-by-token header parse looped on a failed stream), or read values off by one.
+TEST_F(Loaders, PlyHeadersThatOnceExhaustedTheReader) {
+  const std::string vertices =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string ascii_body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  // An obj_info line is skipped whole, whatever it holds: one triangle.
+  const std::string info =
+      write("info.ply", "ply\nformat ascii 1.0\nobj_info element vertex 99999999999\n" + vertices + ascii_body);
+  EXPECT_EQ(load_scene(info).triangle_count(), 1u);
+  // An element without properties holds nothing, however many items it declares.
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + vertices;
+  binary.insert(binary.find("end_header"), "element junk 1000000000000000000\n");
+  const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const int32_t face[3] = {0, 1, 2};
+  binary.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  binary += char(3);
+  binary.append(reinterpret_cast<const char*>(face), sizeof face);
+  EXPECT_EQ(load_scene(write("empty_elements.ply", binary)).triangle_count(), 1u);
+  // An element declared twice is refused: which count would hold?
+  const std::string twice = write("twice.ply", "ply\nformat ascii 1.0\nelement vertex 1000000000\n" + vertices +
+                                                   ascii_body);
+  EXPECT_CONTAINS(error_of([&] { load_scene(twice); }), "twice.ply:4: element 'vertex' declared twice");
+  // A count past 2^64 is malformed, not read as 0.
+  std::string text = "ply\nformat ascii 1.0\n" + vertices + ascii_body;
+  text.replace(text.find("face 1"), 6, "face 055555555555555555555555555555");
+  const std::string huge = write("huge.ply", text);
+  EXPECT_CONTAINS(error_of([&] { load_scene(huge); }), "huge.ply:7: malformed 'element' line");
+  // A value too many on an ascii line would shift every later value: refused at its line.
+  const std::string extra =
+      write("extra.ply", "ply\nformat ascii 1.0\n" + vertices + "0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_CONTAINS(error_of([&] { load_scene(extra); }), "extra.ply:10: vertex 0: 4 values on the line, 3 declared");
+}
+
+// A face that names a vertex twice loses only its fan triangles without area.
+TEST_F(Loaders, PlyFaceWithARepeatedVertexKeepsItsRealTriangles) {
+  const std::string ply = write("repeat.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                                              "property float y\nproperty float z\nelement face 2\n"
+                                              "property list uchar int vertex_indices\nend_header\n"
+                                              "0 0 0\n1 0 0\n1 1 0\n0 1 0\n5 0 1 1 2 3\n3 0 0 1\n");
+  const Scene scene = load_scene(ply);
+  EXPECT_EQ(scene.meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+  EXPECT_TRUE(has_warning(scene, "2 face(s) name a vertex twice"));
+  EXPECT_TRUE(scene.meshes[0].normals.empty());  // the file has none
+}
+
 // ---------------------------------------------------------------- JSON
 
 TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
