@@ -102,7 +102,7 @@ inline std::vector<BadFile> bad_files() {
       {"truncated_body.ply", ply.substr(0, ply.find("3 0 1 2")), "ends early", true},
       {"face_index.ply", replaced(ply, "3 0 2 3", "3 0 2 99"), "vertex 99", true},
       {"negative_count.ply", replaced(ply, "element vertex 4", "element vertex -1"), "element"},
-      {"huge_count.ply", replaced(ply, "element vertex 4", "element vertex 4000000000"), "ends early", true},
+      {"huge_count.ply", replaced(ply, "element vertex 4", "element vertex 4000000000"), "values on the line", true},
       {"nan.ply", replaced(ply, "1 1 0\n", "nan 1 0\n"), "not a finite number", true},
       {"list_count.ply", replaced(ply, "3 0 2 3", "255 0 2 3"), "too few values"},
       {"ascii_as_binary.ply", replaced(ply, "format ascii 1.0", "format binary_big_endian 1.0"),
