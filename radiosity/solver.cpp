@@ -414,7 +414,8 @@ struct ShootingPatch {
       radiosity[k] = unshot[source[k]];
       unshot[source[k]] = Rgb(0.0f);
       for (int c = 0; c < 3; ++c) channels[c][k] = radiosity[k][c];
-      channels[3][k] = radiosity[k].average();
+      // The weights that sample visibility: an overshooting patch may send negative light.
+      channels[3][k] = std::abs(radiosity[k].average());
       const auto& el = mesh.elements[source[k]];
       triangles[k] = SourceTriangle(mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]]);
       for (uint32_t v : el) box.extend(mesh.positions[v]);
@@ -810,6 +811,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
 
     const Patches patches = build_patches(mesh, settings.patch_elements);
     sol.patches = patches.count();
+    double total_area = 0.0;
+    for (size_t e = 0; e < ne; ++e) total_area += mesh.element_area[e];
     // Each patch's form factors at every vertex, kept from its first shot for its later ones
     // while they fit in kFactorCacheBytes: they depend on the geometry alone, and a patch
     // shoots several times (about four on cornell), so its later shots trace only visibility.
@@ -822,14 +825,14 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     ShootingPatch source;
     double last_shot = 0.0;  // seconds
     while (emitted_power > 0.0) {
-      // The patch with the most unshot power.
+      // The patch with the most unshot power, of either sign (see the overshoot below).
       size_t src = 0;
-      double best = -1.0, unshot_power = 0.0;
+      double best = -1.0, best_signed = 0.0, unshot_power = 0.0;
       for (size_t q = 0; q < patches.count(); ++q) {
         double p = 0.0;
         for (uint32_t e : patches.of(q)) p += double(unshot[e].average()) * mesh.element_area[e];
-        unshot_power += p;
-        if (p > best) best = p, src = q;
+        unshot_power += std::abs(p);
+        if (std::abs(p) > best) best = std::abs(p), best_signed = p, src = q;
       }
       sol.residual = unshot_power / emitted_power;
       const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
@@ -841,7 +844,25 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
 
       // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
       // without bias, and the noise averages out over the many shots that reach each vertex.
-      source.assign(mesh, patches.of(src), unshot);
+      // Overshooting (Feda & Purgathofer 1992): a patch with light to send also sends now what it
+      // will receive later, estimated as its reflectance times the mean unshot radiosity of the
+      // rest of the scene, and keeps that amount as negative unshot light, which a later shot of
+      // its own corrects. A patch whose unshot light is negative sends it as it is.
+      const std::span<const uint32_t> shooting = patches.of(src);
+      Rgb overshoot(0.0f);
+      if (best_signed > 0.0) {
+        Rgb own(0.0f), all(0.0f);
+        double own_area = 0.0;
+        for (uint32_t e : shooting) own += unshot[e] * mesh.element_area[e], own_area += mesh.element_area[e];
+        for (size_t e = 0; e < ne; ++e) all += unshot[e] * mesh.element_area[e];
+        if (total_area - own_area > 0.0) {
+          const Rgb rest = (all - own) * float(1.0 / (total_area - own_area));
+          overshoot = Rgb(std::max(rest.r, 0.0f), std::max(rest.g, 0.0f), std::max(rest.b, 0.0f));
+        }
+      }
+      for (uint32_t e : shooting) unshot[e] += element_rho[e] * overshoot;
+      source.assign(mesh, shooting, unshot);
+      for (uint32_t e : shooting) unshot[e] = element_rho[e] * overshoot * -1.0f;
       source.emitter = false;
       source.probe = std::min(settings.reflected_visibility_probe, strata);
       source.strata = source.probe;
@@ -874,6 +895,9 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
       last_shot = elapsed() - shot_start;
     }
     progress.finish();
+    // An overshoot and the negative shot that corrects it see their own visibility rays, so where
+    // they disagree a dim vertex can be left below zero, which no irradiance is: held at zero.
+    for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
 
     {
       Rgb unshot_sum(0.0f), reflectance_sum(0.0f);
