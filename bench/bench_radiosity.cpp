@@ -19,8 +19,11 @@
 // --reference-spp=N (default 32768) for the references' samples per pixel, --fresh-reference to
 // render them again, --repeats=N (default 3) timed runs of each sweep point, of which the median
 // time is reported, --subdivision-levels=N to override the solver's adaptive subdivision (0:
-// none), --solver=progressive|hierarchical for the sweep (default: auto). The sweep also writes radiosity_error_<elements>.png: per-pixel relative error against
-// the centre reference, 10 % white. Google Benchmark flags apply to the form-factor part. Every part checks its
+// none), --solver=progressive|hierarchical for the sweep (default: auto), --view=mesh|two-pass for
+// how the sweep shows each solution (default mesh, the exported vertex colours; two-pass is what
+// `gilt render --method radiosity` shows, its centre render timed at --view-spp=N samples, default
+// 16). The sweep also writes radiosity_error_<elements>.png (radiosity_two_pass_error_…): per-pixel
+// relative error against the centre reference, 10 % white. Google Benchmark flags apply to the form-factor part. Every part checks its
 // results before it reports a time, and stops with a message when they are wrong.
 
 #include <benchmark/benchmark.h>
@@ -212,6 +215,12 @@ double median(std::vector<double> values) {
 int g_subdivision_levels = rad::SolverSettings{}.subdivision_levels;
 rad::SolverKind g_solver = rad::SolverKind::automatic;
 
+/// How the sweep shows each solution (--view=mesh|two-pass). The mesh view is exact at a pixel
+/// centre with one sample; the two-pass view takes the direct light per sample by shadow rays, so
+/// its centre render needs g_view_spp samples (--view-spp=N) and their time is counted.
+rad::ViewMode g_view = rad::ViewMode::mesh;
+int g_view_spp = 16;
+
 rad::SolverSettings solver_settings(int elements) {
   rad::SolverSettings s;
   s.subdivision_levels = g_subdivision_levels;
@@ -299,8 +308,9 @@ void report_time_to_target(const std::vector<SweepPoint>& points, Measure m, dou
 
 void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
   const rc::Scene scene = rc::load_scene("cornell");
-  std::printf("\n== Error against time on cornell, %d x %d: solver tolerance %g ==\n", kImageSize, kImageSize,
-              kTolerance);
+  const bool two_pass = g_view == rad::ViewMode::two_pass;
+  std::printf("\n== Error against time on cornell, %d x %d: solver tolerance %g, %s view ==\n", kImageSize,
+              kImageSize, kTolerance, two_pass ? "two-pass" : "mesh");
   const Reference refs[2] = {make_reference(scene, Pixels::filtered, half_spp, out_dir, fresh_reference),
                              make_reference(scene, Pixels::centres, half_spp, out_dir, fresh_reference)};
 
@@ -314,16 +324,26 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
   std::printf(
       "display noise of a %d-spp filtered radiosity render: %.3f %% (1000 elements, against %d spp)\n",
       kRadiositySpp, 100 * display_noise, kDisplaySpp);
-  std::printf(
-      "\n  time = solve (meshing included) + view + %d-spp render. 16-spp: that render against the\n"
-      "  filtered reference. centre: the same solution rendered through pixel centres (1 spp, exact)\n"
-      "  against the pixel-centre reference. less noise: sqrt(centre^2 - reference noise^2), an estimate\n"
-      "  of the centre error against an exact reference.\n",
-      kRadiositySpp);
+  if (two_pass)
+    std::printf(
+        "\n  time = solve (two-pass settings: no adaptive subdivision) + view + a %d-spp render through\n"
+        "  the pixel centres, whose direct light is sampled per pixel. centre: that render against the\n"
+        "  pixel-centre reference; it holds the render's own noise. filtered: a %d-spp render with the\n"
+        "  pixel filter (untimed) against the filtered reference. less noise: sqrt(centre^2 - reference\n"
+        "  noise^2).\n",
+        g_view_spp, g_view_spp);
+  else
+    std::printf(
+        "\n  time = solve (meshing included) + view + %d-spp render. 16-spp: that render against the\n"
+        "  filtered reference. centre: the same solution rendered through pixel centres (1 spp, exact)\n"
+        "  against the pixel-centre reference. less noise: sqrt(centre^2 - reference noise^2), an estimate\n"
+        "  of the centre error against an exact reference.\n",
+        kRadiositySpp);
 
   std::vector<SweepPoint> points;
   std::printf("\n  %9s %8s %8s %7s %9s %8s %8s %8s %9s %9s %12s\n", "requested", "elements", "vertices",
-              "shots", "residual", "solve s", "render s", "total s", "16-spp %", "centre %", "less noise %");
+              "shots", "residual", "solve s", "render s", "total s", two_pass ? "filtered %" : "16-spp %", "centre %",
+              "less noise %");
   for (int requested : kSweepElements) {
     if (!points.empty()) {
       // Progressive refinement costs shots × vertices, both about proportional to the elements:
@@ -344,15 +364,18 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
     std::vector<double> solve_times, render_times;
     std::optional<rad::Solution> sol;
     std::optional<rad::RadiosityView> view;
-    std::vector<rc::Rgb> image;
+    std::vector<rc::Rgb> image, centres;
     for (int r = 0; r < g_repeats; ++r) {
       view.reset();
       const auto start = std::chrono::steady_clock::now();
-      sol = rad::solve(scene, solver_settings(requested));
+      sol = rad::solve(scene, rad::solver_settings_for(g_view, solver_settings(requested)));
       solve_times.push_back(seconds_since(start));
       const auto render_start = std::chrono::steady_clock::now();
-      view.emplace(scene, *sol, rad::ViewMode::mesh);
-      image = radiosity_render(scene, *view, Pixels::filtered, kRadiositySpp);
+      view.emplace(scene, *sol, g_view);
+      if (two_pass)
+        centres = radiosity_render(scene, *view, Pixels::centres, g_view_spp);
+      else
+        image = radiosity_render(scene, *view, Pixels::filtered, kRadiositySpp);
       render_times.push_back(seconds_since(render_start));
     }
     p.solve_seconds = median(solve_times);
@@ -365,10 +388,17 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
     p.form_factors = sol->form_factors;
     p.shadow_rays = sol->shadow_rays;
     p.residual = sol->residual;
+    // The timed render is the one the view needs to be measured: the mesh view's 16-spp display
+    // (its centre render is exact at one sample), the two-pass view's centre render.
+    if (two_pass)
+      image = radiosity_render(scene, *view, Pixels::filtered, g_view_spp);
+    else
+      centres = radiosity_render(scene, *view, Pixels::centres, 1);
     p.error[kFiltered] = rc::mean_relative_error(image, refs[int(Pixels::filtered)].image);
-    const std::vector<rc::Rgb> centres = radiosity_render(scene, *view, Pixels::centres, 1);
     p.error[kCentres] = rc::mean_relative_error(centres, refs[int(Pixels::centres)].image);
-    write_error_image(out_dir / ("radiosity_error_" + std::to_string(requested) + ".png"), centres,
+    write_error_image(out_dir / (std::string(two_pass ? "radiosity_two_pass_error_" : "radiosity_error_") +
+                                 std::to_string(requested) + ".png"),
+                      centres,
                       refs[int(Pixels::centres)].image);
     const double noise = refs[int(Pixels::centres)].noise;
     p.error[kDenoised] = std::sqrt(std::max(1e-12, p.error[kCentres] * p.error[kCentres] - noise * noise));
@@ -384,11 +414,12 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
       "  noise together), centre %.2f %% (reference noise)\n",
       100 * std::hypot(display_noise, refs[0].noise), 100 * display_noise, 100 * refs[0].noise,
       100 * refs[1].noise);
-  report_time_to_target(points, kFiltered, std::hypot(display_noise, refs[0].noise));
+  // The two-pass view's filtered render is not the timed one: only its centre figures have a time.
+  if (!two_pass) report_time_to_target(points, kFiltered, std::hypot(display_noise, refs[0].noise));
   report_time_to_target(points, kCentres, refs[1].noise);
   report_time_to_target(points, kDenoised, 0.0);
 
-  const fs::path csv = out_dir / "radiosity_sweep.csv";
+  const fs::path csv = out_dir / (two_pass ? "radiosity_sweep_two_pass.csv" : "radiosity_sweep.csv");
   std::ofstream out(csv);
   out << "requested_elements,elements,vertices,shots,form_factors,shadow_rays,residual,solve_seconds,"
          "render_seconds,seconds,error_16spp,error_centres,error_centres_less_noise,reference_spp,"
@@ -676,6 +707,12 @@ int main(int argc, char** argv) {
       g_solver = rad::SolverKind::progressive;
     else if (arg == "--solver=hierarchical")
       g_solver = rad::SolverKind::hierarchical;
+    else if (arg == "--view=two-pass")
+      g_view = rad::ViewMode::two_pass;
+    else if (arg == "--view=mesh")
+      g_view = rad::ViewMode::mesh;
+    else if (arg.starts_with("--view-spp="))
+      g_view_spp = std::max(1, std::atoi(argv[i] + 11));
     else if (arg.starts_with("--subdivision-levels="))
       g_subdivision_levels = std::max(0, std::atoi(argv[i] + 21));
     else if (arg.starts_with("--repeats="))
