@@ -60,22 +60,32 @@ std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t first, uint64_t c
 float epanechnikov(float d2, float r2) { return 2.0f * rc::kInvPi / r2 * std::max(0.0f, 1.0f - d2 / r2); }
 
 /// Runs the k-nearest query and calls f(photon, kernel weight) for each photon that agrees with
-/// the query's normal.
+/// the query's normal. Returns the squared radius of the disk (0 when nothing was found).
 template <class F>
-void for_each_estimate_photon(const PhotonMap& map, const EstimateQuery& q, EstimateScratch& scratch, F&& f) {
-  if (map.empty() || q.k == 0 || !(q.max_radius2 > 0.0f)) return;
+float for_each_estimate_photon(const PhotonMap& map, const EstimateQuery& q, EstimateScratch& scratch, F&& f) {
+  if (map.empty() || q.k == 0 || !(q.max_radius2 > 0.0f)) return 0.0f;
   if (scratch.neighbours.size() < q.k) scratch.neighbours.resize(q.k);
   const size_t found = map.index.knn(q.position, q.k, q.max_radius2, scratch.neighbours.data());
-  if (found == 0) return;
+  if (found == 0) return 0.0f;
   // The disk reaches the k-th photon; with fewer found, it is the whole search radius.
   const float r2 = found == q.k ? scratch.neighbours[found - 1].distance2 : q.max_radius2;
-  if (!(r2 > 0.0f)) return;
+  if (!(r2 > 0.0f)) return 0.0f;
   for (size_t i = 0; i < found; ++i) {
     const Photon& p = map.photons[scratch.neighbours[i].index];
     if (glm::dot(decode_direction(p.normal), q.normal) < kNormalAgreement) continue;
     const float w = epanechnikov(scratch.neighbours[i].distance2, r2);
     if (w > 0.0f) f(p, w);
   }
+  return r2;
+}
+
+/// What an estimate over the disk of squared radius r2 is divided by: its coverage, held at 0.1
+/// and above (as SPPM holds its own), or 1 where it is unknown (a sphere in the ball) or where
+/// nothing was found.
+float coverage_divisor(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& q, float r2) {
+  if (!(r2 > 0.0f)) return 1.0f;
+  const double c = disk_coverage(scene, map.sides, q.position, q.normal, r2, kNormalAgreement);
+  return c < 0.0 ? 1.0f : float(std::max(c, 0.1));
 }
 
 }  // namespace
@@ -157,11 +167,14 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
   return maps;
 }
 
-rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, const rc::Material& material,
-                          const rc::Frame& shading, const rc::Vec3& wo_local, EstimateScratch& scratch) {
+namespace {
+
+rc::Rgb radiance_estimate(const rc::Scene* scene, const PhotonMap& map, const EstimateQuery& query,
+                          const rc::Material& material, const rc::Frame& shading, const rc::Vec3& wo_local,
+                          EstimateScratch& scratch) {
   rc::Rgb sum(0.0f);
   const bool lambertian = material.kind == rc::MaterialKind::diffuse;
-  for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) {
+  const float r2 = for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) {
     if (lambertian) {
       sum += p.power * w;
     } else {
@@ -169,14 +182,39 @@ rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, cons
       sum += rc::bsdf_eval(material, wo_local, wi) * p.power * w;
     }
   });
+  if (scene && !sum.is_black()) sum = sum / coverage_divisor(*scene, map, query, r2);
   // Lambertian: f = ρ/π for every photon, taken out of the sum.
   return lambertian ? material.albedo * sum * rc::kInvPi : sum;
 }
 
-rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, EstimateScratch& scratch) {
+rc::Rgb irradiance_estimate(const rc::Scene* scene, const PhotonMap& map, const EstimateQuery& query,
+                            EstimateScratch& scratch) {
   rc::Rgb sum(0.0f);
-  for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) { sum += p.power * w; });
+  const float r2 = for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) { sum += p.power * w; });
+  if (scene && !sum.is_black()) sum = sum / coverage_divisor(*scene, map, query, r2);
   return sum;
+}
+
+}  // namespace
+
+rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, const rc::Material& material,
+                          const rc::Frame& shading, const rc::Vec3& wo_local, EstimateScratch& scratch) {
+  return radiance_estimate(nullptr, map, query, material, shading, wo_local, scratch);
+}
+
+rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, EstimateScratch& scratch) {
+  return irradiance_estimate(nullptr, map, query, scratch);
+}
+
+rc::Rgb estimate_radiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+                          const rc::Material& material, const rc::Frame& shading, const rc::Vec3& wo_local,
+                          EstimateScratch& scratch) {
+  return radiance_estimate(&scene, map, query, material, shading, wo_local, scratch);
+}
+
+rc::Rgb estimate_irradiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+                            EstimateScratch& scratch) {
+  return irradiance_estimate(&scene, map, query, scratch);
 }
 
 }  // namespace gilt::photonmap

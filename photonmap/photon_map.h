@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "photonmap/coverage.h"
 #include "photonmap/photon.h"
 #include "photonmap/photon_index.h"
 #include "raytrace_core/material.h"
@@ -38,6 +39,9 @@ struct PhotonMap {
   std::vector<Photon> photons;
   uint64_t emitted = 0;  ///< photon paths emitted for this map
   PhotonIndex index;
+  /// The triangle sides the photons were stored on, for the estimates with coverage. The photon
+  /// passes do not fill it yet (bench/README.md, "The photon method's biases").
+  SurfaceSides sides;
 
   bool empty() const { return photons.empty(); }
   /// Builds `index` over the photon positions.
@@ -88,9 +92,19 @@ rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, cons
 /// Irradiance (W·m⁻²) at the query from the same photons, with the same kernel.
 rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, EstimateScratch& scratch);
 
+/// The same two estimates divided by the share of their disk that the map's photon-holding
+/// surface covers (disk_coverage, held at 0.1 and above), which takes away their darkening at
+/// edges, in corners and on thin parts. `scene` is the one the map was traced in.
+rc::Rgb estimate_radiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+                          const rc::Material& material, const rc::Frame& shading, const rc::Vec3& wo_local,
+                          EstimateScratch& scratch);
+rc::Rgb estimate_irradiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+                            EstimateScratch& scratch);
+
 /// The photon-tracing loop, shared by the two-pass mapper and SPPM: follows a photon path from
 /// an emitted ray, calling store(photon, depth, specular_only) at every diffuse or glossy hit
-/// (depth 0 = straight from the light; specular_only = only mirror and glass bounces before),
+/// (depth 0 = straight from the light; specular_only = only mirror and glass bounces before;
+/// store may take the hit as a fourth argument),
 /// which returns false to end the path. Russian roulette by the bounce's albedo keeps the power
 /// of surviving photons steady. Returns the number of rays traced.
 template <class Store>

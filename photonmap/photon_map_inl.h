@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "raytrace_core/bsdf.h"
 
@@ -29,7 +30,12 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
       p.power = power;
       p.direction = encode_direction(wo_world);
       p.normal = encode_direction(glm::dot(si.ng, wo_world) >= 0.0f ? si.ng : -si.ng);
-      if (!store(p, depth, specular_only)) break;
+      bool go_on;
+      if constexpr (std::is_invocable_v<Store, const Photon&, int, bool, const rc::Hit&>)
+        go_on = store(p, depth, specular_only, *hit);
+      else
+        go_on = store(p, depth, specular_only);
+      if (!go_on) break;
     }
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     const rc::Vec3 wo = frame.to_local(wo_world);

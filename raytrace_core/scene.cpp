@@ -469,6 +469,37 @@ std::optional<Hit> Scene::nearest_triangle(uint32_t geom_id, const Vec3& p, floa
   return q.best;
 }
 
+namespace {
+
+/// State of one for_each_triangle_near query, handed to Embree's point-query callback.
+struct NearQuery {
+  const std::function<void(uint32_t, uint32_t)>* f;
+  uint32_t mesh_count;
+};
+
+bool near_triangle_callback(RTCPointQueryFunctionArguments* args) {
+  const auto* q = static_cast<const NearQuery*>(args->userPtr);
+  if (args->geomID < q->mesh_count) (*q->f)(args->geomID, args->primID);
+  return false;  // the radius stays
+}
+
+}  // namespace
+
+void Scene::for_each_triangle_near(const Vec3& p, float radius,
+                                   const std::function<void(uint32_t geom_id, uint32_t prim_id)>& f) const {
+  if (!(radius > 0.0f) || !std::isfinite(radius)) return;
+  NearQuery q{&f, static_cast<uint32_t>(meshes.size())};
+  RTCPointQuery query;
+  query.x = p.x;
+  query.y = p.y;
+  query.z = p.z;
+  query.time = 0.0f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(impl_->scene, &query, &context, near_triangle_callback, &q);
+}
+
 bool Scene::occluded(const Ray& ray) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

@@ -7,6 +7,7 @@
 // thread-safe after commit().
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -134,6 +135,11 @@ class Scene {
   /// the Hit's t and (u, v) its barycentrics. Ties go to the lower triangle index.
   std::optional<Hit> nearest_triangle(uint32_t geom_id, const Vec3& p, float radius, const Vec3& n,
                                       float min_cosine) const;
+  /// Calls f(geom_id, prim_id) for every triangle whose bounding box reaches within `radius`
+  /// of p (a superset of the triangles that do: the caller tests the triangle itself), in no set
+  /// order.
+  void for_each_triangle_near(const Vec3& p, float radius,
+                              const std::function<void(uint32_t geom_id, uint32_t prim_id)>& f) const;
 
   /// All lights: one per emissive triangle and sphere, then the punctual lights.
   const std::vector<Light>& lights() const { return lights_; }

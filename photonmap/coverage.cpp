@@ -1,0 +1,106 @@
+#include "photonmap/coverage.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+
+namespace gilt::photonmap {
+namespace {
+
+/// ∫ (ρ² − s²) dA over the part within distance ρ of the origin of the triangle (origin, u1, u2)
+/// in the plane, s the distance to the origin, signed by the triangle's orientation. In polar
+/// coordinates about the origin the edge u1u2 lies at R(α) = d / cos α, α measured from the foot
+/// of the perpendicular of length d, and ∫₀^m (ρ² − s²) s ds = ρ² m² / 2 − m⁴ / 4 with m = min(R, ρ):
+/// a constant ρ⁴ / 4 where the edge lies outside the disk, and with R inside it an integral of
+/// sec² α and sec⁴ α, whose antiderivatives are tan α and tan α + tan³ α / 3.
+double edge_wedge(glm::dvec2 u1, glm::dvec2 u2, double rho2) {
+  const glm::dvec2 e = u2 - u1;
+  const double length = glm::length(e);
+  const double cross = u1.x * u2.y - u1.y * u2.x;
+  if (!(length > 0.0) || cross == 0.0) return 0.0;
+  const glm::dvec2 along = e / length;
+  const double d = std::fabs(cross) / length;
+  const double x1 = glm::dot(u1, along), x2 = glm::dot(u2, along);  // x1 < x2
+  const double a1 = std::atan(x1 / d), a2 = std::atan(x2 / d);
+  double sum = 0.0, chord_angle = 0.0;
+  if (d * d < rho2) {
+    const double w = std::sqrt(rho2 - d * d);  // half the chord the edge's line cuts from the disk
+    const double xa = std::max(x1, -w), xb = std::min(x2, w);
+    if (xa < xb) {
+      const double ta = xa / d, tb = xb / d;
+      chord_angle = std::atan(tb) - std::atan(ta);
+      sum += 0.5 * rho2 * d * d * (tb - ta) - 0.25 * d * d * d * d * ((tb - ta) + (tb * tb * tb - ta * ta * ta) / 3.0);
+    }
+  }
+  sum += 0.25 * rho2 * rho2 * std::max(0.0, (a2 - a1) - chord_angle);
+  return cross > 0.0 ? sum : -sum;
+}
+
+}  // namespace
+
+SurfaceSides::SurfaceSides(const rc::Scene& scene) {
+  first_.resize(scene.meshes.size());
+  uint64_t total = 0;
+  for (size_t g = 0; g < scene.meshes.size(); ++g) {
+    first_[g] = total;
+    total += scene.meshes[g].indices.size() / 3;
+  }
+  counts_.assign(2 * total, 0);
+}
+
+void SurfaceSides::add(const rc::Scene& scene, uint32_t geom_id, uint32_t prim_id, const rc::Vec3& normal) {
+  if (geom_id >= first_.size()) return;  // a sphere
+  const rc::TriangleMesh& mesh = scene.meshes[geom_id];
+  const uint32_t* idx = &mesh.indices[3 * size_t(prim_id)];
+  const rc::Vec3 &a = mesh.positions[idx[0]], &b = mesh.positions[idx[1]], &c = mesh.positions[idx[2]];
+  const bool front = glm::dot(glm::cross(b - a, c - a), normal) >= 0.0f;
+  std::atomic_ref<uint64_t>(counts_[2 * (first_[geom_id] + prim_id) + (front ? 0 : 1)])
+      .fetch_add(1, std::memory_order_relaxed);
+}
+
+double kernel_integral(const rc::Vec3& a, const rc::Vec3& b, const rc::Vec3& c, const rc::Vec3& p, float r2) {
+  if (!(r2 > 0.0f)) return 0.0;
+  const glm::dvec3 da(a), db(b), dc(c), dp(p);
+  const glm::dvec3 normal = glm::cross(db - da, dc - da);
+  const double twice_area = glm::length(normal);
+  if (!(twice_area > 0.0)) return 0.0;
+  const glm::dvec3 n = normal / twice_area;
+  // The ball meets the triangle's plane in a disk of radius ρ about p's foot, where the kernel
+  // is (ρ² − s²) / r².
+  const double h = glm::dot(dp - da, n), rho2 = double(r2) - h * h;
+  if (!(rho2 > 0.0)) return 0.0;
+  const glm::dvec3 foot = dp - h * n;
+  const glm::dvec3 s = glm::normalize(db - da), t = glm::cross(n, s);
+  auto in_plane = [&](const glm::dvec3& x) { return glm::dvec2(glm::dot(x - foot, s), glm::dot(x - foot, t)); };
+  const glm::dvec2 u[3] = {in_plane(da), in_plane(db), in_plane(dc)};
+  const double sum = edge_wedge(u[0], u[1], rho2) + edge_wedge(u[1], u[2], rho2) + edge_wedge(u[2], u[0], rho2);
+  return std::fabs(sum) / double(r2);
+}
+
+double disk_coverage(const rc::Scene& scene, const SurfaceSides& sides, const rc::Vec3& p, const rc::Vec3& n,
+                     float r2, float min_cosine) {
+  if (sides.empty() || !(r2 > 0.0f)) return 0.0;
+  const float r = std::sqrt(r2);
+  for (const rc::Sphere& s : scene.spheres)
+    if (!scene.materials[s.material].is_traced_through() && std::fabs(glm::length(s.center - p) - s.radius) < r)
+      return -1.0;
+  double sum = 0.0;
+  scene.for_each_triangle_near(p, r, [&](uint32_t geom_id, uint32_t prim_id) {
+    const rc::TriangleMesh& mesh = scene.meshes[geom_id];
+    const uint32_t* idx = &mesh.indices[3 * size_t(prim_id)];
+    const rc::Vec3 &a = mesh.positions[idx[0]], &b = mesh.positions[idx[1]], &c = mesh.positions[idx[2]];
+    const rc::Vec3 cross = glm::cross(b - a, c - a);
+    const float length = glm::length(cross);
+    if (!(length > 0.0f)) return;
+    const float cosine = glm::dot(cross, n) / length;
+    // The side whose photons the estimate takes: the one facing along n, if it is turned close
+    // enough to n and holds photons.
+    const bool front = cosine >= 0.0f;
+    if (std::fabs(cosine) < min_cosine || !sides.holds(geom_id, prim_id, front)) return;
+    sum += kernel_integral(a, b, c, p, r2);
+  });
+  return sum * 2.0 / (rc::kPi * double(r2));
+}
+
+}  // namespace gilt::photonmap
