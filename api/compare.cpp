@@ -354,12 +354,12 @@ Report compare_methods(rc::Scene& scene, const CompareSettings& given,
   for (double budget : o.budgets) {
     for (const std::string& m : o.methods) {
       settings.time_limit = budget;
-      // Preparation scaled to the budget: fewer photons and elements when time is short.
+      // Preparation scaled to the budget: fewer photons when time is short (run_method sizes the
+      // radiosity mesh to the budget itself).
       MethodOptions mo;
       const double share = std::min(1.0, budget / 8.0);
       mo.photon.photons.global_photons = mo.photon.photons.caustic_photons =
           std::max<uint64_t>(20000, uint64_t(200000 * share));
-      mo.solver.mesh.elements = int(std::clamp(1000.0 * budget, 500.0, double(radiosity::kDefaultElements)));
       mo.solver.progress = false;
       const MethodResult result = run_method(scene, camera, m, settings, mo);
       const std::vector<rc::Rgb> pixels = result.film.pixels();

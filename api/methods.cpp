@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "radiosity/budget.h"
 #include "radiosity/view.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
@@ -82,9 +83,12 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
     solver.seed = settings.seed;
     solver.threads = settings.threads;
     solver.progress = settings.progress;
-    if (base.time_limit > 0.0) solver.time_limit = 0.7 * base.time_limit;
-    result.solution.emplace(radiosity::solve(scene, solver));
+    // Under a budget the solve has 70 % of it, and a mesh left to gilt is sized to fit it.
+    radiosity::BudgetFit fit;
+    result.solution.emplace(base.time_limit > 0.0 ? radiosity::solve_within(scene, solver, 0.7 * base.time_limit, &fit)
+                                                  : radiosity::solve(scene, solver));
     result.notes = result.solution->mesh_report.warnings;
+    if (!fit.note.empty()) result.notes.push_back(fit.note);
     view.emplace(scene, *result.solution, options.radiosity_view);
     radiance = [&view](const rc::Ray& ray, rc::SampleContext& ctx) { return view->radiance(ray, ctx); };
     if (base.time_limit > 0.0) settings.time_limit = remaining();

@@ -10,6 +10,7 @@
 
 #include "api/statistics.h"
 #include "cli/commands.h"
+#include "radiosity/budget.h"
 #include "radiosity/check.h"
 #include "radiosity/export.h"
 #include "radiosity/lightmap.h"
@@ -99,10 +100,15 @@ void run_radiosity(RadiosityOptions& o) {
                                   std::chrono::duration<double>(o.solver.time_limit));
     o.solver.time_limit = std::max(1e-3, o.bake_gather > 0 ? (1.0 - kBakeGatherShare) * left : left);
   }
-  const radiosity::Solution sol = radiosity::solve(scene, o.solver);
+  // Under a budget a mesh left to gilt is sized to fit it (radiosity/budget.h).
+  radiosity::BudgetFit budget_fit;
+  const radiosity::Solution sol = o.solver.time_limit > 0.0
+                                      ? radiosity::solve_within(scene, o.solver, o.solver.time_limit, &budget_fit)
+                                      : radiosity::solve(scene, o.solver);
   // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
   if (rc::processes().rank() > 0) return;
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
+  if (!budget_fit.note.empty() && !o.json) std::cerr << "gilt: " << budget_fit.note << "\n";
   const radiosity::VertexFit fit =
       o.fit == "point" ? radiosity::VertexFit::point : radiosity::VertexFit::least_squares;
   std::optional<radiosity::InputColours> onto;

@@ -21,6 +21,7 @@
 #include "api/compare.h"
 #include "api/methods.h"
 #include "api/statistics.h"
+#include "radiosity/budget.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
@@ -202,7 +203,10 @@ py::dict solve_radiosity(PyScene& s, std::optional<int> elements, std::optional<
   else throw rc::InputError("solver " + solver + ": expected auto, progressive or hierarchical");
   if (threads < 0) throw rc::InputError("threads: 0 (all) or more");
   settings.tolerance = tolerance, settings.seed = seed, settings.threads = threads, settings.progress = false;
-  const radiosity::Solution sol = run_interruptible([&] { return radiosity::solve(s.scene, settings); });
+  // Under a time budget a mesh left to gilt is sized to fit it, as in `gilt radiosity --time`.
+  const radiosity::Solution sol = run_interruptible([&] {
+    return time ? radiosity::solve_within(s.scene, settings, *time) : radiosity::solve(s.scene, settings);
+  });
 
   py::array_t<uint32_t> indices({py::ssize_t(sol.mesh.element_count()), py::ssize_t(3)});
   uint32_t* data = indices.mutable_data();

@@ -1,0 +1,96 @@
+// solve_within: a radiosity mesh sized to a time budget. What it chooses depends on the
+// machine's speed, so these tests check the model and which solves run, not times.
+
+#include <gtest/gtest.h>
+
+#include "radiosity/budget.h"
+#include "raytrace_core/io/scene_io.h"
+
+namespace rc = gilt::raytrace_core;
+namespace rad = gilt::radiosity;
+
+namespace {
+
+rad::SolverSettings quiet() {
+  rad::SolverSettings s;
+  s.progress = false;
+  s.subdivision_levels = 0;  // the element counts asked for are the counts meshed
+  return s;
+}
+
+}  // namespace
+
+// The cost model: n² from the pilot's point, capped, nothing without time or a pilot.
+TEST(RadiosityBudget, FittedCountGrowsAsTheSquareRootOfTheTime) {
+  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.4), 2000.0);
+  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.025), 500.0);
+  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 1e6), double(rad::kMaxFittedElements));
+  EXPECT_EQ(rad::fitted_elements(1000, 0.1, 0.0), 0.0);
+  EXPECT_EQ(rad::fitted_elements(1000, 0.1, -1.0), 0.0);
+  EXPECT_EQ(rad::fitted_elements(1000, 0.0, 1.0), 0.0);
+  EXPECT_EQ(rad::fitted_elements(0, 0.1, 1.0), 0.0);
+}
+
+// A mesh size the user set is kept: no pilot runs.
+TEST(RadiosityBudget, AMeshSizeTheUserSetIsKept) {
+  rc::Scene scene = rc::builtin_scene("cornell");
+  scene.commit();
+  rad::SolverSettings s = quiet();
+  s.mesh.elements = 600;
+  rad::BudgetFit fit;
+  const rad::Solution sol = rad::solve_within(scene, s, 30.0, &fit);
+  EXPECT_FALSE(fit.fitted);
+  EXPECT_EQ(fit.pilot_elements, 0u);
+  EXPECT_TRUE(fit.note.empty());
+  EXPECT_LT(sol.mesh.element_count(), 1000u);  // the 600 asked for, not the default 4,000
+}
+
+// On a scene of few triangles the pilot runs at about kPilotElements, and the solve returned is
+// either the pilot (too little time for a finer mesh) or one at the count the fit asked for.
+TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
+  rc::Scene scene = rc::builtin_scene("cornell");
+  scene.commit();
+  rad::BudgetFit fit;
+  const rad::Solution sol = rad::solve_within(scene, quiet(), 2.0, &fit);
+  EXPECT_TRUE(fit.fitted);
+  EXPECT_NEAR(double(fit.pilot_elements), rad::kPilotElements, 0.2 * rad::kPilotElements);
+  EXPECT_FALSE(fit.note.empty());
+  if (fit.requested_elements == 0) {
+    EXPECT_EQ(sol.mesh.element_count(), fit.pilot_elements);
+  } else {
+    EXPECT_GT(fit.requested_elements, int(1.25 * double(fit.pilot_elements)) - 1);
+    EXPECT_NEAR(double(sol.mesh.element_count()), fit.requested_elements, 0.2 * fit.requested_elements);
+  }
+}
+
+// Without a budget, or on an input whose own triangles set the element count, one solve runs.
+TEST(RadiosityBudget, NoPilotWithoutABudgetOrOnALargeInput) {
+  rc::Scene scene = rc::builtin_scene("cornell");
+  scene.commit();
+  rad::BudgetFit fit;
+  rad::solve_within(scene, quiet(), 0.0, &fit);
+  EXPECT_EQ(fit.pilot_elements, 0u);
+
+  rc::Scene fine;
+  fine.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.5f)));
+  fine.materials.push_back(rc::Material::make_emitter("lamp", rc::Rgb(1.0f)));
+  rc::TriangleMesh grid;  // a 16 × 16 floor of 512 triangles
+  for (int j = 0; j <= 16; ++j)
+    for (int i = 0; i <= 16; ++i) grid.positions.push_back({float(i) / 16.0f, 0.0f, float(j) / 16.0f});
+  for (uint32_t j = 0; j < 16; ++j)
+    for (uint32_t i = 0; i < 16; ++i) {
+      const uint32_t a = j * 17 + i, b = a + 1, c = a + 18, d = a + 17;
+      grid.indices.insert(grid.indices.end(), {a, d, c, a, c, b});
+    }
+  fine.meshes.push_back(grid);
+  rc::TriangleMesh lamp;
+  lamp.positions = {{0.4f, 1.0f, 0.4f}, {0.6f, 1.0f, 0.4f}, {0.6f, 1.0f, 0.6f}, {0.4f, 1.0f, 0.6f}};
+  lamp.indices = {0, 1, 2, 0, 2, 3};  // facing down
+  lamp.material = 1;
+  fine.meshes.push_back(lamp);
+  fine.commit();
+  ASSERT_GE(fine.triangle_count(), size_t(rad::kPilotElements / 4));
+  rad::solve_within(fine, quiet(), 30.0, &fit);
+  EXPECT_EQ(fit.pilot_elements, 0u);
+  EXPECT_FALSE(fit.fitted);
+}
