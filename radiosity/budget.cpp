@@ -8,9 +8,9 @@
 
 namespace gilt::radiosity {
 
-double fitted_elements(size_t pilot_elements, double pilot_seconds, double seconds) {
+double fitted_elements(size_t pilot_elements, double pilot_seconds, double seconds, double most) {
   if (!(seconds > 0.0) || !(pilot_seconds > 0.0) || pilot_elements == 0) return 0.0;
-  return std::min(double(pilot_elements) * std::sqrt(seconds / pilot_seconds), double(kMaxFittedElements));
+  return std::min(double(pilot_elements) * std::sqrt(seconds / pilot_seconds), most);
 }
 
 Solution solve_within(const rc::Scene& scene, SolverSettings settings, double seconds, BudgetFit* fit) {
@@ -19,7 +19,7 @@ Solution solve_within(const rc::Scene& scene, SolverSettings settings, double se
   f = BudgetFit{};
   settings.time_limit = seconds;
   const bool gilts_choice = settings.mesh.elements == 0 && !(settings.mesh.max_edge > 0.0f) &&
-                            scene.triangle_count() + scene.spheres.size() < size_t(kPilotElements / 4);
+                            scene.triangle_count() + scene.spheres.size() < size_t(kPilotElements / 2);
   if (!(seconds > 0.0) || !gilts_choice) return solve(scene, settings);
 
   SolverSettings pilot_settings = settings;
@@ -31,8 +31,10 @@ Solution solve_within(const rc::Scene& scene, SolverSettings settings, double se
   const bool converged = pilot.residual <= settings.tolerance;
   // The count that fills what is left, were the cost to grow as n² from the pilot's; rank 0's,
   // so that every process meshes alike.
+  // At most what the default request gives, scaled by how the pilot's mesh met its own request.
+  const double most = double(f.pilot_elements) * double(kDefaultElements) / double(kPilotElements);
   const double n =
-      rc::processes().broadcast_value(converged ? fitted_elements(f.pilot_elements, pilot.seconds, left) : 0.0);
+      rc::processes().broadcast_value(converged ? fitted_elements(f.pilot_elements, pilot.seconds, left, most) : 0.0);
   char line[200];
   if (!(n > 1.25 * double(f.pilot_elements))) {
     f.fitted = true;

@@ -22,13 +22,25 @@ rad::SolverSettings quiet() {
 
 // The cost model: n² from the pilot's point, capped, nothing without time or a pilot.
 TEST(RadiosityBudget, FittedCountGrowsAsTheSquareRootOfTheTime) {
-  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.4), 2000.0);
-  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.025), 500.0);
-  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 1e6), double(rad::kMaxFittedElements));
-  EXPECT_EQ(rad::fitted_elements(1000, 0.1, 0.0), 0.0);
-  EXPECT_EQ(rad::fitted_elements(1000, 0.1, -1.0), 0.0);
-  EXPECT_EQ(rad::fitted_elements(1000, 0.0, 1.0), 0.0);
-  EXPECT_EQ(rad::fitted_elements(0, 0.1, 1.0), 0.0);
+  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.4, 4000.0), 2000.0);
+  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.025, 4000.0), 500.0);
+  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 1e6, 4000.0), 4000.0);
+  EXPECT_EQ(rad::fitted_elements(1000, 0.1, 0.0, 4000.0), 0.0);
+  EXPECT_EQ(rad::fitted_elements(1000, 0.1, -1.0, 4000.0), 0.0);
+  EXPECT_EQ(rad::fitted_elements(1000, 0.0, 1.0, 4000.0), 0.0);
+  EXPECT_EQ(rad::fitted_elements(0, 0.1, 1.0, 4000.0), 0.0);
+}
+
+// A long budget gets the default mesh, not a finer one.
+TEST(RadiosityBudget, ALongBudgetGetsTheDefaultMesh) {
+  rc::Scene scene = rc::builtin_scene("cornell");
+  scene.commit();
+  rad::BudgetFit fit;
+  const rad::Solution fitted = rad::solve_within(scene, quiet(), 1e5, &fit);
+  const rad::Solution plain = rad::solve(scene, quiet());
+  ASSERT_GT(fit.requested_elements, 0);
+  EXPECT_NEAR(double(fit.requested_elements), rad::kDefaultElements, 1.0);
+  EXPECT_EQ(fitted.mesh.element_count(), plain.mesh.element_count());
 }
 
 // A mesh size the user set is kept: no pilot runs.
@@ -89,7 +101,7 @@ TEST(RadiosityBudget, NoPilotWithoutABudgetOrOnALargeInput) {
   lamp.material = 1;
   fine.meshes.push_back(lamp);
   fine.commit();
-  ASSERT_GE(fine.triangle_count(), size_t(rad::kPilotElements / 4));
+  ASSERT_GE(fine.triangle_count(), size_t(rad::kPilotElements / 2));
   rad::solve_within(fine, quiet(), 30.0, &fit);
   EXPECT_EQ(fit.pilot_elements, 0u);
   EXPECT_FALSE(fit.fitted);
