@@ -421,6 +421,20 @@ std::optional<Hit> Scene::intersect(const Ray& ray) const {
 
 namespace {
 
+/// Embree's point query of the ball of `radius` about p, each primitive whose bounds reach it
+/// handed to `callback` with `user`.
+void point_query(RTCScene scene, const Vec3& p, float radius, RTCPointQueryFunction callback, void* user) {
+  RTCPointQuery query;
+  query.x = p.x;
+  query.y = p.y;
+  query.z = p.z;
+  query.time = 0.0f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(scene, &query, &context, callback, user);
+}
+
 /// State of one nearest_triangle query, handed to Embree's point-query callback.
 struct NearestQuery {
   const TriangleMesh* mesh;
@@ -456,15 +470,7 @@ std::optional<Hit> Scene::nearest_triangle(uint32_t geom_id, const Vec3& p, floa
   if (geom_id >= meshes.size() || !(radius > 0.0f)) return std::nullopt;
   NearestQuery q{&meshes[geom_id], geom_id, p, n, min_cosine, Hit{}, sqr(radius)};
   q.best.prim_id = ~0u;
-  RTCPointQuery query;
-  query.x = p.x;
-  query.y = p.y;
-  query.z = p.z;
-  query.time = 0.0f;
-  query.radius = radius;
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
-  rtcPointQuery(impl_->scene, &query, &context, nearest_triangle_callback, &q);
+  point_query(impl_->scene, p, radius, nearest_triangle_callback, &q);
   if (q.best.prim_id == ~0u) return std::nullopt;
   return q.best;
 }
@@ -489,15 +495,7 @@ void Scene::for_each_triangle_near(const Vec3& p, float radius,
                                    const std::function<void(uint32_t geom_id, uint32_t prim_id)>& f) const {
   if (!(radius > 0.0f) || !std::isfinite(radius)) return;
   NearQuery q{&f, static_cast<uint32_t>(meshes.size())};
-  RTCPointQuery query;
-  query.x = p.x;
-  query.y = p.y;
-  query.z = p.z;
-  query.time = 0.0f;
-  query.radius = radius;
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
-  rtcPointQuery(impl_->scene, &query, &context, near_triangle_callback, &q);
+  point_query(impl_->scene, p, radius, near_triangle_callback, &q);
 }
 
 bool Scene::occluded(const Ray& ray) const {
