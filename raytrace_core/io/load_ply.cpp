@@ -114,7 +114,6 @@ struct PlyBody {
   std::vector<Vec3> positions, normals;
   std::vector<uint32_t> indices;
   size_t faces_with_repeats = 0;  // faces that name a vertex twice: their degenerate fans dropped
-  bool colours = false;
 };
 
 /// Walks the body value by value: checks every coordinate is finite and every face index names a
