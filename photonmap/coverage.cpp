@@ -4,6 +4,10 @@
 #include <atomic>
 #include <cmath>
 
+#include "raytrace_core/parallel.h"
+#include "raytrace_core/rng.h"
+#include "raytrace_core/sampling.h"
+
 
 namespace gilt::photonmap {
 namespace {
@@ -57,6 +61,82 @@ void SurfaceSides::add(const rc::Scene& scene, uint32_t geom_id, uint32_t prim_i
   const bool front = glm::dot(glm::cross(b - a, c - a), normal) >= 0.0f;
   std::atomic_ref<uint64_t>(counts_[2 * (first_[geom_id] + prim_id) + (front ? 0 : 1)])
       .fetch_add(1, std::memory_order_relaxed);
+}
+
+SurfaceSides every_side(const rc::Scene& scene) {
+  SurfaceSides sides(scene);
+  std::fill(sides.counts().begin(), sides.counts().end(), 1);
+  return sides;
+}
+
+SurfaceSides open_sides(const rc::Scene& scene, int rays) {
+  SurfaceSides sides(scene);
+  std::vector<uint64_t>& reached = sides.counts();
+  const size_t count = reached.size();
+  constexpr uint32_t kEscaped = ~0u, kNothing = ~0u - 1;
+  // Where each side's rays land: the side they meet (the one facing back along the ray), or the
+  // sky. Winding does not enter: a ray reaches whichever side of a triangle faces it.
+  std::vector<uint32_t> lands(count * size_t(rays), kNothing);
+  for (uint32_t g = 0; g < scene.meshes.size(); ++g) {
+    const rc::TriangleMesh& mesh = scene.meshes[g];
+    rc::parallel_for(mesh.indices.size() / 3, [&](size_t t) {
+      const uint32_t* idx = &mesh.indices[3 * t];
+      const rc::Vec3 &a = mesh.positions[idx[0]], &b = mesh.positions[idx[1]], &c = mesh.positions[idx[2]];
+      const rc::Vec3 cross = glm::cross(b - a, c - a);
+      const float length = glm::length(cross);
+      if (!(length > 0.0f) || !std::isfinite(length)) return;
+      for (int side = 0; side < 2; ++side) {
+        const size_t s = sides.side_index(g, uint32_t(t)) + size_t(side);
+        rc::SurfacePoint sp;
+        sp.ng = (side == 0 ? 1.0f : -1.0f) * cross / length;
+        sp.p_error = rc::Vec3(1e-6f) * (glm::abs(a) + glm::abs(b) + glm::abs(c) + 1.0f);
+        const rc::Frame frame = rc::Frame::from_normal(sp.ng);
+        for (int i = 0; i < rays; ++i) {
+          rc::Rng rng = rc::Rng::for_item(0x5157u, s, uint64_t(i));
+          // A uniform point of the triangle (the folded square), kept off its edges.
+          rc::Vec2 u = rng.uniform2();
+          if (u.x + u.y > 1.0f) u = rc::Vec2(1.0f) - u;
+          u = 0.05f + 0.9f * u;
+          sp.p = a + u.x * (b - a) + u.y * (c - a);
+          const rc::Vec3 d = frame.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
+          const auto hit = scene.intersect(rc::spawn_ray(sp, d));
+          uint32_t& out = lands[s * size_t(rays) + size_t(i)];
+          if (!hit) {
+            out = kEscaped;
+          } else if (hit->geom_id != scene.sphere_geom_id()) {
+            const rc::TriangleMesh& other = scene.meshes[hit->geom_id];
+            const uint32_t* j = &other.indices[3 * size_t(hit->prim_id)];
+            const rc::Vec3 n = glm::cross(other.positions[j[1]] - other.positions[j[0]],
+                                          other.positions[j[2]] - other.positions[j[0]]);
+            out = uint32_t(sides.side_index(hit->geom_id, hit->prim_id) + (glm::dot(n, d) < 0.0f ? 0 : 1));
+          }
+        }
+      }
+    });
+  }
+  // Light reaches a side that sees the sky, and any side that sees a side light reaches (the
+  // same segment carries it back): a search outwards from the sides that see the sky.
+  std::vector<uint32_t> first(count + 1, 0), from;
+  for (size_t s = 0; s < count; ++s)
+    for (int i = 0; i < rays; ++i)
+      if (const uint32_t h = lands[s * size_t(rays) + size_t(i)]; h < kNothing) ++first[h + 1];
+  for (size_t s = 0; s < count; ++s) first[s + 1] += first[s];
+  from.resize(first[count]);
+  std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+  std::vector<uint32_t> queue;
+  for (size_t s = 0; s < count; ++s) {
+    bool sky = false;
+    for (int i = 0; i < rays; ++i) {
+      const uint32_t h = lands[s * size_t(rays) + size_t(i)];
+      if (h == kEscaped) sky = true;
+      else if (h < kNothing) from[fill[h]++] = uint32_t(s);
+    }
+    if (sky) reached[s] = 1, queue.push_back(uint32_t(s));
+  }
+  for (size_t q = 0; q < queue.size(); ++q)
+    for (uint32_t k = first[queue[q]]; k < first[queue[q] + 1]; ++k)
+      if (!reached[from[k]]) reached[from[k]] = 1, queue.push_back(from[k]);
+  return sides;
 }
 
 double kernel_integral(const rc::Vec3& a, const rc::Vec3& b, const rc::Vec3& c, const rc::Vec3& p, float r2) {

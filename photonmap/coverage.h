@@ -10,8 +10,9 @@
 // by it makes the estimate unbiased wherever the photon density is constant over the ball,
 // whatever the shape of the surface in it.
 //
-// The photon passes do not apply it yet: on Šibenik it overshot, for reasons measured but not
-// all understood (bench/README.md, "The photon method's biases").
+// The photon mapper's global map applies it over every triangle side (every_side); SPPM has a
+// stochastic coverage of its own (photonmap/sppm.cpp). See bench/README.md, "The photon
+// method's biases", for what it changed on Šibenik.
 
 #include <cstdint>
 #include <vector>
@@ -39,11 +40,28 @@ class SurfaceSides {
   }
   /// The counts, for joining those of several processes (element-wise sum).
   std::vector<uint64_t>& counts() { return counts_; }
+  /// Index of triangle prim_id of mesh geom_id's front side in counts() (its back: one more).
+  size_t side_index(uint32_t geom_id, uint32_t prim_id) const { return 2 * (size_t(first_[geom_id]) + prim_id); }
 
  private:
   std::vector<uint64_t> first_;   ///< flat index of each mesh's first triangle
   std::vector<uint64_t> counts_;  ///< photons per triangle side
 };
+
+/// Every side of every triangle of the scene, counted as holding photons: the coverage the
+/// photon mapper divides by. On Šibenik open_sides reaches 99.6 % of the sides, and this is the
+/// same to that; where it counts a side that faces into a closed solid, a disk reaching it is
+/// divided by too much and reads dark.
+SurfaceSides every_side(const rc::Scene& scene);
+
+/// The triangle sides light from outside the scene can reach: a side that one of `rays`
+/// cosine-distributed rays, from points spread over it, sees the sky from, and any side that
+/// one of its rays meets a reached side from. Winding does not enter (a ray reaches whichever
+/// side faces it), so surfaces modelled inside out do not fool it; sides facing into closed
+/// solids are not reached. Unlike the sides a map's photons happened to reach, it does not
+/// leave out small triangles no photon hit by chance. A scene lit only from inside (a closed
+/// room with a lamp) reaches no side: give such scenes every side.
+SurfaceSides open_sides(const rc::Scene& scene, int rays = 8);
 
 /// The kernel 2 / (π r²) · (1 − d² / r²) integrated over the triangle sides within distance
 /// √r2 of p that hold photons and face within `min_cosine` of the unit normal n: 1 for a full

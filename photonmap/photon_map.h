@@ -26,6 +26,11 @@ struct PhotonSettings {
   /// many photons are stored, or the first round stores none, or global_rounds rounds.
   uint64_t global_photons = 200'000;
   int global_rounds = 16;
+  /// Rounds go on past half a round stored, while fewer photons are stored than half the paths
+  /// emitted, until the global map has taken this many seconds (or global_rounds rounds): under
+  /// a time budget, a share of it for a denser map of an open scene (0: none; the map then
+  /// depends on the machine's speed, as a budget's passes do).
+  double global_seconds = 0.0;
   uint64_t caustic_photons = 200'000;  ///< emitted for the caustic map (0: no caustic map)
   int max_depth = 1 << 16;             ///< bounces per photon path at most; Russian roulette ends
                                        ///< paths long before (a low cap would bias albedo near 1)
@@ -39,8 +44,8 @@ struct PhotonMap {
   std::vector<Photon> photons;
   uint64_t emitted = 0;  ///< photon paths emitted for this map
   PhotonIndex index;
-  /// The triangle sides the photons were stored on, for the estimates with coverage. The photon
-  /// passes do not fill it yet (bench/README.md, "The photon method's biases").
+  /// The triangle sides that hold photons, for the estimates with coverage (the photon mapper
+  /// counts every side: every_side in photonmap/coverage.h).
   SurfaceSides sides;
 
   bool empty() const { return photons.empty(); }

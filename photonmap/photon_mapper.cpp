@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "photonmap/coverage.h"
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/direct_light.h"
 #include "raytrace_core/error.h"
@@ -51,6 +52,10 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
   stats_.caustic_photons = maps_.caustic.photons.size();
   stats_.paths = maps_.paths;
   stats_.trace_seconds = maps_.seconds;
+  // The global map's estimates are divided by their disk's coverage of the scene's surface
+  // (photonmap/coverage.h): a k-nearest disk that reaches past an edge or into a corner would
+  // read dark. The caustic map is not: its photons are not spread evenly over any disk.
+  if (!maps_.global.empty()) maps_.global.sides = every_side(scene);
   const float radius = settings.max_radius > 0.0f ? settings.max_radius : 0.05f * scene.bounds().radius();
   stats_.max_radius = radius;
   max_radius2_ = radius * radius;
@@ -106,7 +111,7 @@ rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& norm
     }
   }
   const EstimateQuery query{p, normal, size_t(settings_.k), max_radius2_};
-  e += estimate_irradiance(maps_.global, query, thread_scratch());
+  e += estimate_irradiance(scene_, maps_.global, query, thread_scratch());
   e += estimate_irradiance(maps_.caustic, query, thread_scratch());
   return e;
 }
@@ -182,7 +187,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
     l += ds.value * (ds.delta || gather == 0 ? 1.0f : rc::power_heuristic(1.0f, ds.pdf, float(gather), rc::bsdf_pdf(m, wo, ds.wi)));
   if (gather == 0) {
     // Without a final gather the global map is read at x itself.
-    l += estimate_radiance(maps_.global, query, m, frame, wo, thread_scratch());
+    l += estimate_radiance(scene_, maps_.global, query, m, frame, wo, thread_scratch());
     return l;
   }
 

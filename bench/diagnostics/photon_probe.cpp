@@ -11,8 +11,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
+#include "photonmap/coverage.h"
 #include "photonmap/photon_map.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/path_tracer.h"
@@ -32,13 +34,34 @@ int main(int argc, char** argv) {
   const size_t k = argc > 3 ? size_t(std::atoi(argv[3])) : 50;
   const int rays = argc > 4 ? std::atoi(argv[4]) : 256;
   pm::PhotonMaps maps = pm::trace_photons(scene, ps);
-  // COVER=1: the estimates divided by their disk's coverage (photonmap/coverage.h), with every
-  // side of every triangle counted as holding photons: an upper bound on the coverage, since the
-  // photon passes do not record the sides they reach.
+  // COVER=1: the estimates divided by their disk's coverage (photonmap/coverage.h) over every
+  // side of every triangle, as the photon mapper divides them. COVER=open: only over the sides
+  // open_sides finds light from outside can reach, with a count of the stored photons that lie
+  // on the others.
   const bool cover = std::getenv("COVER") != nullptr;
-  if (cover) {
-    maps.global.sides = pm::SurfaceSides(scene);
-    std::fill(maps.global.sides.counts().begin(), maps.global.sides.counts().end(), 1);
+  if (cover && std::string(std::getenv("COVER")) == "open") {
+    maps.global.sides = pm::open_sides(scene);
+    size_t open = 0;
+    for (uint64_t c : maps.global.sides.counts()) open += c;
+    std::printf("open sides: %zu of %zu\n", open, maps.global.sides.counts().size());
+    // How many stored photons lie on sides open_sides calls closed (the photon's own triangle
+    // found by a short ray back along its normal, which faces where it came from).
+    size_t on_closed = 0, found = 0;
+    for (const pm::Photon& ph : maps.global.photons) {
+      const rc::Vec3 n = pm::decode_direction(ph.normal);
+      rc::Ray back{ph.position + 1e-3f * n, -n};
+      back.tmax = 2e-3f;
+      const auto h = scene.intersect(back);
+      if (!h || h->geom_id == scene.sphere_geom_id()) continue;
+      ++found;
+      const rc::TriangleMesh& m = scene.meshes[h->geom_id];
+      const uint32_t* j = &m.indices[3 * size_t(h->prim_id)];
+      const bool front = glm::dot(glm::cross(m.positions[j[1]] - m.positions[j[0]], m.positions[j[2]] - m.positions[j[0]]), n) >= 0.0f;
+      if (!maps.global.sides.holds(h->geom_id, h->prim_id, front)) ++on_closed;
+    }
+    std::printf("photons on sides called closed: %zu of %zu found\n", on_closed, found);
+  } else if (cover) {
+    maps.global.sides = pm::every_side(scene);
   }
   std::printf("%zu global photons from %llu paths\n", maps.global.photons.size(), (unsigned long long)maps.paths);
   const float max_r = 0.05f * scene.bounds().radius();

@@ -140,3 +140,39 @@ TEST(PhotonCoverage, EstimateAtAnOpenEdgeIsAsBrightAsInside) {
   EXPECT_NEAR(plain, 0.5 * sun.irradiance.g, 0.1 * sun.irradiance.g);  // the bias the coverage removes
   EXPECT_NEAR(covered, sun.irradiance.g, 0.05 * sun.irradiance.g);
 }
+
+// A closed cube floating over a floor: light from outside reaches the floor's upper side, the
+// cube's outer sides and the floor's underside (it sees the sky), never the cube's inner sides,
+// whichever way the cube is wound. Every ray from an inner side meets another inner side, so
+// this holds for any number of rays; 8 are the default. (Standing on the floor, the cube's
+// inner sides would see the floor's triangles, coplanar with its bottom, which the sky reaches
+// elsewhere: a side is reached or not as a whole.)
+TEST(PhotonCoverage, OpenSidesAreThoseLightFromOutsideReaches) {
+  for (const bool inside_out : {false, true}) {
+    rc::Scene scene;
+    scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+    scene.meshes.push_back(quad({-4, 0, -4}, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}));  // floor, front +y
+    rc::TriangleMesh cube;
+    cube.name = "cube";
+    for (int i = 0; i < 8; ++i) cube.positions.push_back({float(i & 1), 0.5f + float((i >> 1) & 1), float((i >> 2) & 1)});
+    // Faces wound with the front outwards: −x, +x, −y, +y, −z, +z.
+    const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (const auto& f : faces) {
+      const uint32_t a = f[0], b = f[1], c = f[2], d = f[3];
+      if (inside_out) cube.indices.insert(cube.indices.end(), {a, c, b, a, d, c});
+      else cube.indices.insert(cube.indices.end(), {a, b, c, a, c, d});
+    }
+    scene.meshes.push_back(cube);
+    scene.commit();
+    const pm::SurfaceSides sides = pm::open_sides(scene);
+    for (uint32_t t = 0; t < 2; ++t) {
+      EXPECT_TRUE(sides.holds(0, t, true)) << "floor, upper side";
+      EXPECT_TRUE(sides.holds(0, t, false)) << "floor, underside";
+    }
+    for (uint32_t t = 0; t < 12; ++t) {
+      // The cube's outward side is its front unless it is wound inside out.
+      EXPECT_TRUE(sides.holds(1, t, !inside_out)) << "cube triangle " << t << ", outer side";
+      EXPECT_FALSE(sides.holds(1, t, inside_out)) << "cube triangle " << t << ", inner side";
+    }
+  }
+}

@@ -239,12 +239,11 @@ TEST(PhotonTracing, MapsDoNotDependOnTheThreadCount) {
   EXPECT_TRUE(one.skipped.empty());
 }
 
-TEST(PhotonTracing, SparseGlobalMapsTakeMoreRoundsOfTheSamePhotons) {
-  // A 2 × 2 floor with a 1 × 1 plate 0.5 above it, facing it, under a sun; a speck 20 away
-  // widens the bounds, so most photons from the bounding disk miss both. Global photons (after a
-  // diffuse bounce) are few per round, and rounds go on until half a round's count is stored.
-  // Round k traces photons k·N … (k + 1)·N − 1, so r rounds of N are one round of r·N photons,
-  // their power divided by r instead of by r·N at once: the same map up to rounding.
+namespace {
+
+/// A 2 × 2 floor with a 1 × 1 plate 0.5 above it, facing it, under a sun; a speck 20 away
+/// widens the bounds, so most photons from the bounding box's outline miss both.
+rc::Scene floor_far_under_a_sun() {
   rc::Scene scene;
   scene.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.8f)));
   scene.meshes.push_back(square(1.0f, 0.0f, 0));
@@ -258,6 +257,18 @@ TEST(PhotonTracing, SparseGlobalMapsTakeMoreRoundsOfTheSamePhotons) {
   sun.irradiance = rc::Rgb(1.0f);
   scene.punctual_lights.push_back(sun);
   scene.commit();
+  return scene;
+}
+
+}  // namespace
+
+TEST(PhotonTracing, SparseGlobalMapsTakeMoreRoundsOfTheSamePhotons) {
+  // A 2 × 2 floor with a 1 × 1 plate 0.5 above it, facing it, under a sun; a speck 20 away
+  // widens the bounds, so most photons from the bounding disk miss both. Global photons (after a
+  // diffuse bounce) are few per round, and rounds go on until half a round's count is stored.
+  // Round k traces photons k·N … (k + 1)·N − 1, so r rounds of N are one round of r·N photons,
+  // their power divided by r instead of by r·N at once: the same map up to rounding.
+  const rc::Scene scene = floor_far_under_a_sun();
   pm::PhotonSettings rounds;
   rounds.global_photons = 4000;
   rounds.caustic_photons = 0;
@@ -279,6 +290,32 @@ TEST(PhotonTracing, SparseGlobalMapsTakeMoreRoundsOfTheSamePhotons) {
     ASSERT_EQ(a.global.photons[i].position, b.global.photons[i].position) << i;
     ASSERT_NEAR(a.global.photons[i].power.g, b.global.photons[i].power.g, 1e-6f * b.global.photons[i].power.g) << i;
   }
+}
+
+// Under a time share (global_seconds) a map that stores fewer photons than half its paths takes
+// rounds past half a round stored, up to global_rounds; a closed room, which stores most of its
+// paths, stops after its first round. The share here never runs out, so the counts are exact.
+TEST(PhotonTracing, ATimeShareAddsRoundsOnlyWhereMostPathsStoreNothing) {
+  pm::PhotonSettings settings;
+  settings.caustic_photons = 0;
+  settings.global_rounds = 40;
+  settings.global_seconds = 1e9;
+
+  const rc::Scene open = floor_far_under_a_sun();
+  settings.global_photons = 400;
+  const pm::PhotonMaps a = pm::trace_photons(open, settings);
+  ASSERT_GT(a.global.photons.size(), 0u);
+  EXPECT_LT(2 * a.global.photons.size(), a.global.emitted);
+  EXPECT_EQ(a.global.emitted, 40u * settings.global_photons);
+  pm::PhotonSettings no_share = settings;
+  no_share.global_seconds = 0.0;
+  EXPECT_LT(pm::trace_photons(open, no_share).global.emitted, a.global.emitted) << "half a round was stored sooner";
+
+  const rc::Scene cornell = rc::load_scene("cornell");
+  settings.global_photons = 2000;
+  const pm::PhotonMaps b = pm::trace_photons(cornell, settings);
+  EXPECT_GE(2 * b.global.photons.size(), b.global.emitted);
+  EXPECT_EQ(b.global.emitted, settings.global_photons);
 }
 
 TEST(PhotonTracing, SkipsWhatTheSceneDoesNotNeed) {
