@@ -4,6 +4,7 @@
 
 #include "photonmap/photon_map.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "raytrace_core/bsdf.h"
@@ -135,7 +136,8 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
     // a sparse map's estimates are biased. Each round's photons carry 1 / global_photons of the
     // power; with r rounds they are scaled by 1 / r.
     const uint64_t round = settings.global_photons;
-    for (int r = 0; r < std::max(settings.global_rounds, 1); ++r) {
+    const int most_rounds = std::max({settings.global_rounds, settings.global_time_rounds, 1});
+    for (int r = 0; r < most_rounds; ++r) {
       const std::vector<Photon> more =
           trace_map(scene, maps.global.emitted, round, 0xb000000000ull, settings, maps.paths,
                     [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
@@ -153,8 +155,9 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
       // photons cost the render its samples (cornell at 2 s: relMSE 7 times higher).
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const bool more_time = rc::processes().broadcast_value(seconds < settings.global_seconds) &&
-                             2 * maps.global.photons.size() < maps.global.emitted;
-      if (2 * maps.global.photons.size() >= round && !more_time) break;
+                             2 * maps.global.photons.size() < maps.global.emitted && r + 1 < settings.global_time_rounds;
+      const bool sparse = 2 * maps.global.photons.size() < round && r + 1 < settings.global_rounds;
+      if (!sparse && !more_time) break;
     }
     const float rounds = float(maps.global.emitted / round);
     if (rounds > 1.0f)

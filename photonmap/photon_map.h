@@ -26,11 +26,12 @@ struct PhotonSettings {
   /// many photons are stored, or the first round stores none, or global_rounds rounds.
   uint64_t global_photons = 200'000;
   int global_rounds = 16;
-  /// Rounds go on past half a round stored, while fewer photons are stored than half the paths
-  /// emitted, until the global map has taken this many seconds (or global_rounds rounds): under
-  /// a time budget, a share of it for a denser map of an open scene (0: none; the map then
-  /// depends on the machine's speed, as a budget's passes do).
+  /// Rounds also go on, past half a round stored or global_rounds, while fewer photons are stored
+  /// than half the paths emitted, until the global map has taken this many seconds or
+  /// global_time_rounds rounds: under a time budget, a share of it for a denser map of an open
+  /// scene (0: none; the map then depends on the machine's speed, as a budget's passes do).
   double global_seconds = 0.0;
+  int global_time_rounds = 64;
   uint64_t caustic_photons = 200'000;  ///< emitted for the caustic map (0: no caustic map)
   int max_depth = 1 << 16;             ///< bounces per photon path at most; Russian roulette ends
                                        ///< paths long before (a low cap would bias albedo near 1)

@@ -293,12 +293,12 @@ TEST(PhotonTracing, SparseGlobalMapsTakeMoreRoundsOfTheSamePhotons) {
 }
 
 // Under a time share (global_seconds) a map that stores fewer photons than half its paths takes
-// rounds past half a round stored, up to global_rounds; a closed room, which stores most of its
+// rounds past half a round stored, up to global_time_rounds; a closed room, which stores most of its
 // paths, stops after its first round. The share here never runs out, so the counts are exact.
 TEST(PhotonTracing, ATimeShareAddsRoundsOnlyWhereMostPathsStoreNothing) {
   pm::PhotonSettings settings;
   settings.caustic_photons = 0;
-  settings.global_rounds = 40;
+  settings.global_time_rounds = 40;
   settings.global_seconds = 1e9;
 
   const rc::Scene open = floor_far_under_a_sun();
