@@ -29,15 +29,15 @@ Solution solve_within(const rc::Scene& scene, SolverSettings settings, double se
   f.pilot_seconds = pilot.seconds;
   const double left = seconds - pilot.seconds;
   const bool converged = pilot.residual <= settings.tolerance;
-  // The count that fills what is left, were the cost to grow as n² from the pilot's; rank 0's,
-  // so that every process meshes alike.
-  // At most what the default request gives, scaled by how the pilot's mesh met its own request.
+  f.fitted = true;
+  // The count that fills what is left, were the cost to grow as n² from the pilot's, and at most
+  // what the default request gives (scaled by how the pilot's mesh met its own request); rank
+  // 0's, so that every process meshes alike.
   const double most = double(f.pilot_elements) * double(kDefaultElements) / double(kPilotElements);
   const double n =
       rc::processes().broadcast_value(converged ? fitted_elements(f.pilot_elements, pilot.seconds, left, most) : 0.0);
   char line[200];
   if (!(n > 1.25 * double(f.pilot_elements))) {
-    f.fitted = true;
     std::snprintf(line, sizeof line, "radiosity: %zu elements, solved in %.3g s of a %.3g-s solve budget%s", f.pilot_elements,
                   pilot.seconds, seconds, converged ? "" : " (stopped: a finer mesh would not converge in time)");
     f.note = line;
@@ -45,7 +45,6 @@ Solution solve_within(const rc::Scene& scene, SolverSettings settings, double se
   }
   // The request that gives n elements, scaled by how the pilot's mesh met its own request.
   f.requested_elements = int(std::lround(n * double(kPilotElements) / double(f.pilot_elements)));
-  f.fitted = true;
   settings.mesh.elements = f.requested_elements;
   settings.time_limit = std::max(1e-3, left);
   Solution final_solution = solve(scene, settings);
