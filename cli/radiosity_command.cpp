@@ -88,8 +88,6 @@ void run_radiosity(RadiosityOptions& o) {
   } else if (onto_input)
     radiosity::check_onto_output(o.output, scene);
   o.solver.progress = !o.quiet && !o.json;
-  if (o.bake_gather > 0 && !onto_input)
-    throw rc::InputError("--bake-gather traces the points of a bake onto the input: give --onto input or --lightmap");
   radiosity::BakeGather gather{o.bake_gather, o.solver.seed};
   // --time covers the whole command: loading has used some of it. A final gather of the bake
   // takes what the solve leaves of kBakeGatherShare of it; points it cannot reach in time read
@@ -114,6 +112,11 @@ void run_radiosity(RadiosityOptions& o) {
   std::optional<radiosity::InputColours> onto;
   radiosity::SnapStats snap;
   std::optional<radiosity::Lightmap> atlas;
+  // --onto elements --bake-gather N: the vertices' light traced from the input under them.
+  std::optional<radiosity::Solution> vertex_gather;
+  radiosity::BakeGatherCount vertex_gather_count;
+  double vertex_gather_seconds = 0.0;
+  const auto exported = [&]() -> const radiosity::Solution& { return vertex_gather ? *vertex_gather : sol; };
   if (lightmap) {
     atlas = radiosity::bake_lightmap(scene, sol, ex.quantity, o.lightmap, gather);
     radiosity::write_lightmap(o.output, scene, *atlas, ex);
@@ -121,7 +124,12 @@ void run_radiosity(RadiosityOptions& o) {
     onto = radiosity::fit_input_colours(scene, sol, fit, ex.quantity, gather);
     radiosity::write_onto_input(o.output, scene, *onto, ex);
   } else {
-    radiosity::write_solution(o.output, scene, sol, ex, &snap);
+    if (o.bake_gather > 0) {
+      const auto gather_start = std::chrono::steady_clock::now();
+      vertex_gather.emplace(radiosity::gather_at_vertices(scene, sol, gather, &vertex_gather_count));
+      vertex_gather_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - gather_start).count();
+    }
+    radiosity::write_solution(o.output, scene, exported(), ex, &snap);
   }
   std::optional<radiosity::CheckResult> check;
   std::optional<radiosity::SurfaceCheckResult> surface_check;
@@ -144,7 +152,7 @@ void run_radiosity(RadiosityOptions& o) {
               : radiosity::fit_input_colours(scene, sol, fit, radiosity::Quantity::irradiance, gather);
       surface_check = radiosity::check_input_colours(scene, e, o.check);
     } else {
-      check = radiosity::check_against_path_tracer(scene, sol, o.check);
+      check = radiosity::check_against_path_tracer(scene, exported(), o.check);
     }
     if (surface_check && !o.check_points_file.empty())
       radiosity::write_check_points(o.check_points_file, scene, *surface_check);
@@ -174,6 +182,12 @@ void run_radiosity(RadiosityOptions& o) {
                   {"gathered_samples", onto->gather.gathered},
                   {"samples_read_after_deadline", onto->gather.late},
                   {"seconds", onto->seconds}};
+    if (vertex_gather)
+      j["vertex_gather"] = {{"gather_rays", o.bake_gather},
+                            {"gathered_vertices", vertex_gather_count.gathered},
+                            {"vertices_read_after_deadline", vertex_gather_count.late},
+                            {"vertices", sol.mesh.vertex_count()},
+                            {"seconds", vertex_gather_seconds}};
     if (atlas)
       j["lightmap"] = {{"size", atlas->size},
                        {"image", radiosity::lightmap_image_path(o.output)},
@@ -252,6 +266,11 @@ void run_radiosity(RadiosityOptions& o) {
                 "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
                 100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
+  if (vertex_gather)
+    std::printf("  gather:  %llu of %zu vertices traced from the input surface under them, %d rays each (%llu read "
+                "from the solution after the deadline), %.3g s\n",
+                static_cast<unsigned long long>(vertex_gather_count.gathered), sol.mesh.vertex_count(), o.bake_gather,
+                static_cast<unsigned long long>(vertex_gather_count.late), vertex_gather_seconds);
   if (onto)
     std::printf("  onto:    %s fit to the input's vertices: %llu samples (%llu without a solution; %zu buried "
                 "faces left out), %.3g s\n",
@@ -366,10 +385,12 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
                   "point takes the solution at each vertex")
       ->check(CLI::IsMember({"least-squares", "point"}));
   cmd->add_option("--bake-gather", o->bake_gather,
-                  "With --onto input or --lightmap: a final gather. Each baked point takes its light from N shadow "
-                  "rays and N gather rays that read the solution where they land, rather than from the solution "
-                  "there: no light leaks across walls and roof lines the elements straddle, at the cost of noise "
-                  "(default 0 = off). Under --time the solve keeps 60 % of the budget")
+                  "A final gather. Each baked point (with --onto input or --lightmap) or exported vertex (--onto "
+                  "elements, at the input surface under it) takes its light from N shadow rays and N gather rays "
+                  "that read the solution where they land, rather than from the solution there: no light leaks "
+                  "across walls and roof lines the elements straddle, and a remeshed scan's vertices see the "
+                  "input's own shape, at the cost of noise (default 0 = off). Under --time the solve keeps 60 % of "
+                  "the budget")
       ->check(CLI::Range(0, 1 << 20));
   cmd->add_flag("--srgb8", o->srgb8,
                 "PLY: only the 8-bit sRGB colours, without the float <quantity>_red/_green/_blue beside them");

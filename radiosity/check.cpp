@@ -39,9 +39,6 @@ void CheckSettings::validate() const {
   if (samples < 2) throw rc::InputError("check: samples must be at least 2, not " + std::to_string(samples));
 }
 
-/// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings).
-constexpr float kSameSide = 0.8660254f;
-
 namespace {
 
 /// Path settings whose first surface is a white, unlit Lambertian: π times their radiance
@@ -64,13 +61,8 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
   if (nv == 0) return result;
   const size_t count = std::min(nv, size_t(settings.points));
   const std::vector<Vec3> origin = receiver_points(element_scene(scene, mesh), mesh);
-  // Each vertex stands for the surface around it: the radius of its disk is half the distance
-  // to the nearest centroid of its elements.
-  std::vector<float> radius(nv, std::numeric_limits<float>::max());
-  for (const auto& e : mesh.elements) {
-    const Vec3 centroid = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f;
-    for (uint32_t v : e) radius[v] = std::min(radius[v], 0.5f * glm::distance(centroid, mesh.positions[v]));
-  }
+  // Each vertex stands for the surface around it, a disk of vertex_disk_radius.
+  const std::vector<float> radius = vertex_disk_radius(mesh);
   std::vector<Rgb> mean(count), standard_error(count);
   std::vector<char> usable(count, 0);
   const rc::PathSettings path = irradiance_probe();
@@ -78,19 +70,17 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
     const size_t v = i * nv / count;
     const Vec3 n = mesh.normals[v];
     const rc::Frame frame = rc::Frame::from_normal(n);
-    const rc::Material& m = scene.materials[mesh.vertex_material[v]];
     const float r = radius[v];
     Rgb sum(0.0f), sum_squares(0.0f);
     int taken = 0;
     for (int s = 0; s < settings.samples; ++s) {
       rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(settings.seed, v, 0xc0ffee0000ull + uint64_t(s))), 0};
       const rc::Vec2 u = rc::sample_uniform_disk(ctx.sampler.uniform2()) * r;
-      const rc::Ray ray{origin[v] + frame.to_world(Vec3(u.x, u.y, 0.0f)) + r * n, -n, 2.0f * r};
-      const std::optional<rc::Hit> hit = scene.intersect(ray);
-      if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &m) continue;
       // Only the surface on the vertex's side of a crease (vertices are split at 30°) counts.
-      const rc::SurfaceInteraction si = scene.surface(ray, *hit);
-      if (glm::dot(si.ng, n) < kSameSide) continue;
+      const Vec3 offset = origin[v] - mesh.positions[v] + frame.to_world(Vec3(u.x, u.y, 0.0f));
+      const std::optional<InputPoint> under = input_surface_under(scene, mesh, v, offset, r);
+      if (!under) continue;
+      const rc::Ray& ray = under->ray;
       const Rgb e = rc::path_radiance(scene, ray, ctx, path) * rc::kPi;
       sum += e;
       sum_squares += e * e;

@@ -11,6 +11,7 @@
 #include "radiosity/view.h"
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/sampling.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/loaders.h"
@@ -154,6 +155,73 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
   }
   out.gather = at_input.gather_count();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::vector<float> vertex_disk_radius(const RadiosityMesh& mesh) {
+  std::vector<float> radius(mesh.vertex_count(), std::numeric_limits<float>::max());
+  for (const auto& e : mesh.elements) {
+    const Vec3 centroid = (mesh.positions[e[0]] + mesh.positions[e[1]] + mesh.positions[e[2]]) / 3.0f;
+    for (uint32_t v : e) radius[v] = std::min(radius[v], 0.5f * glm::distance(centroid, mesh.positions[v]));
+  }
+  return radius;
+}
+
+std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const RadiosityMesh& mesh, size_t v,
+                                              const Vec3& offset, float radius) {
+  const Vec3 n = mesh.normals[v];
+  const rc::Ray ray{mesh.positions[v] + offset + radius * n, -n, 2.0f * radius};
+  const std::optional<rc::Hit> hit = scene.intersect(ray);
+  if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &scene.materials[mesh.vertex_material[v]])
+    return std::nullopt;
+  const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+  if (glm::dot(si.ng, n) < kSameSideOfCrease) return std::nullopt;
+  return InputPoint{ray, si};
+}
+
+Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, BakeGather gather,
+                            BakeGatherCount* count) {
+  Solution out = solution;
+  const RadiosityMesh& mesh = solution.mesh;
+  const RadiosityView view(scene, solution, ViewMode::mesh, /*ambient=*/false);
+  const std::vector<float> radius = vertex_disk_radius(mesh);
+  const int rays = std::max(gather.rays, 1);
+  std::atomic<uint64_t> gathered{0}, late{0};
+  rc::parallel_for(mesh.vertex_count(), [&](size_t v) {
+    if (std::chrono::steady_clock::now() >= gather.deadline) {
+      ++late;
+      return;
+    }
+    // The colour stands for the disk around the vertex (vertex_disk_radius), as the check reads
+    // it: each ray starts at its own point of the input under the disk. On a scan one point's
+    // face normal is a poor sample of the facets the disk holds, and a third of the points
+    // under a remeshed vertex lie on facets turned more than 30° from it.
+    const rc::Frame frame = rc::Frame::from_normal(mesh.normals[v]);
+    rc::SampleContext ctx{rc::Sampler::for_pixel_sample(rc::SamplerKind::sobol, gather.seed, v, 0), 0};
+    const rc::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(rays));
+    Rgb sum(0.0f);
+    int taken = 0;
+    for (int r = 0; r < rays; ++r) {
+      rc::SampleContext sub{samples[uint32_t(r)], 0};
+      const rc::Vec2 u = rc::sample_uniform_disk(sub.sampler.uniform2()) * radius[v];
+      const std::optional<InputPoint> under =
+          input_surface_under(scene, mesh, v, frame.to_world(Vec3(u.x, u.y, 0.0f)), radius[v]);
+      if (!under) continue;
+      sum += view.gathered_sample(mesh_surface_point(under->si.p, under->si.ng), sub);
+      ++taken;
+    }
+    if (taken == 0) return;  // no input surface under it (a corner between creases): the solve's value stays
+    ++gathered;
+    const Rgb e = sum / float(taken);
+    out.vertex_irradiance[v] = e;
+    out.vertex_radiosity[v] = scene.materials[mesh.vertex_material[v]].emission * rc::kPi + solution.vertex_albedo[v] * e;
+  });
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const auto& el = mesh.elements[e];
+    out.element_radiosity[e] =
+        (out.vertex_radiosity[el[0]] + out.vertex_radiosity[el[1]] + out.vertex_radiosity[el[2]]) * (1.0f / 3.0f);
+  }
+  if (count) *count = {gathered.load(), late.load()};
   return out;
 }
 

@@ -114,6 +114,33 @@ std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec
 InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity,
                                BakeGather gather = {});
 
+/// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings), so a point of
+/// the input under a vertex belongs to the vertex's side when its normal is within 30° of the vertex's.
+inline constexpr float kSameSideOfCrease = 0.8660254f;
+
+/// Per vertex of the element mesh: half the distance to the nearest centroid of its elements, the
+/// radius of the patch of surface its colour stands for.
+std::vector<float> vertex_disk_radius(const RadiosityMesh& mesh);
+
+/// The point of the input surface under vertex v, displaced by `offset` in its tangent plane: the
+/// first input face a ray straight down the vertex normal meets, from `radius` above to `radius`
+/// below, when it has the vertex's material and faces its side of any crease. With the ray.
+struct InputPoint {
+  rc::Ray ray;
+  rc::SurfaceInteraction si;
+};
+std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const RadiosityMesh& mesh, size_t v,
+                                              const Vec3& offset, float radius);
+
+/// `gilt radiosity --onto elements --bake-gather N`: the solution with each vertex's irradiance
+/// traced (SolutionAtInput's final gather) from the point of the input surface under it, at the
+/// input face's normal, and its radiosity and the element means recomputed from it. On a scan the
+/// remeshed surface's smoothed normals and coarser silhouette move shadows and facing; the gather
+/// sees the input itself. Vertices with no input surface under them keep the solve's value;
+/// vertex_direct and vertex_punctual stay the solve's. For exports and checks, not for a view.
+Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, BakeGather gather,
+                            BakeGatherCount* count = nullptr);
+
 /// Throws InputError unless write_onto_input can write `path` for the scene: called before
 /// solving, so a mistyped output does not cost a solve.
 void check_onto_output(const std::string& path, const rc::Scene& scene);

@@ -130,6 +130,19 @@ std::optional<Rgb> RadiosityView::indirect_irradiance(const rc::SurfacePoint& p,
 }
 
 Rgb RadiosityView::gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const {
+  Rgb sum(0.0f);
+  // The rays are sub-samples of the point's sample: with the Sobol sampler, their shadow rays'
+  // points on each light and their gather directions are each a stratified set.
+  const rc::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(std::max(rays, 1)));
+  for (int r = 0; r < rays; ++r) {
+    rc::SampleContext sub{samples[uint32_t(r)], 0};
+    sum += gathered_sample(p, sub);
+    ctx.rays += sub.rays;
+  }
+  return sum / float(std::max(rays, 1));
+}
+
+Rgb RadiosityView::gathered_sample(const rc::SurfacePoint& p, rc::SampleContext& ctx) const {
   // A white Lambertian stands in for the surface: π times its reflected radiance is irradiance.
   static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
   rc::SurfaceInteraction si;
@@ -137,17 +150,8 @@ Rgb RadiosityView::gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::
   si.ns = p.ng;
   const rc::Frame frame = rc::Frame::from_normal(p.ng);
   const Vec3 wo(0.0f, 0.0f, 1.0f);
-  Rgb sum(0.0f);
-  // The rays are sub-samples of the point's sample: with the Sobol sampler, their shadow rays'
-  // points on each light and their gather directions are each a stratified set.
-  const rc::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(std::max(rays, 1)));
-  for (int r = 0; r < rays; ++r) {
-    rc::SampleContext sub{samples[uint32_t(r)], 0};
-    sum += rc::estimate_direct(scene_, si, white, frame, wo, true, sub.sampler, sub.rays) * rc::kPi;
-    sum += gather(si, frame, true, sub);
-    ctx.rays += sub.rays;
-  }
-  return sum / float(std::max(rays, 1));
+  return rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays) * rc::kPi +
+         gather(si, frame, true, ctx);
 }
 
 Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,

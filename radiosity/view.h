@@ -73,6 +73,9 @@ class RadiosityView {
   /// so light does not leak across a roof line or a wall that no element edge follows, and the
   /// solution's own error enters one bounce later, damped by the reflectance there.
   Rgb gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const;
+  /// One sample of gathered_irradiance: one shadow ray and one gather ray, drawn from ctx's
+  /// sampler as it stands (a sub-sample of a set the caller split).
+  Rgb gathered_sample(const rc::SurfacePoint& p, rc::SampleContext& ctx) const;
 
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
