@@ -52,8 +52,10 @@ class RadiosityView {
   /// Irradiance (W·m⁻²) the solution gives a point of the input at p whose lit side faces along
   /// the unit normal n from other surfaces' reflections (the direct light left out): interpolated
   /// at the nearest point of an element that faces the same way (within 60°) and lies within
-  /// reach (twice the target edge), unless p lies behind the element's plane by more than a
-  /// chord of a concave surface could. Nothing where no element does: the back of a one-sided surface, a face removed as buried, a mirror or glass.
+  /// reach (twice the target edge), unless p lies farther behind or in front of the element's
+  /// plane than a curved surface the element is a chord of could. Nothing where no element does:
+  /// the back of a one-sided surface, the inside of an open shell, a face removed as buried, a
+  /// mirror or glass.
   std::optional<Rgb> indirect_irradiance(const rc::SurfacePoint& p, const Vec3& n) const;
 
   /// Where irradiance() reads the solution for a point of the input at p with lit side along n:
@@ -84,8 +86,8 @@ class RadiosityView {
   /// With via_specular_only, only what the ray brings through a mirror or glass it meets first.
   Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx,
              bool via_specular_only = false) const;
-  /// locate(), unless p lies behind the element's plane by more than a chord of a concave
-  /// surface could (see indirect_irradiance).
+  /// locate(), unless p lies farther from the element's plane than a curved surface the element
+  /// is a chord of could (see indirect_irradiance).
   std::optional<Location> locate_on(const rc::SurfacePoint& p, const Vec3& n) const;
   Rgb indirect_at(const Location& at) const;
   Rgb mesh_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
