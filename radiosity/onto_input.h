@@ -132,9 +132,11 @@ struct InputPoint {
 std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const RadiosityMesh& mesh, size_t v,
                                               const Vec3& offset, float radius);
 
-/// `gilt radiosity --onto elements --bake-gather N`: the solution with each vertex's irradiance
-/// traced (SolutionAtInput's final gather) from the point of the input surface under it, at the
-/// input face's normal, and its radiosity and the element means recomputed from it. On a scan the
+/// `gilt radiosity --onto elements --bake-gather N`: the solution with each vertex's irradiance the
+/// mean of N samples (RadiosityView::gathered_sample: one shadow ray, one gather ray), each from
+/// its own point of the input under the vertex's disk (vertex_disk_radius, input_surface_under)
+/// at that input face's normal, and its radiosity and the element means recomputed from it; past
+/// gather.deadline a vertex keeps the solve's value and counts as late. On a scan the
 /// remeshed surface's smoothed normals and coarser silhouette move shadows and facing; the gather
 /// sees the input itself. Vertices with no input surface under them keep the solve's value;
 /// vertex_direct and vertex_punctual stay the solve's. For exports and checks, not for a view.
