@@ -179,6 +179,9 @@ std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const Radi
   return InputPoint{ray, si};
 }
 
+/// How many points of a vertex's disk gather_at_vertices may draw per sample it takes.
+constexpr uint32_t kDiskAttempts = 16;
+
 Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, BakeGather gather,
                             BakeGatherCount* count) {
   Solution out = solution;
@@ -198,11 +201,16 @@ Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, Ba
     // under a remeshed vertex lie on facets turned more than 30° from it.
     const rc::Frame frame = rc::Frame::from_normal(mesh.normals[v]);
     rc::SampleContext ctx{rc::Sampler::for_pixel_sample(rc::SamplerKind::sobol, gather.seed, v, 0), 0};
-    const rc::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(rays));
+    // Points that miss the input under the disk, or land past a crease, are drawn again, up to
+    // kDiskAttempts per sample: a vertex at a crease or a silhouette may have a small share of
+    // its disk on its side (under 10 % for some of the bunny's), and its N samples would
+    // otherwise be a handful.
+    const uint32_t attempts = uint32_t(rays) * kDiskAttempts;
+    const rc::Sampler::SubSamples samples = ctx.sampler.split(attempts);
     Rgb sum(0.0f);
     int taken = 0;
-    for (int r = 0; r < rays; ++r) {
-      rc::SampleContext sub{samples[uint32_t(r)], 0};
+    for (uint32_t j = 0; j < attempts && taken < rays; ++j) {
+      rc::SampleContext sub{samples[j], 0};
       const rc::Vec2 u = rc::sample_uniform_disk(sub.sampler.uniform2()) * radius[v];
       const std::optional<InputPoint> under =
           input_surface_under(scene, mesh, v, frame.to_world(Vec3(u.x, u.y, 0.0f)), radius[v]);
