@@ -73,7 +73,9 @@ class RadiosityView {
   /// gather ray that reads the solution where it lands (its element's direct light and reflected
   /// light, through mirrors and glass). The final gather of a bake: what a point sees is traced,
   /// so light does not leak across a roof line or a wall that no element edge follows, and the
-  /// solution's own error enters one bounce later, damped by the reflectance there.
+  /// solution's own error enters one bounce later, damped by the reflectance there. A gather ray
+  /// that lands closer than twice its element's size bounces on (up to 8 times) instead of reading
+  /// it: in a crevice or a contact shadow the elements smear the light that the point sees.
   Rgb gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const;
   /// One sample of gathered_irradiance: one shadow ray and one gather ray, drawn from ctx's
   /// sampler as it stands (a sub-sample of a set the caller split).
@@ -90,6 +92,9 @@ class RadiosityView {
   /// is a chord of could (see indirect_irradiance).
   std::optional<Location> locate_on(const rc::SurfacePoint& p, const Vec3& n) const;
   Rgb indirect_at(const Location& at) const;
+  /// Whether a gather ray that met the surface `distance` from its origin, where `at` locates
+  /// it, is too close to read the solution there (kNearHit).
+  bool near_hit(const Location& at, float distance) const;
   Rgb mesh_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
   Rgb two_pass_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
 
