@@ -90,6 +90,9 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   positions_ = mesh.positions;
   element_normal_ = mesh.element_normal;
   element_direct_ = solution.element_direct;
+  sky_by_gather_ = rc::sky_left_to_bsdf_sampling(scene);
+  for (const rc::Light& l : scene.lights())
+    if (l.kind == rc::LightKind::environment && !l.map) constant_sky_ += l.radiance;
   has_specular_ = std::any_of(scene.materials.begin(), scene.materials.end(),
                               [](const rc::Material& m) { return m.is_traced_through(); });
   // An input point lies within about an element's size of the element that stands for it
@@ -170,12 +173,14 @@ Rgb RadiosityView::gathered_sample(const rc::SurfacePoint& p, rc::SampleContext&
   si.ns = p.ng;
   const rc::Frame frame = rc::Frame::from_normal(p.ng);
   const Vec3 wo(0.0f, 0.0f, 1.0f);
-  return rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays) * rc::kPi +
-         gather(si, frame, true, ctx);
+  // A uniform sky comes by the gather ray when it escapes, rather than by a shadow ray of its own
+  // (sky_left_to_bsdf_sampling): exact where the sky is open, and one ray fewer.
+  return rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays, !sky_by_gather_) * rc::kPi +
+         gather(si, frame, true, ctx, false, sky_by_gather_);
 }
 
 Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
-                          rc::SampleContext& ctx, bool via_specular_only) const {
+                          rc::SampleContext& ctx, bool via_specular_only, bool sky_on_escape) const {
   // One cosine-distributed ray on the lit side: its estimate of the irradiance is the radiance
   // it finds times π.
   const Vec3 side = wo_above ? si.ng : -si.ng;
@@ -192,7 +197,10 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
     const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    if (!hit) return via_specular ? out + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction)) : out;
+    if (!hit) {
+      if (via_specular) return out + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+      return depth == 0 && sky_on_escape ? out + beta * constant_sky_ : out;
+    }
     const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
     rc::Material textured;
     const rc::Material& mj = scene_.shading_material(sj, textured);

@@ -86,8 +86,10 @@ class RadiosityView {
   /// cosine-distributed gather ray (through mirrors and glass), times π: where it lands, the
   /// element's mean direct light (or a shadow ray's) and the reflected light interpolated.
   /// With via_specular_only, only what the ray brings through a mirror or glass it meets first.
+  /// With sky_on_escape, a ray that escapes straight away brings the uniform sky's radiance
+  /// (the caller's direct light left it out: rc::sky_left_to_bsdf_sampling).
   Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx,
-             bool via_specular_only = false) const;
+             bool via_specular_only = false, bool sky_on_escape = false) const;
   /// locate(), unless p lies farther from the element's plane than a curved surface the element
   /// is a chord of could (see indirect_irradiance).
   std::optional<Location> locate_on(const rc::SurfacePoint& p, const Vec3& n) const;
@@ -107,6 +109,8 @@ class RadiosityView {
   std::vector<Vec3> element_normal_;
   std::vector<Rgb> element_direct_;          ///< per element (Solution::element_direct; may be empty)
   bool has_specular_ = false;                ///< the scene has mirrors or glass
+  bool sky_by_gather_ = false;               ///< gathered_sample takes the uniform sky by its gather ray
+  Rgb constant_sky_{0.0f};                   ///< radiance of the scene's environments without a map
   std::vector<std::array<uint32_t, 3>> elements_;
   float reach_ = 0.0f;                       ///< how far from an element the two-pass view looks it up
 };

@@ -47,12 +47,26 @@ DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, con
 }
 
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                    const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
+                    const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays, bool constant_sky) {
   const size_t count = scene.lights().size();
   if (count > kEachLightLimit) return sample_direct(scene, si, m, frame, wo, wo_above, sampler, rays).value;
   Rgb sum(0.0f);
-  for (uint32_t li = 0; li < count; ++li) sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, sampler, rays).value;
+  for (uint32_t li = 0; li < count; ++li) {
+    const Light& light = scene.lights()[li];
+    if (!constant_sky && light.kind == LightKind::environment && !light.map) {
+      sampler.uniform2();  // keep the dimensions of the next requests where they would be
+      continue;
+    }
+    sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, sampler, rays).value;
+  }
   return sum;
+}
+
+bool sky_left_to_bsdf_sampling(const Scene& scene) {
+  if (scene.lights().size() > kEachLightLimit) return false;
+  for (const Light& light : scene.lights())
+    if (light.kind == LightKind::environment && !light.map) return true;
+  return false;
 }
 
 }  // namespace gilt::raytrace_core

@@ -46,7 +46,16 @@ inline constexpr size_t kEachLightLimit = 8;
 /// none of the noise of choosing between them (chosen by power with probability p, a sunlit
 /// point's sun reads either 0 or 1/p times its value). With more, one sample of a light chosen by
 /// power, as sample_direct.
+/// With constant_sky false and at most kEachLightLimit lights, constant environments (no map) are
+/// left out: the caller takes their light by BSDF sampling (sky_left_to_bsdf_sampling).
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
-                    const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays);
+                    const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays, bool constant_sky = true);
+
+/// Whether estimate_direct(…, constant_sky = false) leaves a constant environment out: the scene
+/// has one, among at most kEachLightLimit lights. For a Lambertian point under a uniform sky,
+/// a cosine-distributed ray that escapes finds exactly πL·(its share of the open sky); sampled
+/// uniformly over the sphere as a light, one sample has a standard deviation of 1.29 times the
+/// mean even where nothing blocks the sky.
+bool sky_left_to_bsdf_sampling(const Scene& scene);
 
 }  // namespace gilt::raytrace_core

@@ -217,16 +217,14 @@ TEST(Lightmap, TexelsHoldTheSunAndSkyAndThePanelsShadows) {
 
 TEST(Lightmap, FinalGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   // --bake-gather traces each point's light. On the panels' tops nothing but the sun and the sky
-  // reaches: E = 2 + 0.3π, with the sun exact and the sky sampled by the environment's own
-  // sampling (uniform over the sphere for a constant sky). One sample of it is 4πL·cos θ on the
-  // upper half and 0 below, of mean πL and standard deviation πL·√(5/3); 4,096 samples give a
-  // standard error of 0.019, and the test allows four of them. The gather rays escape to the
-  // sky and add nothing there.
+  // reaches: E = 2 + 0.3π, the sun by its shadow ray and the uniform sky by the gather rays,
+  // every one of which escapes and brings πL (rc::sky_left_to_bsdf_sampling): exact, up to
+  // float rounding in the sum of 4,096 samples.
   const fs::path dir = fresh_dir("gather");
   const Solved s = solve(write_model(dir), 400);
   const double sky = 0.3 * M_PI, open = 2.0 + sky;
   const int rays = 4096;
-  const double tolerance = 4.0 * sky * std::sqrt(5.0 / 3.0) / std::sqrt(double(rays));
+  const double tolerance = 1e-4 * open;
   const rad::SolutionAtInput gathered(s.scene, s.solution, rad::Quantity::irradiance, rad::BakeGather{rays, 3});
   const rc::Material& grey = s.scene.materials[s.scene.meshes[0].material];
   int tops = 0;
@@ -264,14 +262,12 @@ TEST(Lightmap, FinalGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
 TEST(Lightmap, VertexGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   // `--onto elements --bake-gather N` (gather_at_vertices): each vertex of the element mesh takes
   // its light from N points of the input under the disk it stands for. On the panels' tops only
-  // the sun and the sky reach: E = 2 + 0.3π, each ray's estimate of the sky of standard deviation
-  // πL·√(5/3) as in the test above; 4,096 rays give a standard error of 0.019 per vertex, and the
-  // test allows four of them.
+  // the sun and the sky reach: E = 2 + 0.3π, exact at every sample as in the test above.
   const fs::path dir = fresh_dir("vertex-gather");
   const Solved s = solve(write_model(dir), 400);
-  const double sky = 0.3 * M_PI, open = 2.0 + sky;
+  const double open = 2.0 + 0.3 * M_PI;
   const int rays = 4096;
-  const double tolerance = 4.0 * sky * std::sqrt(5.0 / 3.0) / std::sqrt(double(rays));
+  const double tolerance = 1e-4 * open;
   rad::BakeGatherCount count;
   const rad::Solution gathered = rad::gather_at_vertices(s.scene, s.solution, rad::BakeGather{rays, 3}, &count);
   const rad::RadiosityMesh& mesh = s.solution.mesh;
