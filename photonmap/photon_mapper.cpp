@@ -103,7 +103,7 @@ rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& norm
       const float pmf = chosen.pmf;
       const rc::Vec2 u_light = sampler.uniform2();
       if (!(pmf > 0.0f)) continue;
-      const rc::LightSample ls = rc::sample_light(scene_, lights[chosen.light], at, u_light);
+      const rc::LightSample ls = rc::sample_light(scene_, lights[chosen.light], at, u_light, normal);
       const float cos_theta = glm::dot(ls.wi, normal);
       if (!(ls.pdf > 0.0f) || !(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
       if (scene_.occluded(ls.shadow_ray)) continue;
@@ -216,7 +216,8 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
           float w = 1.0f;
           if (!through_specular && !bs->delta)
             w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    choice.pmf(light_query, li) * rc::light_pdf(scene_, lights[li], si, dir, si));
+                                    choice.pmf(light_query, li) *
+                                        rc::light_pdf(scene_, lights[li], si, dir, si, rc::receiving_normal(light_query)));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
           gathered += g * rc::environment_radiance(lights[li], dir) * w;

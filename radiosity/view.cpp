@@ -92,7 +92,7 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   element_direct_ = solution.element_direct;
   sky_by_gather_ = rc::sky_left_to_bsdf_sampling(scene);
   for (const rc::Light& l : scene.lights())
-    if (l.kind == rc::LightKind::environment && !l.map) constant_sky_ += l.radiance;
+    if (rc::is_constant_environment(l)) constant_sky_ += l.radiance;
   has_specular_ = std::any_of(scene.materials.begin(), scene.materials.end(),
                               [](const rc::Material& m) { return m.is_traced_through(); });
   // An input point lies within about an element's size of the element that stands for it

@@ -12,7 +12,8 @@ namespace {
 DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const SurfaceInteraction& si, const Material& m,
                         const Frame& frame, const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
   DirectSample out;
-  const LightSample ls = sample_light(scene, scene.lights()[li], si, sampler.uniform2());
+  const Vec3 receiving = receiving_normal(light_query(si, m, wo_above));
+  const LightSample ls = sample_light(scene, scene.lights()[li], si, sampler.uniform2(), receiving);
   // The light must be on wo's side of the geometric surface (no leaks), unless the surface
   // transmits into a lobe (a rough dielectric): then light from behind it counts too.
   if (!(ls.pdf > 0.0f) || ls.radiance.is_black()) return out;
@@ -53,7 +54,7 @@ Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Mate
   Rgb sum(0.0f);
   for (uint32_t li = 0; li < count; ++li) {
     const Light& light = scene.lights()[li];
-    if (!constant_sky && light.kind == LightKind::environment && !light.map) {
+    if (!constant_sky && is_constant_environment(light)) {
       sampler.uniform2();  // keep the dimensions of the next requests where they would be
       continue;
     }
@@ -65,7 +66,7 @@ Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Mate
 bool sky_left_to_bsdf_sampling(const Scene& scene) {
   if (scene.lights().size() > kEachLightLimit) return false;
   for (const Light& light : scene.lights())
-    if (light.kind == LightKind::environment && !light.map) return true;
+    if (is_constant_environment(light)) return true;
   return false;
 }
 

@@ -53,9 +53,9 @@ Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Mate
 
 /// Whether estimate_direct(…, constant_sky = false) leaves a constant environment out: the scene
 /// has one, among at most kEachLightLimit lights. For a Lambertian point under a uniform sky,
-/// a cosine-distributed ray that escapes finds exactly πL·(its share of the open sky); sampled
-/// uniformly over the sphere as a light, one sample has a standard deviation of 1.29 times the
-/// mean even where nothing blocks the sky.
+/// a cosine-distributed ray that escapes finds exactly πL·(its share of the open sky). Light
+/// sampling now draws the same cosine distribution (sample_light's receiving side), so leaving
+/// the sky to the caller's ray saves a shadow ray rather than noise.
 bool sky_left_to_bsdf_sampling(const Scene& scene);
 
 }  // namespace gilt::raytrace_core

@@ -1,6 +1,7 @@
 // Light sampling: area lights by the solid angle they subtend (triangles, where it is neither tiny
 // nor nearly a hemisphere; by area otherwise) or by the cone they subtend (spheres),
-// delta lights directly, the environment uniformly over the sphere (PBRT 4th ed., ch. 12).
+// delta lights directly, an environment map by its importance and a constant environment by the
+// cosine about the receiving side, or uniformly over the sphere (PBRT 4th ed., ch. 12).
 
 #include "raytrace_core/light.h"
 
@@ -184,7 +185,8 @@ double triangle_light_solid_angle(const Scene& scene, const Light& light, const 
   return t ? t->solid_angle() : 0.0;
 }
 
-LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u) {
+LightSample sample_light(const Scene& scene, const Light& light, const SurfacePoint& ref, Vec2 u,
+                         const Vec3& receiving) {
   LightSample ls;
   switch (light.kind) {
     case LightKind::area_triangle:
@@ -266,6 +268,11 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
         ls.wi = s.wi;
         ls.pdf = s.pdf;
         ls.radiance = light.radiance * s.radiance;
+      } else if (receiving != Vec3(0.0f)) {  // cosine-distributed over the receiving side
+        ls.wi = Frame::from_normal(receiving).to_world(sample_cosine_hemisphere(u));
+        ls.pdf = cosine_hemisphere_pdf(glm::dot(ls.wi, receiving));
+        if (!(ls.pdf > 0.0f)) return ls;  // on the horizon, within rounding
+        ls.radiance = light.radiance;
       } else {
         ls.wi = sample_uniform_sphere(u);
         ls.pdf = uniform_sphere_pdf();
@@ -278,7 +285,7 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
 }
 
 float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref, const Vec3& wi,
-                const SurfacePoint& on_light) {
+                const SurfacePoint& on_light, const Vec3& receiving) {
   switch (light.kind) {
     case LightKind::area_triangle:
       if (const std::optional<SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p))
@@ -290,7 +297,9 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
         return area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, on_light);
       return 1.0f / (2.0f * kPi * sphere_cone(s, ref.p).one_minus_cos);
     }
-    case LightKind::environment: return light.map ? light.map->pdf(wi) : uniform_sphere_pdf();
+    case LightKind::environment:
+      if (light.map) return light.map->pdf(wi);
+      return receiving != Vec3(0.0f) ? cosine_hemisphere_pdf(glm::dot(wi, receiving)) : uniform_sphere_pdf();
     case LightKind::point:
     case LightKind::spot:
     case LightKind::directional: return 0.0f;

@@ -25,6 +25,10 @@ struct LightQuery {
   bool two_sided = false;  ///< light from behind n counts too (a surface that transmits)
 };
 
+/// The normal sample_light and light_pdf take as the receiving side: n, or zero when light from
+/// behind n counts too.
+inline Vec3 receiving_normal(const LightQuery& query) { return query.two_sided ? Vec3(0.0f) : query.n; }
+
 /// A light chosen for a query, and the probability of choosing it.
 struct LightChoice {
   uint32_t light = 0;  ///< index into the lights the sampler was built over

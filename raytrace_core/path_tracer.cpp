@@ -28,7 +28,8 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
       for (const uint32_t li : scene.environment_lights()) {
         float weight = 1.0f;
         if (!specular_bounce) {
-          const float light_pdf_v = light_choice.pmf(prev_query, li) * light_pdf(scene, lights[li], prev, -wo_world, prev);
+          const float light_pdf_v = light_choice.pmf(prev_query, li) *
+                                    light_pdf(scene, lights[li], prev, -wo_world, prev, receiving_normal(prev_query));
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
         radiance += beta * environment_radiance(lights[li], -wo_world) * weight;
