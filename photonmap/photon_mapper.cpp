@@ -173,18 +173,15 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   const rc::Vec3 lit_side = wo_above ? si.ng : -si.ng;
   const EstimateQuery query{si.p, lit_side, size_t(settings_.k), max_radius2_};
   const auto& lights = scene_.lights();
-  const rc::LightSampler& choice = scene_.light_sampler();
-  const rc::LightQuery light_query = rc::light_query(si, m, wo_above);  // sample_direct's, for MIS
+  const rc::LightQuery light_query = rc::light_query(si, m, wo_above);  // sample_direct_mis's, for MIS
   const int gather = settings_.gather_rays;
   rc::Rgb l(0.0f);
 
   // Caustics from their map.
   l += estimate_radiance(maps_.caustic, query, m, frame, wo, thread_scratch());
 
-  // Direct light: one light sample, MIS-weighted against the gather rays as BSDF samples.
-  if (const rc::DirectSample ds = rc::sample_direct(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
-      !ds.value.is_black())
-    l += ds.value * (ds.delta || gather == 0 ? 1.0f : rc::power_heuristic(1.0f, ds.pdf, float(gather), rc::bsdf_pdf(m, wo, ds.wi)));
+  // Direct light, MIS-weighted against the gather rays as BSDF samples.
+  l += rc::sample_direct_mis(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays, float(gather));
   if (gather == 0) {
     // Without a final gather the global map is read at x itself.
     l += estimate_radiance(scene_, maps_.global, query, m, frame, wo, thread_scratch());
@@ -216,7 +213,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
           float w = 1.0f;
           if (!through_specular && !bs->delta)
             w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    choice.pmf(light_query, li) *
+                                    rc::light_choice_pmf(scene_, light_query, li) *
                                         rc::light_pdf(scene_, lights[li], si, dir, si, rc::receiving_normal(light_query)));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
@@ -237,7 +234,7 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
           float w = 1.0f;
           if (!through_specular && sj.light >= 0)
             w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    choice.pmf(light_query, uint32_t(sj.light)) * rc::light_pdf(scene_, lights[sj.light], si, dir, sj));
+                                    rc::light_choice_pmf(scene_, light_query, uint32_t(sj.light)) * rc::light_pdf(scene_, lights[sj.light], si, dir, sj));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
           gathered += g * le * w;

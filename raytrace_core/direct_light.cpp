@@ -63,6 +63,27 @@ Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Mate
   return sum;
 }
 
+bool samples_each_light(const Scene& scene) {
+  return scene.lights().size() <= kEachLightLimit && scene.lights().size() == scene.punctual_lights.size();
+}
+
+float light_choice_pmf(const Scene& scene, const LightQuery& query, uint32_t light) {
+  return samples_each_light(scene) ? 1.0f : scene.light_sampler().pmf(query, light);
+}
+
+Rgb sample_direct_mis(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
+                      const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays, float bsdf_samples) {
+  const auto weighted = [&](const DirectSample& ds) {
+    if (ds.value.is_black() || ds.delta || bsdf_samples == 0.0f) return ds.value;
+    return ds.value * power_heuristic(1.0f, ds.pdf, bsdf_samples, bsdf_pdf(m, wo, ds.wi));
+  };
+  if (!samples_each_light(scene)) return weighted(sample_direct(scene, si, m, frame, wo, wo_above, sampler, rays));
+  Rgb sum(0.0f);
+  for (uint32_t li = 0; li < scene.lights().size(); ++li)
+    sum += weighted(sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, sampler, rays));
+  return sum;
+}
+
 bool sky_left_to_bsdf_sampling(const Scene& scene) {
   if (scene.lights().size() > kEachLightLimit) return false;
   for (const Light& light : scene.lights())

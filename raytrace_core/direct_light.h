@@ -51,6 +51,25 @@ inline constexpr size_t kEachLightLimit = 8;
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
                     const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays, bool constant_sky = true);
 
+/// Whether sample_direct_mis samples every light: at most kEachLightLimit lights, all of them
+/// point, spot, directional or environment lights. A sun and a sky then both count at every
+/// bounce, one shadow ray apiece, instead of one chosen by power (a sunlit point read 0 or 1/p
+/// times its sun). Emitting surfaces are left to the light sampler: their triangles come in
+/// numbers, and two triangles of one lamp gain nothing from a ray each.
+bool samples_each_light(const Scene& scene);
+
+/// The probability with which next-event estimation at `query` sampled light `light`, for the
+/// MIS weight of a BSDF-sampled ray that reaches it: 1 where sample_direct_mis samples every
+/// light, else the light sampler's choice of it.
+float light_choice_pmf(const Scene& scene, const LightQuery& query, uint32_t light);
+
+/// Next-event estimation weighted against `bsdf_samples` BSDF samples by the power heuristic
+/// (zero: unweighted): what a path tracer, or a final gather of that many rays, adds at a surface.
+/// Every light once where samples_each_light, else one light by sample_direct. A BSDF-sampled ray
+/// that reaches light `li` weighs itself with light_choice_pmf(…, li) times its light_pdf.
+Rgb sample_direct_mis(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
+                      const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays, float bsdf_samples = 1.0f);
+
 /// Whether estimate_direct(…, constant_sky = false) leaves a constant environment out: the scene
 /// has one, among at most kEachLightLimit lights. For a Lambertian point under a uniform sky,
 /// a cosine-distributed ray that escapes finds exactly πL·(its share of the open sky). Light

@@ -10,7 +10,6 @@ namespace gilt::raytrace_core {
 
 Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx, const PathSettings& settings) {
   const auto& lights = scene.lights();
-  const LightSampler& light_choice = scene.light_sampler();
   Rgb radiance(0.0f), beta(1.0f);
   Ray ray = camera_ray;
   bool specular_bounce = true;  // the camera counts as a delta event: emission seen directly is not weighted
@@ -28,7 +27,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
       for (const uint32_t li : scene.environment_lights()) {
         float weight = 1.0f;
         if (!specular_bounce) {
-          const float light_pdf_v = light_choice.pmf(prev_query, li) *
+          const float light_pdf_v = light_choice_pmf(scene, prev_query, li) *
                                     light_pdf(scene, lights[li], prev, -wo_world, prev, receiving_normal(prev_query));
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
@@ -52,7 +51,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
         float weight = 1.0f;
         if (!specular_bounce && si.light >= 0) {
           const float light_pdf_v =
-              light_choice.pmf(prev_query, uint32_t(si.light)) * light_pdf(scene, lights[si.light], prev, -wo_world, si);
+              light_choice_pmf(scene, prev_query, uint32_t(si.light)) * light_pdf(scene, lights[si.light], prev, -wo_world, si);
           weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
         radiance += beta * le * weight;
@@ -65,11 +64,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
 
     // Next-event estimation, MIS-weighted against BSDF sampling.
-    if (!m.is_specular()) {
-      const DirectSample ds = sample_direct(scene, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
-      if (!ds.value.is_black())
-        radiance += beta * ds.value * (ds.delta ? 1.0f : power_heuristic(1.0f, ds.pdf, 1.0f, bsdf_pdf(m, wo, ds.wi)));
-    }
+    if (!m.is_specular()) radiance += beta * sample_direct_mis(scene, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
 
     // Continue the path by sampling the BSDF.
     const float u_lobe = ctx.sampler.uniform();

@@ -92,3 +92,66 @@ TEST(DirectLight, SunAndSkyMeanMatchesTheClosedForm) {
   }
   EXPECT_EQ(rays, 2u * 2000u) << "one shadow ray per light and call";
 }
+
+// The path tracer's next-event estimation (sample_direct_mis) under a sun and a sky samples both
+// at every call. The sun, a delta light, counts in full; the sky's sample, drawn by the cosine
+// about the floor, has the Lambertian BSDF's own density, so the power heuristic gives it weight
+// ½ (the BSDF-sampled rays that escape carry the other half). Every call is then
+// ρ (E cos θ / π + L / 2), up to float rounding. Choosing one of the two by power, a call read
+// the sun as 0 or 1/p times its part.
+TEST(DirectLight, PathTracerSamplesBothSunAndSkyAtEveryBounce) {
+  rc::Light sky;
+  sky.kind = rc::LightKind::environment;
+  sky.radiance = Rgb(0.5f);
+  const rc::Scene scene = open_floor({sun(Vec3(0.3f, -1.0f, 0.2f), 4.0f), sky});
+  ASSERT_TRUE(rc::samples_each_light(scene));
+  const rc::SurfaceInteraction si = floor_point(scene);
+  const rc::Material& m = scene.materials[si.material];
+  const rc::LightQuery query = rc::light_query(si, m, true);
+  EXPECT_EQ(rc::light_choice_pmf(scene, query, 0), 1.0f);
+  EXPECT_EQ(rc::light_choice_pmf(scene, query, 1), 1.0f);
+  const rc::Frame frame = rc::Frame::from_normal(si.ns);
+  const Vec3 wo = frame.to_local(Vec3(0.0f, 1.0f, 0.0f));
+  const double cos_sun = 1.0 / std::sqrt(0.3 * 0.3 + 1.0 + 0.2 * 0.2);
+  const double expected = kAlbedo * (4.0 * cos_sun / rc::kPi + 0.5 / 2.0);
+  rc::Sampler rng(rc::Rng(9));
+  uint64_t rays = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double e = rc::sample_direct_mis(scene, si, m, frame, wo, true, rng, rays).r;
+    ASSERT_NEAR(e, expected, 1e-5 * expected) << "call " << i;
+  }
+  EXPECT_EQ(rays, 2u * 2000u) << "one shadow ray per light and call";
+}
+
+// Emitting surfaces are left to the light sampler: with one emitting triangle among the lights,
+// sample_direct_mis chooses one light per call, and a BSDF-sampled ray is weighed with the
+// sampler's own probability of that light.
+TEST(DirectLight, EmittingSurfacesAreChosenByTheLightSampler) {
+  rc::Scene scene;
+  scene.materials.push_back(rc::Material::make_diffuse("floor", Rgb(kAlbedo)));
+  rc::Material lamp = rc::Material::make_diffuse("lamp", Rgb(0.0f));
+  lamp.emission = Rgb(5.0f);
+  scene.materials.push_back(lamp);
+  rc::TriangleMesh floor;
+  floor.positions = {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}};
+  floor.indices = {0, 1, 2, 0, 2, 3};
+  rc::TriangleMesh light;
+  light.positions = {{0, 3, 0}, {1, 3, 0}, {0, 3, 1}};
+  light.indices = {0, 2, 1};
+  light.material = 1;
+  scene.meshes = {floor, light};
+  scene.punctual_lights = {sun(Vec3(0.0f, -1.0f, 0.0f), 4.0f)};
+  scene.commit();
+  ASSERT_EQ(scene.lights().size(), 2u);
+  EXPECT_FALSE(rc::samples_each_light(scene));
+  const rc::SurfaceInteraction si = floor_point(scene);
+  const rc::LightQuery query = rc::light_query(si, scene.materials[si.material], true);
+  for (uint32_t li = 0; li < 2; ++li)
+    EXPECT_EQ(rc::light_choice_pmf(scene, query, li), scene.light_sampler().pmf(query, li));
+  const rc::Frame frame = rc::Frame::from_normal(si.ns);
+  rc::Sampler rng(rc::Rng(10));
+  uint64_t rays = 0;
+  for (int i = 0; i < 100; ++i)
+    rc::sample_direct_mis(scene, si, scene.materials[si.material], frame, frame.to_local(Vec3(0, 1, 0)), true, rng, rays);
+  EXPECT_LE(rays, 100u) << "at most one shadow ray per call";
+}
