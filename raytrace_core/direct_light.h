@@ -1,8 +1,10 @@
 #pragma once
-// Next-event estimation: light arriving at a surface point straight from one light, chosen by
-// power, through one shadow ray. One routine for every method; each caller applies its own
-// multiple-importance weight (Veach 1997), as Tungsten's TraceBase::estimateDirect is shared by
-// its path and photon tracers.
+// Next-event estimation: light arriving at a surface point straight from the lights, through
+// shadow rays: one light chosen by the light sampler (sample_direct), or every light of a few
+// (estimate_direct; sample_direct_mis, MIS-weighted against BSDF sampling). One set of routines
+// for every method, as Tungsten's TraceBase::estimateDirect is shared by its path and photon
+// tracers; pbrt-v4's path tracer always chooses one light, which under a sun and a sky leaves a
+// sunlit point reading its sun as 0 or 1/p times its value.
 
 #include <cstddef>
 #include <cstdint>
