@@ -155,7 +155,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
           const rc::Vec3 wo = frame.to_local(wo_world);
           const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
           if (!m.is_traced_through()) {
-            direct += beta * rc::sample_direct(scene, si, m, frame, wo, wo_above, sampler, local_rays).value;
+            direct += beta * rc::sample_direct_mis(scene, si, m, frame, wo, wo_above, sampler, local_rays, 0.0f);
             ps.visible = true;
             ps.position = si.p;
             ps.lit_side = wo_above ? si.ng : -si.ng;
