@@ -8,11 +8,12 @@ namespace gilt::raytrace_core {
 
 namespace {
 
-/// One sample of light `li`, chosen with probability `pmf`.
+/// One sample of light `li`, chosen with probability `pmf`; `receiving` is receiving_normal() of the
+/// point's light query, computed once by the caller for all its lights.
 DirectSample sample_one(const Scene& scene, uint32_t li, float pmf, const SurfaceInteraction& si, const Material& m,
-                        const Frame& frame, const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
+                        const Frame& frame, const Vec3& wo, bool wo_above, const Vec3& receiving, Sampler& sampler,
+                        uint64_t& rays) {
   DirectSample out;
-  const Vec3 receiving = receiving_normal(light_query(si, m, wo_above));
   const LightSample ls = sample_light(scene, scene.lights()[li], si, sampler.uniform2(), receiving);
   // The light must be on wo's side of the geometric surface (no leaks), unless the surface
   // transmits into a lobe (a rough dielectric): then light from behind it counts too.
@@ -39,18 +40,21 @@ DirectSample sample_direct(const Scene& scene, const SurfaceInteraction& si, con
                            const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays) {
   const LightSampler& lights = scene.light_sampler();
   if (lights.size() == 0) return {};
-  const LightChoice choice = lights.sample(light_query(si, m, wo_above), sampler.uniform());
+  const LightQuery query = light_query(si, m, wo_above);
+  const LightChoice choice = lights.sample(query, sampler.uniform());
   if (!(choice.pmf > 0.0f)) {
     sampler.uniform2();  // keep the dimensions of the next requests where they would be
     return {};
   }
-  return sample_one(scene, choice.light, choice.pmf, si, m, frame, wo, wo_above, sampler, rays);
+  return sample_one(scene, choice.light, choice.pmf, si, m, frame, wo, wo_above, receiving_normal(query), sampler,
+                    rays);
 }
 
 Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Material& m, const Frame& frame,
                     const Vec3& wo, bool wo_above, Sampler& sampler, uint64_t& rays, bool constant_sky) {
   const size_t count = scene.lights().size();
   if (count > kEachLightLimit) return sample_direct(scene, si, m, frame, wo, wo_above, sampler, rays).value;
+  const Vec3 receiving = receiving_normal(light_query(si, m, wo_above));
   Rgb sum(0.0f);
   for (uint32_t li = 0; li < count; ++li) {
     const Light& light = scene.lights()[li];
@@ -58,7 +62,7 @@ Rgb estimate_direct(const Scene& scene, const SurfaceInteraction& si, const Mate
       sampler.uniform2();  // keep the dimensions of the next requests where they would be
       continue;
     }
-    sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, sampler, rays).value;
+    sum += sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, receiving, sampler, rays).value;
   }
   return sum;
 }
@@ -78,9 +82,10 @@ Rgb sample_direct_mis(const Scene& scene, const SurfaceInteraction& si, const Ma
     return ds.value * power_heuristic(1.0f, ds.pdf, bsdf_samples, bsdf_pdf(m, wo, ds.wi));
   };
   if (!samples_each_light(scene)) return weighted(sample_direct(scene, si, m, frame, wo, wo_above, sampler, rays));
+  const Vec3 receiving = receiving_normal(light_query(si, m, wo_above));
   Rgb sum(0.0f);
   for (uint32_t li = 0; li < scene.lights().size(); ++li)
-    sum += weighted(sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, sampler, rays));
+    sum += weighted(sample_one(scene, li, 1.0f, si, m, frame, wo, wo_above, receiving, sampler, rays));
   return sum;
 }
 

@@ -29,12 +29,23 @@ rc::Scene open_floor(const std::vector<rc::Light>& lights) {
   return scene;
 }
 
-/// The floor's surface under the camera ray straight down onto (0.5, 0, 0.3).
-rc::SurfaceInteraction floor_point(const rc::Scene& scene) {
+/// The floor's point (0.5, 0, 0.3) seen straight from above: its surface, its shading frame and
+/// the direction towards the viewer in that frame.
+struct FloorView {
+  rc::SurfaceInteraction si;
+  rc::Frame frame;
+  Vec3 wo;
+};
+
+FloorView view_from_above(const rc::Scene& scene) {
   const rc::Ray down{Vec3(0.5f, 1.0f, 0.3f), Vec3(0.0f, -1.0f, 0.0f)};
   const auto hit = scene.intersect(down);
   EXPECT_TRUE(hit.has_value());
-  return scene.surface(down, *hit);
+  FloorView v;
+  v.si = scene.surface(down, *hit);
+  v.frame = rc::Frame::from_normal(v.si.ns);
+  v.wo = v.frame.to_local(Vec3(0.0f, 1.0f, 0.0f));
+  return v;
 }
 
 rc::Light sun(Vec3 towards_ground, float irradiance) {
@@ -42,6 +53,13 @@ rc::Light sun(Vec3 towards_ground, float irradiance) {
   l.kind = rc::LightKind::directional;
   l.direction = glm::normalize(towards_ground);
   l.irradiance = Rgb(irradiance);
+  return l;
+}
+
+rc::Light constant_sky(float radiance) {
+  rc::Light l;
+  l.kind = rc::LightKind::environment;
+  l.radiance = Rgb(radiance);
   return l;
 }
 
@@ -57,14 +75,12 @@ TEST(DirectLight, EveryLightOfAFewIsSampledAtEachPoint) {
   point.intensity = Rgb(3.0f);
   const Vec3 sun_travel(0.6f, -0.8f, 0.0f);
   const rc::Scene scene = open_floor({sun(sun_travel, 2.0f), point});
-  const rc::SurfaceInteraction si = floor_point(scene);
-  const rc::Frame frame = rc::Frame::from_normal(si.ns);
-  const Vec3 wo = frame.to_local(Vec3(0.0f, 1.0f, 0.0f));
+  const FloorView v = view_from_above(scene);
   const float expected = kAlbedo / rc::kPi * (2.0f * 0.8f + 3.0f / 4.0f);
   rc::Sampler rng(rc::Rng{});
   uint64_t rays = 0;
   for (int i = 0; i < 64; ++i) {
-    const Rgb e = rc::estimate_direct(scene, si, scene.materials[si.material], frame, wo, true, rng, rays);
+    const Rgb e = rc::estimate_direct(scene, v.si, scene.materials[v.si.material], v.frame, v.wo, true, rng, rays);
     ASSERT_NEAR(e.r, expected, 1e-5f * expected) << "call " << i;
   }
   EXPECT_EQ(rays, 2u * 64u) << "one shadow ray per light and call";
@@ -75,19 +91,14 @@ TEST(DirectLight, EveryLightOfAFewIsSampledAtEachPoint) {
 // closed form ρ (E cos θ / π + L), up to float rounding of the cosine. (Drawn over the sphere, as
 // before, one sample had a standard deviation 1.29 times the sky's part.)
 TEST(DirectLight, SunAndSkyMeanMatchesTheClosedForm) {
-  rc::Light sky;
-  sky.kind = rc::LightKind::environment;
-  sky.radiance = Rgb(0.5f);
-  const rc::Scene scene = open_floor({sun(Vec3(0.0f, -1.0f, 0.0f), 4.0f), sky});
-  const rc::SurfaceInteraction si = floor_point(scene);
-  const rc::Frame frame = rc::Frame::from_normal(si.ns);
-  const Vec3 wo = frame.to_local(Vec3(0.0f, 1.0f, 0.0f));
+  const rc::Scene scene = open_floor({sun(Vec3(0.0f, -1.0f, 0.0f), 4.0f), constant_sky(0.5f)});
+  const FloorView v = view_from_above(scene);
   // The floor's 20 × 20 lies below the point: the whole upper hemisphere is open sky.
   const double expected = kAlbedo * (4.0 / rc::kPi + 0.5);
   rc::Sampler rng(rc::Rng(7));
   uint64_t rays = 0;
   for (int i = 0; i < 2000; ++i) {
-    const double e = rc::estimate_direct(scene, si, scene.materials[si.material], frame, wo, true, rng, rays).r;
+    const double e = rc::estimate_direct(scene, v.si, scene.materials[v.si.material], v.frame, v.wo, true, rng, rays).r;
     ASSERT_NEAR(e, expected, 1e-5 * expected) << "call " << i;
   }
   EXPECT_EQ(rays, 2u * 2000u) << "one shadow ray per light and call";
@@ -100,24 +111,19 @@ TEST(DirectLight, SunAndSkyMeanMatchesTheClosedForm) {
 // ρ (E cos θ / π + L / 2), up to float rounding. Choosing one of the two by power, a call read
 // the sun as 0 or 1/p times its part.
 TEST(DirectLight, PathTracerSamplesBothSunAndSkyAtEveryBounce) {
-  rc::Light sky;
-  sky.kind = rc::LightKind::environment;
-  sky.radiance = Rgb(0.5f);
-  const rc::Scene scene = open_floor({sun(Vec3(0.3f, -1.0f, 0.2f), 4.0f), sky});
+  const rc::Scene scene = open_floor({sun(Vec3(0.3f, -1.0f, 0.2f), 4.0f), constant_sky(0.5f)});
   ASSERT_TRUE(rc::samples_each_light(scene));
-  const rc::SurfaceInteraction si = floor_point(scene);
-  const rc::Material& m = scene.materials[si.material];
-  const rc::LightQuery query = rc::light_query(si, m, true);
+  const FloorView v = view_from_above(scene);
+  const rc::Material& m = scene.materials[v.si.material];
+  const rc::LightQuery query = rc::light_query(v.si, m, true);
   EXPECT_EQ(rc::light_choice_pmf(scene, query, 0), 1.0f);
   EXPECT_EQ(rc::light_choice_pmf(scene, query, 1), 1.0f);
-  const rc::Frame frame = rc::Frame::from_normal(si.ns);
-  const Vec3 wo = frame.to_local(Vec3(0.0f, 1.0f, 0.0f));
   const double cos_sun = 1.0 / std::sqrt(0.3 * 0.3 + 1.0 + 0.2 * 0.2);
   const double expected = kAlbedo * (4.0 * cos_sun / rc::kPi + 0.5 / 2.0);
   rc::Sampler rng(rc::Rng(9));
   uint64_t rays = 0;
   for (int i = 0; i < 2000; ++i) {
-    const double e = rc::sample_direct_mis(scene, si, m, frame, wo, true, rng, rays).r;
+    const double e = rc::sample_direct_mis(scene, v.si, m, v.frame, v.wo, true, rng, rays).r;
     ASSERT_NEAR(e, expected, 1e-5 * expected) << "call " << i;
   }
   EXPECT_EQ(rays, 2u * 2000u) << "one shadow ray per light and call";
@@ -144,14 +150,13 @@ TEST(DirectLight, EmittingSurfacesAreChosenByTheLightSampler) {
   scene.commit();
   ASSERT_EQ(scene.lights().size(), 2u);
   EXPECT_FALSE(rc::samples_each_light(scene));
-  const rc::SurfaceInteraction si = floor_point(scene);
-  const rc::LightQuery query = rc::light_query(si, scene.materials[si.material], true);
+  const FloorView v = view_from_above(scene);
+  const rc::Material& m = scene.materials[v.si.material];
+  const rc::LightQuery query = rc::light_query(v.si, m, true);
   for (uint32_t li = 0; li < 2; ++li)
     EXPECT_EQ(rc::light_choice_pmf(scene, query, li), scene.light_sampler().pmf(query, li));
-  const rc::Frame frame = rc::Frame::from_normal(si.ns);
   rc::Sampler rng(rc::Rng(10));
   uint64_t rays = 0;
-  for (int i = 0; i < 100; ++i)
-    rc::sample_direct_mis(scene, si, scene.materials[si.material], frame, frame.to_local(Vec3(0, 1, 0)), true, rng, rays);
+  for (int i = 0; i < 100; ++i) rc::sample_direct_mis(scene, v.si, m, v.frame, v.wo, true, rng, rays);
   EXPECT_LE(rays, 100u) << "at most one shadow ray per call";
 }
