@@ -72,9 +72,6 @@ void run_radiosity(RadiosityOptions& o) {
   if (o.fit != "least-squares" && !onto_input) throw rc::InputError("--fit applies to --onto input only");
   if (!o.check_points_file.empty()) {
     if (o.check_points == 0) throw rc::InputError("--check-points writes the points of --check N: give --check too");
-    if (!onto_input)
-      throw rc::InputError("--check-points applies to --onto input and --lightmap, whose check draws points on the "
-                           "input's faces");
     const std::filesystem::path parent = std::filesystem::absolute(o.check_points_file).parent_path();
     if (!std::filesystem::is_directory(parent))
       throw rc::InputError("--check-points " + o.check_points_file + ": folder " + parent.string() + " does not exist");
@@ -156,6 +153,7 @@ void run_radiosity(RadiosityOptions& o) {
     }
     if (surface_check && !o.check_points_file.empty())
       radiosity::write_check_points(o.check_points_file, scene, *surface_check);
+    if (check && !o.check_points_file.empty()) radiosity::write_check_points(o.check_points_file, *check);
   }
 
   const double secs = std::max(sol.seconds, 1e-9);
@@ -411,9 +409,11 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
   cmd->add_option("--check-samples", o->check.samples, "Path-traced samples per checked vertex (default 4096)")
       ->check(CLI::Range(2, 100000000));
   cmd->add_option("--check-points", o->check_points_file,
-                  "With --check and --onto input or --lightmap: write every compared point (its face's file "
-                  "vertices, barycentrics, albedo, path-traced irradiance with its standard error, the baked "
-                  "value) as CSV, to score other bakes against the same reference");
+                  "With --check: write every compared point as CSV, to score other bakes against the same "
+                  "reference. With --onto input or --lightmap: its face's file vertices, barycentrics, albedo, "
+                  "path-traced irradiance with its standard error, the baked value; with --onto elements: the "
+                  "vertex, its position, normal and disk radius, the path-traced irradiance with its standard "
+                  "error, the solved value");
   cmd->add_flag("--json", o->json, "Print the statistics as one JSON object");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
   return [o, onto, fit] {

@@ -104,7 +104,8 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
   double error = 0.0, noise = 0.0, absolute = 0.0, total = 0.0;
   for (size_t i = 0; i < count; ++i) {
     if (!usable[i]) continue;
-    const Rgb& solved = solution.vertex_irradiance[i * nv / count];
+    const size_t v = i * nv / count;
+    const Rgb& solved = solution.vertex_irradiance[v];
     for (int c = 0; c < 3; ++c) {
       const double denominator = double(mean[i][c]) + floor;
       if (!(denominator > 0.0)) continue;  // black everywhere: nothing to compare
@@ -113,6 +114,7 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
       total += double(mean[i][c]);
       noise += double(standard_error[i][c]) / denominator;
     }
+    result.compared.push_back({uint32_t(v), mesh.positions[v], mesh.normals[v], radius[v], mean[i], standard_error[i], solved});
   }
   result.points = used;
   result.mean_relative_error = error / (3.0 * double(used));
@@ -263,6 +265,24 @@ void write_check_points(const std::string& path, const rc::Scene& scene, const S
     rgb(p.standard_error);
     rgb(p.baked);
     out += '\n';
+  }
+  rc::StagedFile(path, out).commit();
+}
+
+void write_check_points(const std::string& path, const CheckResult& result) {
+  std::string out =
+      "vertex,x,y,z,nx,ny,nz,disk_radius,reference_r,reference_g,reference_b,standard_error_r,standard_error_g,"
+      "standard_error_b,solved_r,solved_g,solved_b\n";
+  char line[512];
+  for (const VertexCheckPoint& p : result.compared) {
+    std::snprintf(line, sizeof line,
+                  "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", p.vertex,
+                  double(p.position.x), double(p.position.y), double(p.position.z), double(p.normal.x),
+                  double(p.normal.y), double(p.normal.z), double(p.disk_radius), double(p.reference.r),
+                  double(p.reference.g), double(p.reference.b), double(p.standard_error.r),
+                  double(p.standard_error.g), double(p.standard_error.b), double(p.solved.r), double(p.solved.g),
+                  double(p.solved.b));
+    out += line;
   }
   rc::StagedFile(path, out).commit();
 }

@@ -21,6 +21,17 @@ struct CheckSettings {
   void validate() const;
 };
 
+/// One vertex of the element check, as `gilt radiosity --check N --check-points FILE` writes it.
+struct VertexCheckPoint {
+  uint32_t vertex = 0;         ///< index in the exported element mesh
+  Vec3 position{0.0f};
+  Vec3 normal{0.0f};
+  float disk_radius = 0.0f;    ///< the disk of input surface the reference averages over
+  Rgb reference{0.0f};         ///< path-traced irradiance over the disk
+  Rgb standard_error{0.0f};    ///< of `reference`
+  Rgb solved{0.0f};            ///< the solution's (or its final gather's) irradiance at the vertex
+};
+
 /// The check's findings, over the checked vertices and the three channels. The mean relative
 /// error divides by the reference plus 1 % of its mean, and a few nearly dark vertices still
 /// rule it; the relative mean absolute error weighs every vertex by its light.
@@ -31,6 +42,7 @@ struct CheckResult {
   double reference_noise = 0.0;      ///< the same mean of the estimates' standard errors (noise and the
                                      ///< surface's variation within each disk)
   double seconds = 0.0;
+  std::vector<VertexCheckPoint> compared;  ///< the vertices compared, in vertex order
 };
 
 /// Compares the solution's vertex irradiance with path-traced irradiance averaged over the input
@@ -74,6 +86,9 @@ struct SurfaceCheckResult {
 /// Writes `result.compared` as CSV with a header line (atomically); throws rc::InputError when
 /// the file cannot be written.
 void write_check_points(const std::string& path, const rc::Scene& scene, const SurfaceCheckResult& result);
+/// The same for the element check: one line per compared vertex (index, position, normal, disk
+/// radius, reference with its standard error, solved irradiance).
+void write_check_points(const std::string& path, const CheckResult& result);
 
 /// Draws `settings.points` points uniformly by area over the faces that `irradiance` (an
 /// InputColours fitted with Quantity::irradiance) covers, from `settings.seed`, and compares
