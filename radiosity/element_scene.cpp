@@ -15,6 +15,10 @@ rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh) {
   }
   rc::TriangleMesh elements;
   elements.name = "radiosity elements";
+  // Hit::prim_id is the element index: an element that rounds to no area in float must keep its
+  // place, or every later element is read as its successor (on Šibenik the view and the vertex
+  // bake read elements metres away from where their rays landed).
+  elements.keep_degenerate = true;
   elements.positions = mesh.positions;
   elements.indices.reserve(3 * mesh.element_count());
   for (const auto& e : mesh.elements) elements.indices.insert(elements.indices.end(), e.begin(), e.end());

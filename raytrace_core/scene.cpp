@@ -263,7 +263,7 @@ void Scene::commit() {
                          std::to_string(mesh.positions.size()) + " it has");
       const Vec3 c = glm::cross(mesh.positions[i1] - mesh.positions[i0], mesh.positions[i2] - mesh.positions[i0]);
       const float len2 = glm::dot(c, c);
-      if (!(len2 > 0.0f) || !std::isfinite(len2)) {
+      if ((!(len2 > 0.0f) || !std::isfinite(len2)) && !mesh.keep_degenerate) {
         ++dropped;
         continue;
       }

@@ -49,6 +49,10 @@ struct TriangleMesh {
   std::vector<glm::vec4> tangents;
   std::vector<uint32_t> indices; ///< three per triangle, counter-clockwise seen from the front
   uint32_t material = 0;
+  /// commit() drops triangles of no area, which renumbers the rest. A mesh whose triangle index
+  /// is a key into arrays kept elsewhere (radiosity elements: Hit::prim_id is the element) keeps
+  /// them instead; no ray hits them and point queries pass them by.
+  bool keep_degenerate = false;
 
   size_t triangle_count() const { return indices.size() / 3; }
 };
