@@ -276,6 +276,23 @@ TEST(OntoInput, BadRequestsAreRefusedBeforeSolving) {
   fs::remove_all(dir);
 }
 
+/// The rows of a `--check-points` CSV, whose header starts with `header` and whose lines each hold
+/// `columns` numbers.
+void read_check_points(const fs::path& csv, const std::string& header, size_t columns,
+                       std::vector<std::vector<double>>& rows) {
+  std::istringstream in(slurp(csv));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line.rfind(header, 0), 0u) << line;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) row.push_back(std::stod(f));
+    ASSERT_EQ(row.size(), columns) << line;
+    rows.push_back(row);
+  }
+}
+
 // `--check-points` writes every compared point, so another bake can be scored against the same
 // reference: the figures recomputed from the file are the ones the run printed, the weights are
 // barycentric, and the corners are the input file's vertices.
@@ -285,18 +302,8 @@ TEST(OntoInput, CheckPointsHoldWhatTheCheckCompared) {
   const fs::path csv = dir / "points.csv";
   const Json j = Json::parse(run(quoted(scene) + " --onto input --elements 400 --check 60 --check-samples 32 --json "
                                  "--check-points " + quoted(csv) + " -o " + quoted(dir / "x.glb"), dir));
-  std::istringstream in(slurp(csv));
-  std::string line;
-  ASSERT_TRUE(std::getline(in, line));
-  EXPECT_EQ(line.rfind("gltf_mesh,gltf_primitive,v0,v1,v2,w0,w1,w2,x,y,z,albedo_r", 0), 0u) << line;
   std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream fields(line);
-    for (std::string f; std::getline(fields, f, ',');) row.push_back(std::stod(f));
-    ASSERT_EQ(row.size(), 23u) << line;
-    rows.push_back(row);
-  }
+  ASSERT_NO_FATAL_FAILURE(read_check_points(csv, "gltf_mesh,gltf_primitive,v0,v1,v2,w0,w1,w2,x,y,z,albedo_r", 23, rows));
   ASSERT_EQ(rows.size(), j["check"]["points"].get<size_t>());
   ASSERT_GT(rows.size(), 30u);
   double mean = 0.0;
@@ -327,18 +334,8 @@ TEST(OntoInput, ElementCheckPointsHoldWhatTheCheckCompared) {
   const fs::path csv = dir / "vertices.csv";
   const Json j = Json::parse(run("cornell --elements 400 --check 40 --check-samples 32 --json --check-points " +
                                  quoted(csv) + " -o " + quoted(dir / "x.ply"), dir));
-  std::istringstream in(slurp(csv));
-  std::string line;
-  ASSERT_TRUE(std::getline(in, line));
-  EXPECT_EQ(line.rfind("vertex,x,y,z,nx,ny,nz,disk_radius,reference_r", 0), 0u) << line;
   std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream fields(line);
-    for (std::string f; std::getline(fields, f, ',');) row.push_back(std::stod(f));
-    ASSERT_EQ(row.size(), 17u) << line;
-    rows.push_back(row);
-  }
+  ASSERT_NO_FATAL_FAILURE(read_check_points(csv, "vertex,x,y,z,nx,ny,nz,disk_radius,reference_r", 17, rows));
   ASSERT_EQ(rows.size(), j["check"]["points"].get<size_t>());
   ASSERT_GT(rows.size(), 30u);
   const size_t vertices = j["vertices"].get<size_t>();
