@@ -144,6 +144,10 @@ SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_d
   std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
     return x.key != y.key ? x.key < y.key : x.corner < y.corner;
   });
+  std::vector<uint64_t> cuts;
+  cuts.reserve(soup.cuts.size());
+  for (const auto& [a, b] : soup.cuts) cuts.push_back(uint64_t(std::min(a, b)) << 32 | std::max(a, b));
+  std::sort(cuts.begin(), cuts.end());
   const double cos_sharp = std::cos(sharp_angle_degrees * (3.14159265358979323846 / 180.0));
   FanSets sets;
   sets.parent.resize(3 * nt);
@@ -154,6 +158,7 @@ SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_d
     if (x.key != y.key || (i + 2 < uses.size() && uses[i + 2].key == x.key) || (i > 0 && uses[i - 1].key == x.key))
       continue;  // a border, or an edge of three or more triangles
     if (x.forward == y.forward) continue;  // wound the same way: the two sides disagree on the front
+    if (std::binary_search(cuts.begin(), cuts.end(), x.key)) continue;  // a contact line
     if (glm::dot(face_normal[x.corner / 3], face_normal[y.corner / 3]) < cos_sharp) continue;
     // x runs a → b, y runs b → a: a's corners are x.corner and y's second, b's the converse.
     sets.parent[sets.find(x.corner)] = sets.find(next_corner(y.corner));

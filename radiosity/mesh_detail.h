@@ -21,6 +21,9 @@ using rc::DVec3;
 struct TriangleSoup {
   std::vector<DVec3> points;
   std::vector<std::array<uint32_t, 3>> triangles;
+  /// Edges (pairs of points) that vertices are not shared across: the lines imprinted where other
+  /// surfaces touch or cross this one, and creases (see split_sharp_vertices).
+  std::vector<std::array<uint32_t, 2>> cuts;
 };
 
 /// What repairing one input mesh found; each count names one kind of repair.
@@ -87,7 +90,7 @@ struct SplitSurface {
 };
 
 /// Splits the soup's vertices where the dihedral angle between neighbouring triangles exceeds
-/// `sharp_angle_degrees`, and where the surface is not manifold (an edge of three triangles, two
+/// `sharp_angle_degrees`, along the soup's cuts, and where the surface is not manifold (an edge of three triangles, two
 /// triangles wound against each other, fans meeting at a point): each smooth fan of triangles
 /// around a vertex gets its own copy of the vertex, with the fan's area-weighted normal.
 SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_degrees);

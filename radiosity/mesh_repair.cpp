@@ -478,8 +478,17 @@ void remesh_part(SurfaceMesh& mesh, const RemeshParams& params, Constrained& con
   mesh.collect_garbage();
 }
 
-TriangleSoup to_soup(const SurfaceMesh& mesh) {
+TriangleSoup to_soup(const SurfaceMesh& mesh, const Constrained* constrained = nullptr) {
   TriangleSoup soup;
+  // A contact line is where light may jump (one side lit, the other under a wall): the vertices
+  // on it get a copy for each side (split_sharp_vertices), so that neither side's light is
+  // interpolated into the other's elements. (Borders have no other side; creases are cut by angle.)
+  if (constrained)
+    for (edge_descriptor e : mesh.edges())
+      if ((*constrained)[e] && !mesh.is_border(e)) {
+        const auto h = mesh.halfedge(e);
+        soup.cuts.push_back({static_cast<uint32_t>(mesh.source(h).idx()), static_cast<uint32_t>(mesh.target(h).idx())});
+      }
   soup.points.reserve(mesh.number_of_vertices());
   for (auto v : mesh.vertices()) {
     const Point& p = mesh.point(v);
@@ -500,6 +509,7 @@ void append_soup(TriangleSoup& soup, const TriangleSoup& piece) {
   const auto offset = static_cast<uint32_t>(soup.points.size());
   soup.points.insert(soup.points.end(), piece.points.begin(), piece.points.end());
   for (const auto& t : piece.triangles) soup.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  for (const auto& c : piece.cuts) soup.cuts.push_back({c[0] + offset, c[1] + offset});
 }
 
 }  // namespace
@@ -581,7 +591,7 @@ TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, c
     if (mesh.number_of_faces() == 0) continue;
     Constrained constrained = mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
     remesh_part(mesh, params, constrained, c);
-    append_soup(soup, to_soup(mesh));
+    append_soup(soup, to_soup(mesh, &constrained));
   }
   return soup;
 }

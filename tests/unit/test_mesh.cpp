@@ -537,8 +537,9 @@ bool inside_footprint(double x, double y, double cx, double cy, double hx, doubl
 }
 
 // Where a solid stands on the floor or pierces it, the line of contact is imprinted on the floor
-// and on the solid, and what lies inside the solid is removed: no element straddles the line, so
-// Gouraud interpolation cannot smear the dark inside over the lit outside.
+// and on the solid, and what lies inside the solid is removed: no element straddles the line, and
+// no vertex on it is shared by the elements on its two sides (each side has its own copy), so
+// Gouraud interpolation cannot smear the dark on one side over the lit other.
 TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   Scene scene;
   scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
@@ -567,6 +568,7 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   const double expected = 16.0 - 4.0 * standing.hx * standing.hy - 4.0 * sunk.hx * sunk.hy;
   double floor_area = 0.0;
   size_t straddling = 0;
+  std::vector<char> used_above(mesh.vertex_count(), 0), used_below(mesh.vertex_count(), 0);
   for (size_t e = 0; e < mesh.element_count(); ++e) {
     const auto& el = mesh.elements[e];
     const DVec3 centroid = (d(mesh.positions[el[0]]) + d(mesh.positions[el[1]]) + d(mesh.positions[el[2]])) / 3.0;
@@ -584,10 +586,18 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
       bool above = false, below = false;
       for (uint32_t v : el) above |= mesh.positions[v].z > 1e-6f, below |= mesh.positions[v].z < -1e-6f;
       straddling += above && below;
+      for (uint32_t v : el) (centroid.z > 0.0 ? used_above : used_below)[v] = 1;
     }
   }
   EXPECT_NEAR(floor_area, expected, 1e-5 * expected);
   EXPECT_EQ(straddling, 0u);
+  size_t shared = 0, on_line = 0;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    shared += used_above[v] && used_below[v];
+    on_line += (used_above[v] || used_below[v]) && std::abs(mesh.positions[v].z) < 1e-6f;
+  }
+  EXPECT_GT(on_line, 0u) << "the sunk box has vertices on the floor's line";
+  EXPECT_EQ(shared, 0u) << "vertices on the line shared by the sunk box's elements above and below it";
 }
 
 // input_point_buried tests one point of a face that is only partly buried: the floor's two
