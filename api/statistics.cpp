@@ -54,6 +54,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
   const double secs = std::max(sol.seconds, 1e-9);
   return {{"ranks", rc::processes().count()},
           {"elements", sol.mesh.element_count()},
+          {"meshed_elements", sol.mesh_report.elements},
           {"vertices", sol.mesh.vertex_count()},
           {"max_edge", sol.mesh_report.max_edge},
           {"refined_elements", sol.refined_elements},

@@ -221,8 +221,10 @@ void run_radiosity(RadiosityOptions& o) {
     return;
   }
   std::printf("gilt radiosity: %s, %d thread(s)\n", o.scene.c_str(), threads);
-  std::printf("  mesh:    %zu elements, %zu vertices, target edge %.4g, %zu elements bisected at steep direct light\n",
-              sol.mesh.element_count(), sol.mesh.vertex_count(), sol.mesh_report.max_edge, sol.refined_elements);
+  std::printf("  mesh:    %zu elements (%zu as meshed), %zu vertices, target edge %.4g, %zu elements bisected at steep "
+              "direct light\n",
+              sol.mesh.element_count(), sol.mesh_report.elements, sol.mesh.vertex_count(), sol.mesh_report.max_edge,
+              sol.refined_elements);
   if (sol.mesh_report.contact_edges > 0 || sol.mesh_report.buried_area > 0.0)
     std::printf("  contact: %zu edges imprinted where surfaces touch; %.3g %% of the area buried under or inside "
                 "other surfaces, removed (%zu input faces, %zu elements)\n",

@@ -591,6 +591,15 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     rep.contact_edges += c.contact_edges;
     warn_counts(rep, mesh_label(scene.meshes[s], s), c);
   }
+  rep.elements = out.element_count();
+  // The remesher keeps the input's borders, creases and contact lines where they are, so a model
+  // of many small faces cannot be meshed coarser than they allow.
+  if (settings.elements > 0 && settings.max_edge == 0.0f && out.element_count() > 2 * size_t(settings.elements))
+    rep.warnings.push_back("asked for about " + std::to_string(settings.elements) + " elements, meshed " +
+                           std::to_string(out.element_count()) +
+                           ": the remesher keeps the input's borders, creases and contact lines, and makes no "
+                           "element coarser than they allow (the edge length asked for is " +
+                           std::to_string(edge_length) + ")");
   return out;
 }
 

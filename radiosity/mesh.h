@@ -44,6 +44,7 @@ struct RadiosityMesh {
 /// What meshing did: counts of repairs and the edge length used.
 struct MeshReport {
   float max_edge = 0.0f;
+  size_t elements = 0;         ///< elements as meshed (adaptive subdivision adds more later)
   size_t merged_vertices = 0, removed_degenerate = 0, reoriented = 0, self_intersecting = 0;
   size_t contact_edges = 0;    ///< input edges imprinted where surfaces touch (before remeshing)
   size_t buried_faces = 0;     ///< imprinted input faces removed: they lie inside or under other surfaces

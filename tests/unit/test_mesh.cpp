@@ -624,6 +624,39 @@ TEST(Mesh, PointsUnderABoxAreBuriedOnAFaceThatIsNot) {
   EXPECT_FALSE(input_point_buried(scene, Vec3(-0.9f, -0.8f, 0.8f), up)) << "the standing box's top";
 }
 
+// A model of many small separate tiles cannot be meshed coarser than its tiles: each keeps its
+// border. Asked for fewer elements than that, the mesher says so rather than silently giving
+// many more (on Šibenik, --elements 20000 gave 170,608); without --elements it says nothing.
+TEST(Mesh, SaysWhenTheInputAllowsNoFewerElementsThanAsked) {
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+  TriangleMesh tiles;
+  tiles.name = "tiles";
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) {
+      const float x = 0.1f * float(i), y = 0.1f * float(j), s = 0.08f;
+      const auto v = static_cast<uint32_t>(tiles.positions.size());
+      tiles.positions.insert(tiles.positions.end(), {Vec3(x, y, 0), Vec3(x + s, y, 0), Vec3(x + s, y + s, 0), Vec3(x, y + s, 0)});
+      tiles.indices.insert(tiles.indices.end(), {v, v + 1, v + 2, v, v + 2, v + 3});
+    }
+  scene.meshes.push_back(tiles);
+  scene.commit();
+  const auto says_so = [](const MeshReport& r) {
+    return std::any_of(r.warnings.begin(), r.warnings.end(),
+                       [](const std::string& w) { return w.find("asked for about 100 elements") != std::string::npos; });
+  };
+  MeshReport report;
+  const RadiosityMesh mesh = build_mesh(scene, MeshSettings{.elements = 100}, &report);
+  EXPECT_EQ(report.elements, mesh.element_count());
+  EXPECT_GE(mesh.element_count(), 1800u) << "two triangles per tile at least";
+  EXPECT_TRUE(says_so(report));
+  MeshReport unasked;
+  build_mesh(scene, MeshSettings{}, &unasked);
+  EXPECT_FALSE(says_so(unasked));
+  EXPECT_TRUE(std::none_of(unasked.warnings.begin(), unasked.warnings.end(),
+                           [](const std::string& w) { return w.find("asked for about") != std::string::npos; }));
+}
+
 // A room modelled inside out (a closed box facing outwards, as a scaled cube primitive comes)
 // encloses what stands in it just as a block encloses the floor under it. What the camera inside
 // sees is kept; and when "buried" would take a large share of the scene, nothing is removed.
