@@ -102,7 +102,7 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   MethodPlan photon{"photon", {}, {}};
   if (needs.caustic) photon.runs.push_back("caustic map (light, mirror/glass+, diffuse)");
   else photon.skipped.push_back("caustic map: " + needs.caustic_reason);
-  if (needs.global) photon.runs.push_back("global map, irradiance precomputed at every 4th photon, final gather");
+  if (needs.global) photon.runs.push_back("global map, irradiance precomputed at a site per 4th photon (paths of their own), final gather");
   else photon.skipped.push_back("global map and final gather: " + needs.global_reason);
   if (lit) photon.runs.push_back("direct light by light sampling with MIS against the gather rays");
   plans.push_back(photon);

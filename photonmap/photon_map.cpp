@@ -178,6 +178,17 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
   return maps;
 }
 
+std::vector<Photon> trace_global_sites(const rc::Scene& scene, const PhotonSettings& settings, uint64_t paths,
+                                       uint64_t& traced) {
+  if (!scene.committed()) throw std::logic_error("trace_global_sites: the scene was not committed");
+  // Path numbers from 2^62 on, far from the maps' (which count from 0), on a stream of their own.
+  return trace_map(scene, uint64_t(1) << 62, paths, 0xb100000000ull, settings, traced,
+                   [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
+                     if (!specular_only) out.push_back(p);
+                     return true;
+                   });
+}
+
 namespace {
 
 rc::Rgb radiance_estimate(const rc::Scene* scene, const PhotonMap& map, const EstimateQuery& query,

@@ -75,6 +75,13 @@ MapNeeds map_needs(const rc::Scene& scene);
 /// stream, so the maps are identical for any thread count) and builds their indexes.
 PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings);
 
+/// Photons as the global map would store them (after at least one diffuse bounce) from `paths`
+/// further paths, on a random stream of their own, so that they are independent of the maps'
+/// photons; `traced` grows by the paths traced. The two-pass mapper precomputes irradiance at
+/// their positions (photon_mapper.h says why not at the map's own photons).
+std::vector<Photon> trace_global_sites(const rc::Scene& scene, const PhotonSettings& settings, uint64_t paths,
+                                       uint64_t& traced);
+
 /// Scratch space for density estimates, one per thread: queries do not allocate.
 struct EstimateScratch {
   std::vector<Neighbour> neighbours;

@@ -29,7 +29,8 @@ struct PhotonMapperSettings {
   /// the caustic map and the pixel's area as well: on cornell-caustics at 16 s relMSE fell from
   /// 0.0021 at 16 rays to 0.00095 at 4, 0.00064 at 2 and 0.00061 at 1 (bench/README.md).
   int gather_rays = 1;
-  int precompute_stride = 4;   ///< irradiance is precomputed at every n-th global photon
+  int precompute_stride = 4;   ///< irradiance is precomputed at sites from one path in n of the global map's
+                               ///< paths (about one per n-th global photon; see the constructor)
   int direct_samples = 16;     ///< shadow rays per precomputed irradiance point
   int max_depth = 32;          ///< specular bounces followed from the camera and along gather rays
   IndexKind index = IndexKind::hash_grid;  ///< over the irradiance points (bench_photon --index)
