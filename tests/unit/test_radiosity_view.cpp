@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <utility>
 
 #include "radiosity/solver.h"
@@ -112,6 +113,32 @@ std::pair<double, double> mean_and_error(int n, Sample sample) {
   return {mean, std::sqrt(std::max(0.0, squares / n - mean * mean) / (n - 1))};
 }
 
+/// Irradiance at the point p facing n, from 2^15 of the view's gathered samples and from as many
+/// path-traced ones (a white Lambertian probe standing in for the surface), each with its
+/// standard error.
+struct GatherAgainstTrace {
+  double gathered, gather_error, traced, trace_error;
+  /// Four standard errors of the difference, both estimated from the samples.
+  double tolerance() const { return 4.0 * std::hypot(gather_error, trace_error); }
+};
+GatherAgainstTrace gather_against_trace(const rc::Scene& scene, const rad::RadiosityView& view, Vec3 p, Vec3 n) {
+  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
+  rc::PathSettings probe;
+  probe.first_surface = &white;
+  constexpr int kSamples = 1 << 15;
+  GatherAgainstTrace g;
+  std::tie(g.gathered, g.gather_error) = mean_and_error(kSamples, [&](int i) {
+    rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(1, 0, uint64_t(i))), 0};
+    return double(view.gathered_sample(rad::mesh_surface_point(p, n), ctx).g);
+  });
+  std::tie(g.traced, g.trace_error) = mean_and_error(kSamples, [&](int i) {
+    rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(2, 0, uint64_t(i))), 0};
+    const rc::Ray in{p + 0.01f * n, -n, 0.02f};
+    return double(rc::path_radiance(scene, in, ctx, probe).g) * rc::kPi;
+  });
+  return g;
+}
+
 }  // namespace
 
 // A slab a hair above the floor, under the sun and a sky: under it the light is what slips in
@@ -148,27 +175,15 @@ TEST(RadiosityView, AGatherUnderALowSlabAgreesWithThePathTracer) {
   const rad::Solution sol = rad::solve(scene, settings);
   const rad::RadiosityView view(scene, sol, rad::ViewMode::mesh, false);
 
-  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
-  rc::PathSettings probe;
-  probe.first_surface = &white;
-  const int n = 1 << 15;
   const Vec3 up(0.0f, 1.0f, 0.0f);
   struct Case {
     Vec3 p, n;
   };
   for (const Case& c : {Case{Vec3(0.45f, 0.0f, 0.1f), up}, Case{Vec3(0.45f, lo, 0.1f), -up}}) {
-    const auto [gathered, gather_error] = mean_and_error(n, [&](int i) {
-      rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(1, 0, uint64_t(i))), 0};
-      return double(view.gathered_sample(rad::mesh_surface_point(c.p, c.n), ctx).g);
-    });
-    const auto [traced, trace_error] = mean_and_error(n, [&](int i) {
-      rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(2, 0, uint64_t(i))), 0};
-      const rc::Ray down{c.p + 0.01f * c.n, -c.n, 0.02f};
-      return double(rc::path_radiance(scene, down, ctx, probe).g) * rc::kPi;
-    });
-    EXPECT_GT(traced, 0.0) << "light reaches under the slab";
-    EXPECT_NEAR(gathered, traced, 4.0 * std::hypot(gather_error, trace_error))
-        << "at " << c.p.y << " facing " << c.n.y << ": the path tracer's error " << trace_error;
+    const GatherAgainstTrace g = gather_against_trace(scene, view, c.p, c.n);
+    EXPECT_GT(g.traced, 0.0) << "light reaches under the slab";
+    EXPECT_NEAR(g.gathered, g.traced, g.tolerance())
+        << "at " << c.p.y << " facing " << c.n.y << ": the path tracer's error " << g.trace_error;
   }
 }
 
@@ -200,10 +215,6 @@ TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
   scene.punctual_lights = {sun, sky};
   scene.commit();
 
-  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
-  rc::PathSettings probe;
-  probe.first_surface = &white;
-  const int n = 1 << 15;
   struct Case {
     Vec3 p, n;
   };
@@ -217,17 +228,9 @@ TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
     const rad::Solution sol = rad::solve(scene, settings);
     const rad::RadiosityView view(scene, sol, rad::ViewMode::mesh, false);
     for (const Case& c : cases) {
-      const auto [gathered, gather_error] = mean_and_error(n, [&](int i) {
-        rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(1, 0, uint64_t(i))), 0};
-        return double(view.gathered_sample(rad::mesh_surface_point(c.p, c.n), ctx).g);
-      });
-      const auto [traced, trace_error] = mean_and_error(n, [&](int i) {
-        rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(2, 0, uint64_t(i))), 0};
-        const rc::Ray in{c.p + 0.01f * c.n, -c.n, 0.02f};
-        return double(rc::path_radiance(scene, in, ctx, probe).g) * rc::kPi;
-      });
-      EXPECT_NEAR(gathered, traced, 4.0 * std::hypot(gather_error, trace_error))
-          << rad::to_string(solver) << " at (" << c.p.x << ", " << c.p.y << "): the path tracer's error " << trace_error;
+      const GatherAgainstTrace g = gather_against_trace(scene, view, c.p, c.n);
+      EXPECT_NEAR(g.gathered, g.traced, g.tolerance())
+          << rad::to_string(solver) << " at (" << c.p.x << ", " << c.p.y << "): the path tracer's error " << g.trace_error;
     }
   }
 }
