@@ -20,9 +20,6 @@ namespace {
 /// the thread count.
 constexpr uint64_t kChunk = 4096;
 
-/// Stored normals within about 25° of the query's count (cos 25° ≈ 0.9).
-constexpr float kNormalAgreement = 0.9f;
-
 /// Emits photons first, …, first + count − 1 and keeps those `keep` accepts, in photon order,
 /// each with its power divided by `count`.
 template <class Keep>
@@ -73,7 +70,7 @@ float for_each_estimate_photon(const PhotonMap& map, const EstimateQuery& q, Est
   if (!(r2 > 0.0f)) return 0.0f;
   for (size_t i = 0; i < found; ++i) {
     const Photon& p = map.photons[scratch.neighbours[i].index];
-    if (glm::dot(decode_direction(p.normal), q.normal) < kNormalAgreement) continue;
+    if (glm::dot(decode_direction(p.normal), q.normal) < kSameSurfaceCosine) continue;
     const float w = epanechnikov(scratch.neighbours[i].distance2, r2);
     if (w > 0.0f) f(p, w);
   }
@@ -85,7 +82,7 @@ float for_each_estimate_photon(const PhotonMap& map, const EstimateQuery& q, Est
 /// nothing was found.
 float coverage_divisor(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& q, float r2) {
   if (!(r2 > 0.0f)) return 1.0f;
-  const double c = disk_coverage(scene, map.sides, q.position, q.normal, r2, kNormalAgreement);
+  const double c = disk_coverage(scene, map.sides, q.position, q.normal, r2, kSameSurfaceCosine);
   return c < 0.0 ? 1.0f : float(std::max(c, 0.1));
 }
 

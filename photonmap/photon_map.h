@@ -87,6 +87,16 @@ struct EstimateScratch {
   std::vector<Neighbour> neighbours;
 };
 
+/// A photon counts in a density estimate (the photon method's k nearest, SPPM's disk) when its
+/// stored normal lies within about 25° of the query's lit side (cos 25° ≈ 0.9): on the same
+/// surface, a little curved or tessellated, but not on the other side of a sheet, on a wall
+/// meeting it in a crease, or on a facet turned well away. Both methods divide by the coverage
+/// of the surface that passes the same test. A wider test mixes orientations: on a column's lit
+/// side the facets turned away from the light hold fewer photons, and at 60° SPPM's image of
+/// Šibenik came out 0.9 % dark at any radius (bench/README.md, "SPPM's test of a photon's
+/// surface"); the photon method's k nearest took in photons from creases and came out 13 % bright.
+inline constexpr float kSameSurfaceCosine = 0.9f;
+
 /// A density-estimate query: where, which way the surface faces, how many photons and how far.
 struct EstimateQuery {
   rc::Vec3 position;

@@ -48,16 +48,12 @@ struct PixelState {
 
 constexpr uint64_t kPhotonStream = 0xe000000000ull;
 
-/// A photon counts at a visible point when its stored normal lies within 60° of the point's lit
-/// side: on the same surface, curved or tessellated, but not on the other side of a sheet or on
-/// a wall meeting it at a right angle. At 25° (the photon method's test, photon_map.cpp, and
-/// SPPM's until the light-BVH session) the facets of Šibenik's columns and arches turned away
-/// each other's photons while the disk still counted their area: the image was 11.6 % dark at
-/// 30 s against a path-traced reference, 4.1 % at 60° (bench/README.md, "SPPM's test of a
-/// photon's surface"), 1.1 % with the disk's coverage (probe_coverage); the Cornell box did not
-/// change. The photon method keeps 25°: at 60° its k-nearest
-/// estimate took in photons from creases and came out 13 % bright instead of 3 %.
-constexpr float kSameSurfaceCosine = 0.5f;
+// A photon counts at a visible point when it passes kSameSurfaceCosine (photon_map.h), the
+// photon method's test. SPPM had 60° from the light-BVH session on: at 25° the facets of
+// Šibenik's columns and arches turned away each other's photons while the disk still counted
+// their area (11.6 % dark at 30 s). The disk's coverage (probe_coverage) counts only the surface
+// that passes the test, which took that darkening away, and the wider test then left a darkening
+// of its own (bench/README.md, "SPPM's test of a photon's surface").
 
 constexpr uint64_t kCoverageStream = 0xe100000000ull;
 
