@@ -53,6 +53,13 @@ std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t first, uint64_t c
   return photons;
 }
 
+/// trace_map's `keep` for the global map (and its irradiance sites): every photon after at least
+/// one diffuse bounce, neither direct light nor a caustic; the path goes on.
+bool keep_global(const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
+  if (!specular_only) out.push_back(p);
+  return true;
+}
+
 /// Epanechnikov's kernel on a disk of squared radius r2, normalised over the disk:
 /// 2 / (π r²) · (1 − d² / r²).
 float epanechnikov(float d2, float r2) { return 2.0f * rc::kInvPi / r2 * std::max(0.0f, 1.0f - d2 / r2); }
@@ -136,12 +143,7 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
     const int most_rounds = std::max({settings.global_rounds, settings.global_time_rounds, 1});
     for (int r = 0; r < most_rounds; ++r) {
       const std::vector<Photon> more =
-          trace_map(scene, maps.global.emitted, round, 0xb000000000ull, settings, maps.paths,
-                    [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
-                      // After at least one diffuse bounce: not direct, not a caustic.
-                      if (!specular_only) out.push_back(p);
-                      return true;
-                    });
+          trace_map(scene, maps.global.emitted, round, 0xb000000000ull, settings, maps.paths, keep_global);
       maps.global.emitted += round;
       maps.global.photons.insert(maps.global.photons.end(), more.begin(), more.end());
       // A first round that stores nothing finds a scene with no interreflection worth a map.
@@ -179,11 +181,7 @@ std::vector<Photon> trace_global_sites(const rc::Scene& scene, const PhotonSetti
                                        uint64_t& traced) {
   if (!scene.committed()) throw std::logic_error("trace_global_sites: the scene was not committed");
   // Path numbers from 2^62 on, far from the maps' (which count from 0), on a stream of their own.
-  return trace_map(scene, uint64_t(1) << 62, paths, 0xb100000000ull, settings, traced,
-                   [](const Photon& p, int, bool specular_only, std::vector<Photon>& out) {
-                     if (!specular_only) out.push_back(p);
-                     return true;
-                   });
+  return trace_map(scene, uint64_t(1) << 62, paths, 0xb100000000ull, settings, traced, keep_global);
 }
 
 namespace {

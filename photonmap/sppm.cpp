@@ -48,13 +48,6 @@ struct PixelState {
 
 constexpr uint64_t kPhotonStream = 0xe000000000ull;
 
-// A photon counts at a visible point when it passes kSameSurfaceCosine (photon_map.h), the
-// photon method's test. SPPM had 60° from the light-BVH session on: at 25° the facets of
-// Šibenik's columns and arches turned away each other's photons while the disk still counted
-// their area (11.6 % dark at 30 s). The disk's coverage (probe_coverage) counts only the surface
-// that passes the test, which took that darkening away, and the wider test then left a darkening
-// of its own (bench/README.md, "SPPM's test of a photon's surface").
-
 constexpr uint64_t kCoverageStream = 0xe100000000ull;
 
 /// One probe of how much of the gather disk (radius r about p, in the plane facing `lit`) is
@@ -223,6 +216,12 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
         uint32_t m_count = 0;
         index.for_each_within(ps.position, ps.radius * ps.radius, [&](Neighbour nb) {
           const Photon& p = photons[nb.index];
+          // The photon method's test of a photon's surface (photon_map.h). SPPM had 60° from the
+          // light-BVH session on: at 25° the facets of Šibenik's columns and arches turned away
+          // each other's photons while the disk still counted their area (11.6 % dark at 30 s).
+          // The disk's coverage (probe_coverage) counts only the surface that passes the test,
+          // which took that darkening away, and the wider test then left a darkening of its own
+          // (bench/README.md, "SPPM's test of a photon's surface").
           if (glm::dot(decode_direction(p.normal), ps.lit_side) < kSameSurfaceCosine) return;
           const rc::Vec3 wi = ps.frame.to_local(decode_direction(p.direction));
           phi += rc::bsdf_eval(m, ps.wo, wi) * p.power;

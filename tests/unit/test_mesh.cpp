@@ -652,7 +652,6 @@ TEST(Mesh, SaysWhenTheInputAllowsNoFewerElementsThanAsked) {
   EXPECT_TRUE(says_so(report));
   MeshReport unasked;
   build_mesh(scene, MeshSettings{}, &unasked);
-  EXPECT_FALSE(says_so(unasked));
   EXPECT_TRUE(std::none_of(unasked.warnings.begin(), unasked.warnings.end(),
                            [](const std::string& w) { return w.find("asked for about") != std::string::npos; }));
 }
