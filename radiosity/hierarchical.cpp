@@ -35,6 +35,7 @@
 
 #include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
+#include "radiosity/probe_fraction.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/processes.h"
 #include "raytrace_core/rng.h"
@@ -762,16 +763,6 @@ SubtreeCut cut_tree(const Tree& tree, int count) {
 }
 
 }  // namespace
-
-double extended_fraction(int hits, int rays, int probe) {
-  // In ratios of binomials, with a = C(R − p, k − p) / C(R, k) and b = C(R − p, k) / C(R, k).
-  double a = 1.0, b = 1.0;
-  for (int i = 0; i < probe; ++i) {
-    a *= double(std::max(hits - i, 0)) / double(rays - i);
-    b *= double(std::max(rays - hits - i, 0)) / double(rays - i);
-  }
-  return (double(hits) / double(rays) - a) / (1.0 - a - b);
-}
 
 std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const Rgb> emitted,
                                     size_t first_vertex, const HierarchicalSettings& settings, int rays,

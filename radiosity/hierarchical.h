@@ -100,16 +100,6 @@ std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const
                                     size_t first_vertex, const HierarchicalSettings& settings, int rays,
                                     uint64_t* shadow_rays);
 
-/// The visible fraction from `hits` of `rays` shadow rays whose first `probe` found the source
-/// partly hidden (a probe that finds it all open or all hidden stops there). hits / rays is
-/// biased under that rule: for a source 80 % visible, 16 rays, the probe stops at all open often
-/// enough that the sources it extends read 0.86 on average (0.14 for one 20 % visible). This is
-/// the unbiased estimator of a stopped Bernoulli sequence (Girshick, Mosteller & Savage 1946): of
-/// the sequences with `hits` hits in `rays` whose first `probe` are mixed, the share that begin
-/// with a hit, k / R − a over 1 − a − b with a = C(R − p, k − p) / C(R, k) and b = C(R − p, k) /
-/// C(R, k). It lies between 1 / p and (p − 1) / p. Needs 0 < hits < rays and probe < rays.
-double extended_fraction(int hits, int rays, int probe);
-
 /// Solves the interreflection above the given direct light: links, iterates to `tolerance`,
 /// then gathers at every vertex from the cluster hierarchy.
 HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const HierarchicalSettings& settings);

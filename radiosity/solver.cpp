@@ -23,6 +23,7 @@
 #include "radiosity/element_albedo.h"
 #include "radiosity/element_scene.h"
 #include "radiosity/form_factor.h"
+#include "radiosity/probe_fraction.h"
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/light.h"
@@ -418,7 +419,7 @@ struct ShootingPatch {
   float low_offset = 0.0f;  ///< the least normal · x over the patch's corners
   bool emitter = false;  ///< sharp shadows: the per-element occluder test and the adaptive probe
   int probe = 2;         ///< side of the first stratified visibility probe (rays = probe²)
-  int strata = 4;        ///< side of the full set used in a penumbra (emitters only)
+  int strata = 4;        ///< a penumbra takes strata² rays, a quarter in each quarter of the patch (emitters only)
 
   void assign(const RadiosityMesh& mesh, std::span<const uint32_t> source, std::vector<Rgb>& unshot) {
     elements.assign(source.begin(), source.end());
@@ -550,34 +551,57 @@ struct Receivers {
       ++counts.skipped;
       return gathered;
     }
-    // Stratified points on the patch, each drawn in proportion to what its element sends to v;
-    // only when the probe is split between blocked and open (a penumbra) the full set decides.
+    // Points on the patch, each drawn in proportion to what its element sends to v: a ray from
+    // one of v's origins (taken in turn) to the point at u of the patch's sample square, whose
+    // u.x picks the element by the running sum and is then stretched back to [0, 1).
     const std::span<const rc::SurfacePoint> from = origins(v);
-    const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));  // rays take the origins in turn
-    auto fraction_open = [&](int side) {
+    const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
+    size_t ray_index = 0;
+    auto open_at = [&](float ux, float uy) {
+      ux *= total;
+      size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + m, ux) - cdf.begin());
+      k = std::min(k, last);
+      const float lo = k ? cdf[k - 1] : 0.0f;
+      ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
+      const rc::Vec2 bary = rc::sample_uniform_triangle({ux, uy});
+      const auto& el = mesh.elements[src.elements[k]];
+      const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
+                     bary.y * mesh.positions[el[2]];
+      ++counts.rays;
+      const rc::SurfacePoint& at = from[(first + ray_index++) % kVisibilityOrigins];
+      return geometry.occluded(rc::spawn_shadow_ray(at, surface_point(q, mesh.element_normal[src.elements[k]]))) ? 0 : 1;
+    };
+    // A point drawn uniformly in quarter j of the square (x by bit 0, y by bit 1).
+    auto open_in_quarter = [&](int j) {
+      const float ux = (float(j & 1) + rng.uniform()) * 0.5f;
+      const float uy = (float(j >> 1) + rng.uniform()) * 0.5f;
+      return open_at(ux, uy);
+    };
+    if (!src.emitter || src.probe != 2 || src.strata <= 2) {
+      // Side × side strata, one ray each.
+      const int side = src.probe;
       int open = 0;
       for (int i = 0; i < side; ++i)
         for (int j = 0; j < side; ++j) {
-          // u.x picks the element by the running sum and is then stretched back to [0, 1).
-          float ux = (float(i) + rng.uniform()) / float(side) * total;
-          size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + m, ux) - cdf.begin());
-          k = std::min(k, last);
-          const float lo = k ? cdf[k - 1] : 0.0f;
-          ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
-          const rc::Vec2 bary = rc::sample_uniform_triangle({ux, (float(j) + rng.uniform()) / float(side)});
-          const auto& el = mesh.elements[src.elements[k]];
-          const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
-                         bary.y * mesh.positions[el[2]];
-          ++counts.rays;
-          const rc::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
-          open += !geometry.occluded(
-              rc::spawn_shadow_ray(at, surface_point(q, mesh.element_normal[src.elements[k]])));
+          const float ux = (float(i) + rng.uniform()) / float(side);
+          const float uy = (float(j) + rng.uniform()) / float(side);
+          open += open_at(ux, uy);
         }
-      return float(open) / float(side * side);
-    };
-    float visible = fraction_open(src.probe);
-    if (src.emitter && visible > 0.0f && visible < 1.0f && src.strata > src.probe) visible = fraction_open(src.strata);
-    return gathered * visible;
+      return gathered * (float(open) / float(side * side));
+    }
+    // Emitters' sharp shadows: a probe of one ray per quarter; where it finds a mix (a penumbra),
+    // as many rays in all as the full set of strata, each quarter's drawn independently in it,
+    // read without the probe's bias (quartered_fraction). A probe that finds all open or all
+    // blocked stands.
+    std::array<int, 4> hits;
+    for (int j = 0; j < 4; ++j) hits[j] = open_in_quarter(j);
+    const int probe_open = hits[0] + hits[1] + hits[2] + hits[3];
+    if (probe_open == 0) return Rgb(0.0f);
+    if (probe_open == 4) return gathered;
+    const int per_quarter = std::max(2, (src.strata * src.strata + 3) / 4);
+    for (int j = 0; j < 4; ++j)
+      for (int t = 1; t < per_quarter; ++t) hits[j] += open_in_quarter(j);
+    return gathered * float(quartered_fraction(hits, per_quarter));
   }
 };
 

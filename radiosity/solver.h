@@ -41,8 +41,8 @@ struct SolverSettings {
   double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
   double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); refinement
                              ///< stops after 30 % of it, and no shot starts that would end past it
-  int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (stratified
-                                ///< on the source); pairs a 2×2 probe finds all open or all blocked take 4
+  int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (a quarter in
+                                ///< each quarter of the source); pairs a 4-ray probe finds all open or all blocked take 4
   int reflected_visibility_probe = 1;  ///< probe side (rays = side²) for patches that only reflect light
   int patch_elements = 16;             ///< elements per shooting patch (1: every element shoots alone)
   int subdivision_levels = 2;          ///< adaptive subdivision may halve the mesh's edge this many times

@@ -5,7 +5,6 @@
 
 #include <cmath>
 
-#include "radiosity/hierarchical.h"
 #include "radiosity/solver.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/rng.h"
@@ -321,30 +320,3 @@ TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
     for (int k = 0; k < 3; ++k) ASSERT_TRUE(std::isfinite(e[k]) && e[k] >= 0.0f);
 }
 
-// A probe of p shadow rays that finds the source all open or all hidden stops; one that finds a
-// mix goes on to R rays. Over every outcome, weighted by its binomial probability for a true
-// visible fraction v, the estimates must average to v exactly (to rounding), where hits / R
-// averages to 0.86 at v = 0.8 (R = 16). Exact enumeration, no sampling.
-TEST(HierarchicalRadiosity, ExtendedVisibleFractionIsUnbiased) {
-  constexpr int probe = 4;
-  for (int rays : {5, 8, 16, 64}) {
-    for (double v : {0.02, 0.2, 0.5, 0.8, 0.97}) {
-      // P(k hits in R rays, the first p of them mixed) = [C(R, k) − C(R−p, k−p) − C(R−p, k)] vᵏ (1−v)^(R−k).
-      auto choose = [](int n, int k) { return k < 0 || k > n ? 0.0 : std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0)); };
-      double expected = std::pow(v, probe), naive = expected;  // the probe all open reads 1
-      for (int k = 1; k < rays; ++k) {
-        const double p = (choose(rays, k) - choose(rays - probe, k - probe) - choose(rays - probe, k)) *
-                         std::pow(v, k) * std::pow(1.0 - v, rays - k);
-        const double f = rad::extended_fraction(k, rays, probe);
-        ASSERT_GE(f, 1.0 / probe - 1e-12);
-        ASSERT_LE(f, (probe - 1.0) / probe + 1e-12);
-        expected += p * f;
-        naive += p * double(k) / rays;
-      }
-      EXPECT_NEAR(expected, v, 1e-9) << rays << " rays, v " << v;
-      if (rays == 16 && v == 0.8) {
-        EXPECT_NEAR(naive, 0.86, 0.005) << "the bias the estimator removes";
-      }
-    }
-  }
-}
