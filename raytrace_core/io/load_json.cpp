@@ -274,7 +274,10 @@ class JsonSceneReader {
                                 (own_camera_ ? "the scene's own" : "an earlier file's") +
                                 " is used; --camera chooses another)");
     }
-    for (std::string& w : part.warnings) scene_.warnings.push_back(std::move(w));
+    // A PLY's own material is replaced by the one given here: its note about it would mislead.
+    const std::string replaced = override_material ? ply_default_material_note(mesh_path.string()) : std::string();
+    for (std::string& w : part.warnings)
+      if (w != replaced) scene_.warnings.push_back(std::move(w));
   }
 
   void read_shape(const Json& j, const std::string& p) {

@@ -217,11 +217,14 @@ void load_ply(const fs::path& path, Scene& scene) {
   mesh.indices = std::move(body.indices);
   mesh.material = static_cast<uint32_t>(scene.materials.size());
   scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
-  std::string note = file + ": a PLY holds geometry only: diffuse albedo 0.8, no lights";
-  if (has_colours) note += "; vertex colours ignored";
-  scene.warnings.push_back(note);
+  scene.warnings.push_back(ply_default_material_note(file));
+  if (has_colours) scene.warnings.push_back(file + ": vertex colours ignored");
   if (mesh.indices.empty()) scene.warnings.push_back(file + ": no faces");
   scene.meshes.push_back(std::move(mesh));
+}
+
+std::string ply_default_material_note(const std::string& file) {
+  return file + ": a PLY holds geometry only: diffuse albedo 0.8, no lights";
 }
 
 }  // namespace gilt::raytrace_core

@@ -18,6 +18,9 @@ void load_obj(const std::filesystem::path& path, Scene& scene);
 void load_gltf(const std::filesystem::path& path, Scene& scene);
 /// Appends a PLY mesh (ascii or binary) with one default diffuse material.
 void load_ply(const std::filesystem::path& path, Scene& scene);
+/// The warning load_ply gives about the material it makes (a PLY holds geometry only). A JSON
+/// scene that gives the file's mesh a material of its own drops it.
+std::string ply_default_material_note(const std::string& file);
 /// Appends gilt's own JSON scene, loading the mesh files it names relative to itself.
 void load_json(const std::filesystem::path& path, Scene& scene);
 

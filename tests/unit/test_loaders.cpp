@@ -674,6 +674,24 @@ TEST_F(Loaders, PlyAscii) {
   EXPECT_TRUE(has_warning(scene, "no lights"));
 }
 
+// A JSON scene that gives a PLY mesh its own material replaces the PLY's default one, so the
+// PLY's note about that default ("diffuse albedo 0.8, no lights") would mislead there; without a
+// material of its own the note stays.
+TEST_F(Loaders, JsonMaterialReplacesThePlyNote) {
+  write("mesh.ply", std::string(kPlyHeader) +
+                        "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n0.5 2 0 0 0 1\n"
+                        "4 0 1 2 3\n3 3 2 4\n");
+  const std::string own = write("own.json", R"({"materials": {"marble": {"kind": "diffuse", "albedo": 0.6}},
+    "meshes": [{"file": "mesh.ply", "material": "marble"}],
+    "lights": [{"type": "environment", "radiance": 1}]})");
+  const Scene with_material = load_scene(own);
+  EXPECT_FALSE(has_warning(with_material, "geometry only"));
+  EXPECT_FLOAT_EQ(with_material.materials[with_material.meshes[0].material].albedo.g, 0.6f);
+  const std::string plain = write("plain.json", R"({"meshes": [{"file": "mesh.ply"}],
+    "lights": [{"type": "environment", "radiance": 1}]})");
+  EXPECT_TRUE(has_warning(load_scene(plain), "geometry only"));
+}
+
 TEST_F(Loaders, PlyBadInput) {
   const std::string body = "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n";
   const std::string index = write("bad_index.ply", kPlyHeader + body + "0.5 2 0 0 0 1\n4 0 1 2 3\n3 3 2 9\n");
