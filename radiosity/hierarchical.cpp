@@ -35,6 +35,7 @@
 #include <optional>
 
 #include "radiosity/element_scene.h"
+#include "radiosity/cluster_kernel.h"
 #include "radiosity/form_factor.h"
 #include "radiosity/probe_fraction.h"
 #include "raytrace_core/parallel.h"
@@ -96,6 +97,7 @@ struct Node {
   float area = 0.0f;
   Vec3 area_vector{0.0f};  ///< Σ A_k n_k
   float albedo = 0.0f;     ///< area-weighted mean reflectance (channel mean)
+  glm::mat3 covariance{0.0f};  ///< of its points about center, uniform by area
 
   bool leaf() const { return right == kNone; }
 };
@@ -256,10 +258,17 @@ class TreeBuilder {
     node.normal = len > 1e-6 * area && len > 0.0 ? Vec3(weighted_normal / len) : Vec3(0.0f);
     float spread = node.normal == Vec3(0.0f) ? 2.0f : 0.0f, radius2 = 0.0f;
     float low = 0.0f, high = 0.0f;
+    glm::dmat3 second(0.0);
     for (uint32_t i = first; i < first + count; ++i) {
       const uint32_t e = tree_.order[i];
       if (node.normal != Vec3(0.0f))
         spread = std::max(spread, glm::length(mesh_.element_normal[e] - node.normal));
+      const auto& el = mesh_.elements[e];
+      const DVec3 g = DVec3(centroid_[e]) - DVec3(node.center);
+      second += double(mesh_.element_area[e]) *
+                (triangle_covariance(DVec3(mesh_.positions[el[0]]), DVec3(mesh_.positions[el[1]]),
+                                     DVec3(mesh_.positions[el[2]])) +
+                 glm::outerProduct(g, g));
       for (uint32_t v : mesh_.elements[e]) {
         const Vec3 d = mesh_.positions[v] - node.center;
         radius2 = std::max(radius2, glm::dot(d, d));
@@ -268,6 +277,7 @@ class TreeBuilder {
       }
     }
     node.spread = spread;
+    if (area > 0.0) node.covariance = glm::mat3(second / area);
     node.radius = std::sqrt(radius2) * (1.0f + 1e-6f);
     node.low = low, node.high = high;
     return node;
@@ -374,11 +384,12 @@ rc::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint3
 }
 
 /// A link: node `receiver` gathers from node `source`. Far links give the irradiance facing the
-/// source, I_S(−ω)·factor with factor = V / r², along ω, the unit direction from the receiver's
-/// centre to the source's; exact links (element to element) give B_S·factor with factor = F·V,
-/// along the receiver's normal. Twelve bytes: the direction is found again from the nodes when
-/// gathering (link_direction), since a 300k-triangle interior at tolerance 2e-6 holds 120
-/// million links, and at 28 bytes with the sort's buffer those took 10 GB.
+/// source, I_S(−ω)·factor with factor = V κ / r² (κ the kernel's average over the two ends'
+/// extent, cluster_kernel_scale), along ω, the unit direction from the receiver's centre to the
+/// source's; exact links (element to element) give B_S·factor with factor = F·V, along the
+/// receiver's normal. Twelve bytes: the direction is found again from the nodes when gathering
+/// (link_direction), since a 300k-triangle interior at tolerance 2e-6 holds 120 million links,
+/// and at 28 bytes with the sort's buffer those took 10 GB.
 struct Link {
   static constexpr uint32_t kExactBit = 0x80000000u;
   uint32_t receiver;
@@ -672,7 +683,10 @@ class Linker {
       split_mixed(r, s + 1, r_depth, s_depth + 1, visible, links);
       split_mixed(r, S.right, r_depth, s_depth + 1, visible, links);
     } else {
-      links.emplace_back(r, s, visible / dist2, false);
+      // The kernel averaged over the two ends' extent, not read at their centres alone.
+      const Vec3 n_r = receiving == Facing::front ? R.normal : w, n_s = sending == Facing::front ? S.normal : -w;
+      const float scale = cluster_kernel_scale(d, n_r, n_s, R.covariance + S.covariance);
+      links.emplace_back(r, s, visible * scale / dist2, false);
     }
   }
 
@@ -779,7 +793,10 @@ struct TreeWalk {
         }
         const float cos_receiver = glm::dot(n, d) / dist;
         if (!(cos_receiver > 0.0f)) continue;
-        value = intensity(moment[s], -d / dist) * (cos_receiver / (dist * dist));
+        // The kernel averaged over the source's extent (cluster_kernel_scale), the receiver a point.
+        const Vec3 n_s = facing(S, -d / dist) == Facing::front ? S.normal : -d / dist;
+        const float scale = cluster_kernel_scale(d, n, n_s, S.covariance);
+        value = intensity(moment[s], -d / dist) * (cos_receiver * scale / (dist * dist));
       }
       rc::Bounds3 reach = S.box;
       reach.extend(p);
