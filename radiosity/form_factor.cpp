@@ -68,6 +68,21 @@ SourceTriangle::SourceTriangle(const Vec3& a, const Vec3& b, const Vec3& c)
   rule_points_[2] = m + 0.5f * c;
 }
 
+double SourceTriangle::form_factor_from(const SourceTriangle& receiver, const Vec3& n) const {
+  // Dunavant's degree-4 rule: barycentric (α, α, 1 − 2α) and permutations, two orbits.
+  constexpr double kAlpha[2] = {0.445948490915965, 0.091576213509771};
+  constexpr double kWeight[2] = {0.223381589678011, 0.109951743655322};
+  double sum = 0.0;
+  for (int orbit = 0; orbit < 2; ++orbit) {
+    const float x = float(kAlpha[orbit]), y = float(1.0 - 2.0 * kAlpha[orbit]);
+    const Vec3 points[3] = {x * receiver.a_ + x * receiver.b_ + y * receiver.c_,
+                            x * receiver.a_ + y * receiver.b_ + x * receiver.c_,
+                            y * receiver.a_ + x * receiver.b_ + x * receiver.c_};
+    for (const Vec3& p : points) sum += kWeight[orbit] * form_factor(p, n);
+  }
+  return sum;
+}
+
 void SourceBatch::assign(std::span<const SourceTriangle> triangles) {
   if (triangles.size() > kMaxBatch) throw std::length_error("SourceBatch: more than kMaxBatch triangles");
   triangles_.assign(triangles.begin(), triangles.end());

@@ -386,10 +386,11 @@ rc::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint3
 /// A link: node `receiver` gathers from node `source`. Far links give the irradiance facing the
 /// source, I_S(−ω)·factor with factor = V κ / r² (κ the kernel's average over the two ends'
 /// extent, cluster_kernel_scale), along ω, the unit direction from the receiver's centre to the
-/// source's; exact links (element to element) give B_S·factor with factor = F·V, along the
-/// receiver's normal. Twelve bytes: the direction is found again from the nodes when gathering
-/// (link_direction), since a 300k-triangle interior at tolerance 2e-6 holds 120 million links,
-/// and at 28 bytes with the sort's buffer those took 10 GB.
+/// source's; exact links (element to element) give B_S·factor with factor = F·V, F the element's
+/// mean factor to the source (SourceTriangle::form_factor_from), along the receiver's normal.
+/// Twelve bytes: the direction is found again from the nodes when gathering (link_direction),
+/// since a 300k-triangle interior at tolerance 2e-6 holds 120 million links, and at 28 bytes
+/// with the sort's buffer those took 10 GB.
 struct Link {
   static constexpr uint32_t kExactBit = 0x80000000u;
   uint32_t receiver;
@@ -575,7 +576,8 @@ class Linker {
     if (R.leaf() && S.leaf()) {
       const uint32_t er = tree_.element(R), es = tree_.element(S);
       ++count_for(r).form_factors;
-      const float f = float(tree_.triangles[es].form_factor(R.center, in_.mesh.element_normal[er]));
+      const float f =
+          float(tree_.triangles[es].form_factor_from(tree_.triangles[er], in_.mesh.element_normal[er]));
       if (f > 0.0f) {
         const float visible = visibility(r, s);
         if (visible > 0.0f) out.exact.emplace_back(r, s, f * visible, true);
