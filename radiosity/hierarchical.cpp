@@ -33,6 +33,8 @@
 #include <stdexcept>
 #include <numeric>
 #include <optional>
+#include <tuple>
+#include <utility>
 
 #include "radiosity/element_scene.h"
 #include "radiosity/cluster_kernel.h"
@@ -218,9 +220,10 @@ class TreeBuilder {
     return half;
   }
 
-  /// The area of elements [first, first + count) of the order when they face both ways (their
-  /// normals' spread about the mean is 1 or more, as Node::spread), else 0.
-  float mixed_area(uint32_t first, uint32_t count) const {
+  /// The unit area-weighted mean normal of elements [first, first + count) of the order (0 where
+  /// the normals cancel) and their spread about it, the largest |n_k − mean| (2 where they
+  /// cancel): Node::normal and Node::spread.
+  std::pair<Vec3, float> normal_and_spread(uint32_t first, uint32_t count) const {
     double area = 0.0;
     DVec3 sum(0.0);
     for (uint32_t i = first; i < first + count; ++i) {
@@ -229,11 +232,21 @@ class TreeBuilder {
       sum += double(mesh_.element_area[e]) * DVec3(mesh_.element_normal[e]);
     }
     const double len = glm::length(sum);
-    if (!(len > 1e-6 * area && len > 0.0)) return float(area);
+    if (!(len > 1e-6 * area && len > 0.0)) return {Vec3(0.0f), 2.0f};
     const Vec3 mean(sum / len);
+    float spread = 0.0f;
     for (uint32_t i = first; i < first + count; ++i)
-      if (glm::length(mesh_.element_normal[tree_.order[i]] - mean) >= 1.0f) return float(area);
-    return 0.0f;
+      spread = std::max(spread, glm::length(mesh_.element_normal[tree_.order[i]] - mean));
+    return {mean, spread};
+  }
+
+  /// The area of elements [first, first + count) of the order when they face both ways (their
+  /// normals' spread is 1 or more, as Node::spread), else 0.
+  float mixed_area(uint32_t first, uint32_t count) const {
+    if (normal_and_spread(first, count).second < 1.0f) return 0.0f;
+    double area = 0.0;
+    for (uint32_t i = first; i < first + count; ++i) area += mesh_.element_area[tree_.order[i]];
+    return float(area);
   }
 
   Node summarise(uint32_t first, uint32_t count) const {
@@ -255,15 +268,12 @@ class TreeBuilder {
     node.area_vector = Vec3(weighted_normal);
     node.albedo = area > 0.0 ? float(albedo / area) : 0.0f;
     node.center = area > 0.0 ? Vec3(weighted_centroid / area) : node.box.center();
-    const double len = glm::length(weighted_normal);
-    node.normal = len > 1e-6 * area && len > 0.0 ? Vec3(weighted_normal / len) : Vec3(0.0f);
-    float spread = node.normal == Vec3(0.0f) ? 2.0f : 0.0f, radius2 = 0.0f;
+    std::tie(node.normal, node.spread) = normal_and_spread(first, count);
+    float radius2 = 0.0f;
     float low = 0.0f, high = 0.0f;
     glm::dmat3 second(0.0);
     for (uint32_t i = first; i < first + count; ++i) {
       const uint32_t e = tree_.order[i];
-      if (node.normal != Vec3(0.0f))
-        spread = std::max(spread, glm::length(mesh_.element_normal[e] - node.normal));
       const auto& el = mesh_.elements[e];
       const DVec3 g = DVec3(centroid_[e]) - DVec3(node.center);
       second += double(mesh_.element_area[e]) *
@@ -277,7 +287,6 @@ class TreeBuilder {
         low = std::min(low, h), high = std::max(high, h);
       }
     }
-    node.spread = spread;
     if (area > 0.0) node.covariance = glm::mat3(second / area);
     node.radius = std::sqrt(radius2) * (1.0f + 1e-6f);
     node.low = low, node.high = high;
