@@ -75,6 +75,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
           {"linking_stopped_by_time", sol.linking_stopped},
           {"shots", sol.shots},
           {"residual", sol.residual},
+          {"tail_added", sol.tail_added},
           {"tolerance", settings.tolerance},
           {"form_factors", sol.form_factors},
           {"form_factors_per_second", double(sol.form_factors) / secs},

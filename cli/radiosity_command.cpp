@@ -233,11 +233,11 @@ void run_radiosity(RadiosityOptions& o) {
                 sol.mesh_report.buried_faces, sol.mesh_report.buried_elements);
   if (sol.solver == radiosity::SolverKind::hierarchical)
     std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links at tolerance %.3g%s, %d iterations, residual %.3g "
-                "(tolerance %.3g), final gather %s (%.3g nodes per vertex)\n",
+                "(tolerance %.3g%s), final gather %s (%.3g nodes per vertex)\n",
                 sol.solver_reason.c_str(), sol.nodes, sol.links, sol.link_tolerance,
                 sol.linking_stopped ? (sol.links > 0 ? " (finer linking stopped by --time)" : " (linking stopped by --time)") : "",
                 sol.iterations, sol.residual,
-                o.solver.tolerance, sol.final_gather_note.c_str(),
+                o.solver.tolerance, sol.tail_added ? "; the geometric tail added" : "", sol.final_gather_note.c_str(),
                 double(sol.gather_nodes) / double(std::max<size_t>(1, sol.mesh.vertex_count())));
   else
     std::printf("  solve:   progressive (%s): %llu shots, residual %.3g (tolerance %.3g)\n", sol.solver_reason.c_str(),

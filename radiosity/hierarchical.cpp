@@ -26,6 +26,7 @@
 #include "radiosity/hierarchical.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -1100,20 +1101,31 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     }
   };
 
-  // Jacobi iteration: gather, then reflect.
-  std::vector<Rgb> next(ne);
+  // Jacobi iteration: gather, then reflect. It converges from below, each step's change a
+  // factor λ (the largest eigenvalue of ρ·gather) smaller than the last, so stopping leaves
+  // λ / (1 − λ) times the last change ungathered: 4 times the tolerance in a white furnace of
+  // ρ = 0.8, which read 0.3 % dark. Once λ has settled (two successive ratios of the changes
+  // agree), the tail is added: the geometric series' sum along the last change (Aitken's
+  // extrapolation, per channel).
+  std::vector<Rgb> next(ne), last_indirect(ne);
   auto iterate = [&] {
     result.iterations = 0;
     result.residual = 0.0;
+    std::array<double, 3> step{}, last_step{}, ratio{}, last_ratio{};
     for (int it = 0; it < settings.max_iterations; ++it) {
       if (out_of_time()) break;
+      last_indirect.swap(indirect);
       gather(radiosity, indirect);
       double total = 0.0;
+      last_step = step, last_ratio = ratio, step = {};
       for (size_t e = 0; e < ne; ++e) {
         indirect[e] *= gain[e];
         next[e] = in.albedo[e] * (direct[e] + indirect[e]);
         total += double(next[e].average()) * mesh.element_area[e];
+        for (int k = 0; k < 3; ++k)
+          step[size_t(k)] += double(in.albedo[e][k]) * double(indirect[e][k] - last_indirect[e][k]) * mesh.element_area[e];
       }
+      for (size_t k = 0; k < 3; ++k) ratio[k] = last_step[k] > 0.0 ? step[k] / last_step[k] : 0.0;
       const double floor = kResidualFloor * total / area;
       double change = 0.0;
       for (size_t e = 0; e < ne; ++e) {
@@ -1125,6 +1137,18 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       ++result.iterations;
       result.residual = total > 0.0 ? change / area : 0.0;
       if (result.residual < settings.tolerance) break;
+    }
+    if (result.iterations < 3) return;
+    std::array<float, 3> tail{};
+    for (size_t k = 0; k < 3; ++k) {
+      const double l = ratio[k];
+      if (l > 0.0 && l < kMaxReflectedGain && std::abs(l - last_ratio[k]) <= 0.02 * l) tail[k] = float(l / (1.0 - l));
+    }
+    result.extrapolated = tail[0] > 0.0f || tail[1] > 0.0f || tail[2] > 0.0f;
+    for (size_t e = 0; e < ne; ++e) {
+      for (int k = 0; k < 3; ++k)
+        indirect[e][k] = std::max(0.0f, indirect[e][k] + tail[size_t(k)] * (indirect[e][k] - last_indirect[e][k]));
+      radiosity[e] = in.albedo[e] * (direct[e] + indirect[e]);
     }
   };
 
