@@ -1122,17 +1122,16 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         indirect[e] *= gain[e];
         next[e] = in.albedo[e] * (direct[e] + indirect[e]);
         total += double(next[e].average()) * mesh.element_area[e];
-        for (int k = 0; k < 3; ++k)
-          step[size_t(k)] += double(in.albedo[e][k]) * double(indirect[e][k] - last_indirect[e][k]) * mesh.element_area[e];
       }
-      for (size_t k = 0; k < 3; ++k) ratio[k] = last_step[k] > 0.0 ? step[k] / last_step[k] : 0.0;
       const double floor = kResidualFloor * total / area;
       double change = 0.0;
       for (size_t e = 0; e < ne; ++e) {
         const Rgb delta = next[e] - radiosity[e];
         change += (std::fabs(delta.r) + std::fabs(delta.g) + std::fabs(delta.b)) / 3.0 * mesh.element_area[e] /
                   std::max(double(next[e].average()), floor);
+        for (int k = 0; k < 3; ++k) step[size_t(k)] += double(delta[k]) * mesh.element_area[e];
       }
+      for (size_t k = 0; k < 3; ++k) ratio[k] = last_step[k] > 0.0 ? step[k] / last_step[k] : 0.0;
       radiosity.swap(next);
       ++result.iterations;
       result.residual = total > 0.0 ? change / area : 0.0;
@@ -1144,7 +1143,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       const double l = ratio[k];
       if (l > 0.0 && l < kMaxReflectedGain && std::abs(l - last_ratio[k]) <= 0.02 * l) tail[k] = float(l / (1.0 - l));
     }
-    result.extrapolated = tail[0] > 0.0f || tail[1] > 0.0f || tail[2] > 0.0f;
+    result.tail_added = tail[0] > 0.0f || tail[1] > 0.0f || tail[2] > 0.0f;
     for (size_t e = 0; e < ne; ++e) {
       for (int k = 0; k < 3; ++k)
         indirect[e][k] = std::max(0.0f, indirect[e][k] + tail[size_t(k)] * (indirect[e][k] - last_indirect[e][k]));

@@ -80,7 +80,7 @@ struct HierarchicalResult {
   size_t nodes = 0, links = 0;
   int iterations = 0;
   double residual = 0.0;  ///< relative change of the last iteration
-  bool extrapolated = false;  ///< whether the iteration's geometric tail was added (see solve_hierarchical)
+  bool tail_added = false;  ///< whether the iteration's geometric tail was added (see solve_hierarchical)
   size_t clamped_elements = 0;  ///< elements whose links promised more light than they can reflect (scaled down)
   uint64_t shadow_rays = 0, form_factors = 0;
   uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated

@@ -986,7 +986,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
                                          "(surfaces a hair apart?); their gathering was scaled down to keep the "
                                          "solution bounded");
     sol.residual = h.residual;
-    sol.tail_added = h.extrapolated;
+    sol.tail_added = h.tail_added;
     sol.gather_nodes = h.gather_nodes;
     sol.final_gather = h.final_gather;
     sol.final_gather_note = h.final_gather_note;

@@ -143,7 +143,7 @@ TEST(HierarchicalRadiosity, CoarseLinksDoNotBrightenTheFurnace) {
 
 // The Jacobi iteration converges from below, each change λ times the last (λ = ρ in a white
 // furnace, where every element sees the same). Stopping at relative change T leaves about
-// T λ / (1 − λ) ungathered: 3 % dark at T = 1e-2 and ρ = 0.8, 0.5 % at 1e-3. The solver adds
+// T λ / (1 − λ) ungathered: 3 % dark at T = 1e-2 and ρ = 0.8, 0.3 % at 1e-3. The solver adds
 // that geometric tail once two successive ratios agree. In the furnace the error is that one
 // mode alone, so the tail's sum is exact but for rounding: the stopped solution must agree with
 // the converged one (T = 1e-6) to 0.1 %, thirty times closer than without the tail.
