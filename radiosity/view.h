@@ -52,8 +52,8 @@ class RadiosityView {
   /// Irradiance (W·m⁻²) the solution gives a point of the input at p whose lit side faces along
   /// the unit normal n from other surfaces' reflections (the direct light left out): interpolated
   /// at the nearest point of an element that faces the same way (within 60°) and lies within
-  /// reach (twice the target edge), unless p lies farther behind or in front of the element's
-  /// plane than a curved surface the element is a chord of could. Nothing where no element does:
+  /// reach (twice the target edge), unless p lies farther from the element than a curved surface
+  /// the element is a chord of could. Nothing where no element does:
   /// the back of a one-sided surface, the inside of an open shell, a face removed as buried, a
   /// mirror or glass.
   std::optional<Rgb> indirect_irradiance(const rc::SurfacePoint& p, const Vec3& n) const;
@@ -90,10 +90,12 @@ class RadiosityView {
   /// (the caller's direct light left it out: rc::sky_left_to_bsdf_sampling).
   Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx,
              bool via_specular_only = false, bool sky_on_escape = false) const;
-  /// locate(), unless p lies farther from the element's plane than a curved surface the element
-  /// is a chord of could (see indirect_irradiance).
+  /// locate(), unless p lies farther from the element than a curved surface the element is a
+  /// chord of could (see indirect_irradiance); seen from behind its face (n against p.ng), within
+  /// the sagitta of the element's own size.
   std::optional<Location> locate_on(const rc::SurfacePoint& p, const Vec3& n) const;
   Rgb indirect_at(const Location& at) const;
+  float longest_edge(uint32_t element) const;
   /// Whether a gather ray that met the surface `distance` from its origin, where `at` locates
   /// it, is too close to read the solution there (kNearHit).
   bool near_hit(const Location& at, float distance) const;
