@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
+#include <utility>
 
 #include "radiosity/cluster_kernel.h"
 #include "raytrace_core/rng.h"
