@@ -19,9 +19,9 @@
 // of its mean normal) sends I(ω) = ω·Σ B_k A_k n_k / π, exact for a plane, and receives the
 // irradiance vector W = Σ J w (J the irradiance facing the source, w towards it), so that an
 // element below it with normal n gets n·W: exact when every source is in front of it. A
-// curved or scattered cluster uses the first two spherical-harmonic bands of the clamped cosine
-// (max(0, cos) ≈ 1/4 + cos/2) for both; the oracle's error factor is then 1, so such links are
-// accepted only where little light travels.
+// curved or scattered cluster sends by bins of its elements' normals (intensity, below) and
+// receives by bins of the links' directions (irradiance_at); the oracle's error factor is then 1,
+// so such links are accepted only where little light travels.
 
 #include "radiosity/hierarchical.h"
 
@@ -741,19 +741,39 @@ void pull(const Tree& tree, const RadiosityMesh& mesh, std::span<const Rgb> radi
   }
 }
 
-/// What a node has gathered: the irradiance vector of flat receivers, and the two bands of
-/// curved ones (Σ J and Σ J w).
+/// What a node has gathered: the irradiance vector of flat receivers, and for curved ones, per
+/// bin of the links' directions w, the irradiance vector W_b = Σ J w and the sum S_b = Σ J over
+/// the links whose w falls in the bin.
 struct Gathered {
   RgbVec flat;
-  Rgb sum{0.0f};
-  RgbVec band1;
+  RgbVec bins[kDirectionBins];
+  Rgb sums[kDirectionBins];
 };
 
+/// An element of normal n under a curved receiver takes S_b E[max(0, n·w)] from each bin b, the
+/// expectation over the bin's directions read from their mean x = n·W_b / S_b and their spread
+/// s = √(1 − κ²), κ = |W_b| / S_b: the ramp max(0, x) smoothed over [−s, s] by (x + s)² / 4s.
+/// Exact for one link (s = 0: max(0, J n·w)) and for directions spread evenly over the sphere
+/// (x = 0, s = 1: ¼ S_b); for an even hemisphere it gives 0.54, 0.22 and 0.04 for normals along,
+/// across and against it, where the answer is 0.5, 0.25 and 0. The two-band model it replaces,
+/// max(0, ¼ Σ J + ½ n·Σ J w), gave an element turned 90° from a lone source a quarter of its
+/// light, and one facing it three quarters: it moved light from the elements of a carved or curved
+/// cluster that face a bright source to those that do not (HierarchicalRadiosity.
+/// ABallsFacesTakeTheLightOfTheirOwnSide).
 Rgb irradiance_at(const Gathered& g, const Vec3& n) {
   Rgb out = g.flat.dot(n);
-  const Rgb b1 = g.band1.dot(n);
-  for (int k = 0; k < 3; ++k)
-    out[k] = std::max(0.0f, out[k] + std::max(0.0f, 0.25f * g.sum[k] + 0.5f * b1[k]));
+  for (int k = 0; k < 3; ++k) out[k] = std::max(0.0f, out[k]);
+  for (int i = 0; i < kDirectionBins; ++i) {
+    const Rgb b = g.bins[i].dot(n);
+    for (int k = 0; k < 3; ++k) {
+      const float sum = g.sums[i][k];
+      if (!(sum > 0.0f)) continue;
+      const float kappa = std::min(1.0f, glm::length(g.bins[i].c[k]) / sum);
+      const float x = b[k] / sum, spread = std::sqrt(std::max(0.0f, 1.0f - kappa * kappa));
+      const float phi = x >= spread ? x : (x <= -spread ? 0.0f : (x + spread) * (x + spread) / (4.0f * spread));
+      out[k] += sum * phi;
+    }
+  }
   return out;
 }
 
@@ -1021,8 +1041,8 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         if (side == Facing::front) {
           acc.flat.add(j, dir);
         } else if (side == Facing::mixed) {
-          acc.sum += j;
-          acc.band1.add(j, dir);
+          acc.bins[direction_bin(dir)].add(j, dir);
+          acc.sums[direction_bin(dir)] += j;
         }
       }
     }
@@ -1056,8 +1076,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       if (node.leaf()) continue;
       for (size_t c : {i + 1, size_t(node.right)}) {
         gathered[c].flat.add(gathered[i].flat);
-        gathered[c].sum += gathered[i].sum;
-        gathered[c].band1.add(gathered[i].band1);
+        for (int b = 0; b < kDirectionBins; ++b) gathered[c].bins[b].add(gathered[i].bins[b]), gathered[c].sums[b] += gathered[i].sums[b];
       }
     }
     auto leaf_irradiance = [&](size_t i) {
