@@ -1041,8 +1041,9 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         if (side == Facing::front) {
           acc.flat.add(j, dir);
         } else if (side == Facing::mixed) {
-          acc.bins[direction_bin(dir)].add(j, dir);
-          acc.sums[direction_bin(dir)] += j;
+          const int bin = direction_bin(dir);
+          acc.bins[bin].add(j, dir);
+          acc.sums[bin] += j;
         }
       }
     }
