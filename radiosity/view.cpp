@@ -87,7 +87,6 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
     vertex_indirect_[v] = indirect + (ambient ? solution.ambient : Rgb(0.0f));
   }
   positions_ = mesh.positions;
-  element_normal_ = mesh.element_normal;
   element_direct_ = solution.element_direct;
   sky_by_gather_ = rc::sky_left_to_bsdf_sampling(scene);
   for (const rc::Light& l : scene.lights())

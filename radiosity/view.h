@@ -108,7 +108,6 @@ class RadiosityView {
   std::vector<Rgb> vertex_radiance_;         ///< mesh view: W·sr⁻¹·m⁻²
   std::vector<Rgb> vertex_indirect_;         ///< two-pass view: W·m⁻² from reflections, ambient term included
   std::vector<Vec3> positions_;              ///< of the elements' vertices
-  std::vector<Vec3> element_normal_;
   std::vector<Rgb> element_direct_;          ///< per element (Solution::element_direct; may be empty)
   bool has_specular_ = false;                ///< the scene has mirrors or glass
   bool sky_by_gather_ = false;               ///< gathered_sample takes the uniform sky by its gather ray

@@ -27,6 +27,23 @@ rc::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
   return m;
 }
 
+/// Gives `scene` (its meshes added, all of material 0) a white diffuse material (0.8) and a sun
+/// of unit irradiance travelling along `sun_direction`, commits it, and solves it with elements
+/// of at most `max_edge`.
+rad::Solution solve_sunlit(rc::Scene& scene, Vec3 sun_direction, float max_edge) {
+  scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
+  rc::Light sun;
+  sun.kind = rc::LightKind::directional;
+  sun.direction = glm::normalize(sun_direction);
+  sun.irradiance = Rgb(1.0f);
+  scene.punctual_lights.push_back(sun);
+  scene.commit();
+  rad::SolverSettings settings;
+  settings.mesh.max_edge = max_edge;
+  settings.progress = false;
+  return rad::solve(scene, settings);
+}
+
 }  // namespace
 
 // A one-sided floor (front up) lit by the sun and by a sunlit wall beside it, and under it a
@@ -37,21 +54,12 @@ rc::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 // what a shadow ray found there.)
 TEST(RadiosityView, DoesNotReadTheSolutionThroughASurface) {
   rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));        // floor, up
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 2, -1}, {-1, 2, 1}, {-1, 0, 1}));      // wall, +x
   scene.meshes.push_back(quad({-0.5f, -0.3f, -0.5f}, {0.5f, -0.3f, -0.5f}, {0.5f, -0.3f, 0.5f},
                               {-0.5f, -0.3f, 0.5f}));                                   // plate, down
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
-  sun.direction = glm::normalize(Vec3(-1.0f, -1.0f, 0.2f));
-  sun.irradiance = Rgb(1.0f);
-  scene.punctual_lights.push_back(sun);
-  scene.commit();
-  rad::SolverSettings settings;
-  settings.mesh.max_edge = 0.5f;  // the view looks up to 1.0 away: the floor is within reach of the plate
-  settings.progress = false;
-  const rad::Solution sol = rad::solve(scene, settings);
+  // Elements of 0.5: the view looks up to 1.0 away, so the floor is within reach of the plate.
+  const rad::Solution sol = solve_sunlit(scene, Vec3(-1.0f, -1.0f, 0.2f), 0.5f);
   const rad::RadiosityView view(scene, sol, rad::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f);
@@ -244,7 +252,6 @@ TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
 // outside this way.)
 TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
   rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));                  // floor, up
   scene.meshes.push_back(quad({-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f},
                               {-0.5f, 0.5f, 0.5f}));                                              // canopy, down
@@ -252,16 +259,7 @@ TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
   chip.positions = {{-0.05f, 0.53f, -0.05f}, {-0.05f, 0.53f, 0.05f}, {0.05f, 0.53f, 0.0f}};
   chip.indices = {0, 1, 2};
   scene.meshes.push_back(chip);
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
-  sun.direction = glm::normalize(Vec3(-0.3f, -1.0f, 0.2f));
-  sun.irradiance = Rgb(1.0f);
-  scene.punctual_lights.push_back(sun);
-  scene.commit();
-  rad::SolverSettings settings;
-  settings.mesh.max_edge = 1.0f;
-  settings.progress = false;
-  const rad::Solution sol = rad::solve(scene, settings);
+  const rad::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);
   const rad::RadiosityView view(scene, sol, rad::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f), down(0.0f, -1.0f, 0.0f);
@@ -284,19 +282,9 @@ TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
 // from the hit.)
 TEST(RadiosityView, AnElementBesideThePointIsNotItsChord) {
   rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
   scene.meshes.push_back(quad({0.5f, 0.02f, -0.25f}, {0.5f, 0.02f, 0.25f}, {1.0f, 0.02f, 0.25f},
                               {1.0f, 0.02f, -0.25f}));  // ledge, up
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
-  sun.direction = glm::normalize(Vec3(-0.3f, -1.0f, 0.2f));
-  sun.irradiance = Rgb(1.0f);
-  scene.punctual_lights.push_back(sun);
-  scene.commit();
-  rad::SolverSettings settings;
-  settings.mesh.max_edge = 1.0f;  // the bound for chords: 0.07
-  settings.progress = false;
-  const rad::Solution sol = rad::solve(scene, settings);
+  const rad::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);  // the bound for chords: 0.07
   const rad::RadiosityView view(scene, sol, rad::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f);
