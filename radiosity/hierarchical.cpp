@@ -399,8 +399,9 @@ rc::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint3
 /// extent, cluster_kernel_scale), along ω, the unit direction from the receiver's centre to the
 /// source's; exact links (element to element) give B_S·factor with factor = F·V, F the element's
 /// mean factor to the source (SourceTriangle::form_factor_from), along the receiver's normal.
-/// Twelve bytes: the direction is found again from the nodes when gathering (link_direction),
-/// since a 300k-triangle interior at tolerance 2e-6 holds 120 million links, and at 28 bytes
+/// Twelve bytes: the direction is found again from the nodes when gathering (a far link's, from
+/// its receiver's centre to its source's, as split_mixed made it; an exact link's, the receiving
+/// element's normal), since a 300k-triangle interior at tolerance 2e-6 holds 120 million links, and at 28 bytes
 /// with the sort's buffer those took 10 GB.
 struct Link {
   static constexpr uint32_t kExactBit = 0x80000000u;
@@ -417,15 +418,6 @@ struct Link {
     return a.receiver != b.receiver ? a.receiver < b.receiver : a.tagged_source < b.tagged_source;
   }
 };
-
-/// The unit direction of a far link from its receiver's centre to its source's (as split_mixed
-/// made it), or an exact link's receiving element's normal.
-Vec3 link_direction(const Tree& tree, const RadiosityMesh& mesh, const Link& link) {
-  const Node& R = tree.nodes[link.receiver];
-  if (link.exact()) return mesh.element_normal[tree.element(R)];
-  const Vec3 d = tree.nodes[link.source()].center - R.center;
-  return d / std::sqrt(glm::dot(d, d));
-}
 
 struct Counters {
   std::atomic<uint64_t> rays{0}, form_factors{0}, gather_nodes{0};
@@ -741,6 +733,45 @@ void pull(const Tree& tree, const RadiosityMesh& mesh, std::span<const Rgb> radi
   }
 }
 
+/// What the links read of a source node in one gather, packed for them: its centre and area, its
+/// power, and its non-empty normal bins (bins[first .. next node's first) of a shared pool). A
+/// gather reads one of these per link, in the order of the links' sources, so it is the links'
+/// memory traffic: 32 bytes and a bin or two (most nodes are flat) against the 132-byte node
+/// and six 36-byte bins. The bins kept are the non-zero ones in bin order, and a zero bin adds
+/// exactly nothing to intensity(), so the sums are the same to the bit.
+struct PackedSources {
+  struct Source {
+    Vec3 center;
+    uint32_t first;
+    Rgb power;
+    float area;
+  };
+  std::vector<Source> nodes;  ///< one per tree node, and one more closing the last node's bins
+  std::vector<RgbVec> bins;
+
+  void pack(const Tree& tree, std::span<const Rgb> power, std::span<const Moments> moment) {
+    const size_t n = tree.nodes.size();
+    nodes.resize(n + 1);
+    bins.clear();
+    for (size_t i = 0; i < n; ++i) {
+      nodes[i] = {tree.nodes[i].center, uint32_t(bins.size()), power[i], tree.nodes[i].area};
+      for (const RgbVec& b : moment[i].bins)
+        if (b.c[0] != Vec3(0.0f) || b.c[1] != Vec3(0.0f) || b.c[2] != Vec3(0.0f)) bins.push_back(b);
+    }
+    nodes[n] = {Vec3(0.0f), uint32_t(bins.size()), Rgb(0.0f), 0.0f};
+  }
+
+  /// intensity() of node s towards ω.
+  Rgb intensity(uint32_t s, const Vec3& omega) const {
+    Rgb out(0.0f);
+    for (uint32_t b = nodes[s].first; b < nodes[s + 1].first; ++b) {
+      const Rgb along = bins[b].dot(omega);
+      for (int k = 0; k < 3; ++k) out[k] += std::max(0.0f, along[k]);
+    }
+    return out * (1.0f / kPi);
+  }
+};
+
 /// What a node has gathered: the irradiance vector of flat receivers, and for curved ones, per
 /// bin of the links' directions w, the irradiance vector W_b = Σ J w and the sum S_b = Σ J over
 /// the links whose w falls in the bin.
@@ -1025,18 +1056,24 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // down to the elements.
   std::vector<Rgb> power, indirect(ne, Rgb(0.0f));
   std::vector<Moments> moment;
+  PackedSources packed;
   std::vector<Gathered> gathered(tree.nodes.size());
   // Gathers at the receivers [lo, hi) over their links.
   auto gather_receivers = [&](size_t lo, size_t hi) {
     for (size_t g = lo; g < hi; ++g) {
       const Node& R = tree.nodes[receivers[g]];
       Gathered& acc = gathered[receivers[g]];
+      const Vec3 exact_dir = R.leaf() ? mesh.element_normal[tree.element(R)] : Vec3(0.0f);
       for (uint32_t l = first_link[g]; l < first_link[g + 1]; ++l) {
         const Link& link = links[l];
         const uint32_t source = link.source();
-        const Vec3 dir = link_direction(tree, mesh, link);
-        const Rgb j = link.exact() ? power[source] * (link.factor / tree.nodes[source].area)
-                                   : intensity(moment[source], -dir) * link.factor;
+        const PackedSources::Source& S = packed.nodes[source];
+        Vec3 dir = exact_dir;
+        if (!link.exact()) {
+          const Vec3 d = S.center - R.center;
+          dir = d / std::sqrt(glm::dot(d, d));
+        }
+        const Rgb j = link.exact() ? S.power * (link.factor / S.area) : packed.intensity(source, -dir) * link.factor;
         const Facing side = facing(R, dir);
         if (side == Facing::front) {
           acc.flat.add(j, dir);
@@ -1050,6 +1087,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   };
   auto gather = [&](std::span<const Rgb> from, std::vector<Rgb>& out) {
     pull(tree, mesh, from, power, moment);
+    packed.pack(tree, power, moment);
     std::fill(gathered.begin(), gathered.end(), Gathered{});
     if (group.count() == 1) {
       rc::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
