@@ -76,6 +76,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
           {"shots", sol.shots},
           {"residual", sol.residual},
           {"tail_added", sol.tail_added},
+          {"chebyshev_beta", sol.chebyshev_beta},
           {"tolerance", settings.tolerance},
           {"form_factors", sol.form_factors},
           {"form_factors_per_second", double(sol.form_factors) / secs},

@@ -231,12 +231,14 @@ void run_radiosity(RadiosityOptions& o) {
                 sol.mesh_report.contact_edges,
                 100.0 * sol.mesh_report.buried_area / std::max(sol.mesh_report.meshed_area, 1e-300),
                 sol.mesh_report.buried_faces, sol.mesh_report.buried_elements);
+  char chebyshev[48] = "";
+  if (sol.chebyshev_beta > 0.0) std::snprintf(chebyshev, sizeof chebyshev, " (Chebyshev, beta %.3g)", sol.chebyshev_beta);
   if (sol.solver == radiosity::SolverKind::hierarchical)
-    std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links at tolerance %.3g%s, %d iterations, residual %.3g "
+    std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links at tolerance %.3g%s, %d iterations%s, residual %.3g "
                 "(tolerance %.3g%s), final gather %s (%.3g nodes per vertex)\n",
                 sol.solver_reason.c_str(), sol.nodes, sol.links, sol.link_tolerance,
                 sol.linking_stopped ? (sol.links > 0 ? " (finer linking stopped by --time)" : " (linking stopped by --time)") : "",
-                sol.iterations, sol.residual,
+                sol.iterations, chebyshev, sol.residual,
                 o.solver.tolerance, sol.tail_added ? "; the geometric tail added" : "", sol.final_gather_note.c_str(),
                 double(sol.gather_nodes) / double(std::max<size_t>(1, sol.mesh.vertex_count())));
   else

@@ -72,6 +72,12 @@ constexpr uint64_t kPilotStream = 0x5100000000ull, kEstimateStream = 0x540000000
 /// A cluster link whose pilot found the source partly or wholly hidden is accepted when this many
 /// times its error is acceptable.
 constexpr double kPartialVisibility = 10.0;
+/// Chebyshev's iteration (see solve_hierarchical) reads its bound β on the spectrum from at most
+/// this many Jacobi steps, and holds it within [least, most].
+constexpr int kChebyshevWarmUp = 6;
+constexpr double kChebyshevLeast = 0.2, kChebyshevMost = 0.99;
+/// It reads β again when the residual falls this much (relatively) slower than β allows.
+constexpr double kChebyshevSlack = 0.05;
 /// The final gather's probe takes every this-many-th vertex.
 constexpr uint32_t kGatherProbeStride = 61;
 /// `auto` skips the final gather when it would trace more than this many times the links' rays.
@@ -1159,20 +1165,44 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     }
   };
 
-  // Jacobi iteration: gather, then reflect. It converges from below, each step's change a
-  // factor λ (the largest eigenvalue of ρ·gather) smaller than the last, so stopping leaves
-  // λ / (1 − λ) times the last change ungathered: 4 times the tolerance in a white furnace of
-  // ρ = 0.8, which read 0.3 % dark. Once λ has settled (two successive ratios of the changes
-  // agree), the tail is added: the geometric series' sum along the last change (Aitken's
-  // extrapolation, per channel).
-  std::vector<Rgb> next(ne), last_indirect(ne);
+  // Jacobi iteration: gather, then reflect, x ← J(x) = ρ (E + G x). It converges from below,
+  // each step's change a factor λ (the largest eigenvalue of ρ·gather) smaller than the last:
+  // on Šibenik's nave (80,258 elements) λ ≈ 0.7, and 16 gathers reached a relative change of
+  // 7.5 · 10⁻⁴.
+  //
+  // Chebyshev's semi-iteration (Golub & Varga 1961; Saad, "Iterative Methods for Sparse Linear
+  // Systems", §12.1) takes the same gathers further: x_{k+1} = x_{k−1} + ω_{k+1} (J(x_k) − x_{k−1}),
+  // with ω_2 = 1 / (1 − β²/2), ω_{k+1} = 1 / (1 − β² ω_k / 4), damps every error component
+  // whose eigenvalue lies in [−β, β] by β / (1 + √(1 − β²)) per gather, 0.41 against Jacobi's
+  // 0.7 at β = 0.7, and still converges, more slowly, for any eigenvalue in (−1, 1). The matrix
+  // ρ F is similar to a symmetric one (reciprocity, A F = (A F)ᵀ), so its eigenvalues are real;
+  // the links' models make it only nearly so. β is λ read from the first Jacobi steps (the
+  // ratio of their area-weighted changes, as a power iteration reads it), and kept for the
+  // ladder's later levels. Iterates are held non-negative.
+  //
+  // The stop: the residual r = J(x) − x (per element, relative, area-weighted) bounds the error
+  // x* − x by r / (1 − λ), so Chebyshev's iteration stops at r < tolerance · (1 − β). Where it
+  // never started (a solve that converged within the first Jacobi steps), the plain Jacobi stop
+  // leaves about λ / (1 − λ) times the last change ungathered: 4 times the tolerance in a white
+  // furnace of ρ = 0.8, which read 0.3 % dark. Once λ has settled (two successive ratios of the
+  // changes agree), that tail is added: the geometric series' sum along the last change
+  // (Aitken's extrapolation, per channel).
+  std::vector<Rgb> next(ne), last_indirect(ne), older_indirect(ne);
+  double beta = 0.0;  // Chebyshev's bound on the spectrum, once read
   auto iterate = [&] {
     result.iterations = 0;
     result.residual = 0.0;
+    result.tail_added = false;
     std::array<double, 3> step{}, last_step{}, ratio{}, last_ratio{};
+    // Chebyshev's state: omega = 0 while the steps are plain Jacobi; 1 after the plain step that
+    // is its x_1 = J(x_0); ω_k after that. A restart makes the next step plain again.
+    double omega = 0.0, last_residual = 0.0;
+    int chebyshev_steps = 0;
+    bool plain_next = false;
     for (int it = 0; it < settings.max_iterations; ++it) {
       if (out_of_time()) break;
-      last_indirect.swap(indirect);
+      older_indirect.swap(last_indirect);  // x_{k−1}'s
+      last_indirect.swap(indirect);        // x_k's
       gather(radiosity, indirect);
       double total = 0.0;
       last_step = step, last_ratio = ratio, step = {};
@@ -1190,12 +1220,51 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         for (int k = 0; k < 3; ++k) step[size_t(k)] += double(delta[k]) * mesh.element_area[e];
       }
       for (size_t k = 0; k < 3; ++k) ratio[k] = last_step[k] > 0.0 ? step[k] / last_step[k] : 0.0;
-      radiosity.swap(next);
-      ++result.iterations;
+      last_residual = result.residual;
       result.residual = total > 0.0 ? change / area : 0.0;
-      if (result.residual < settings.tolerance) break;
+      ++result.iterations;
+      const bool chebyshev = omega >= 1.0 && !plain_next;
+      if (chebyshev) {
+        omega = omega == 1.0 ? 1.0 / (1.0 - 0.5 * beta * beta) : 1.0 / (1.0 - 0.25 * beta * beta * omega);
+        ++chebyshev_steps;
+        for (size_t e = 0; e < ne; ++e) {
+          for (int k = 0; k < 3; ++k)
+            indirect[e][k] = std::max(0.0f, older_indirect[e][k] + float(omega) * (indirect[e][k] - older_indirect[e][k]));
+          next[e] = in.albedo[e] * (direct[e] + indirect[e]);
+        }
+      }
+      radiosity.swap(next);
+      if (beta > 0.0 ? result.residual < settings.tolerance * (1.0 - beta) : result.residual < settings.tolerance) break;
+      if (beta == 0.0 && result.iterations >= 3) {
+        // λ from the Jacobi steps' ratios, once two successive ones agree to a fifth, or after
+        // kChebyshevWarmUp steps; a later level of the ladder starts with the last level's.
+        double lambda = 0.0;
+        bool settled = true;
+        for (size_t k = 0; k < 3; ++k) {
+          lambda = std::max(lambda, ratio[k]);
+          settled = settled && std::abs(ratio[k] - last_ratio[k]) <= 0.2 * ratio[k];
+        }
+        if (settled || result.iterations >= kChebyshevWarmUp) beta = std::clamp(lambda, kChebyshevLeast, kChebyshevMost);
+      } else if (chebyshev && chebyshev_steps >= 3 && last_residual > 0.0) {
+        // The power iteration reads λ low while faster components still decay beside it. An
+        // eigenvalue μ above β decays by q = (t + √(t² − 1)) / a per step, t = μ / β and
+        // a = (1 + √(1 − β²)) / β: where the residual falls more slowly than β allows, μ is
+        // read back from q and the recurrence restarts with β = μ (Manteuffel 1977 adapts
+        // its parameters the same way).
+        const double q = result.residual / last_residual, a = (1.0 + std::sqrt(1.0 - beta * beta)) / beta;
+        if (q < 1.0 && q * a > 1.0 + kChebyshevSlack) {
+          const double y = q * a, mu = 0.5 * (y + 1.0 / y) * beta;
+          if (mu > beta * (1.0 + kChebyshevSlack)) {
+            beta = std::min(mu, kChebyshevMost);
+            plain_next = true, chebyshev_steps = 0;
+          }
+        }
+      }
+      // A plain step, once β is known, is the recurrence's x_1 = J(x_0).
+      if (!chebyshev && beta > 0.0) omega = 1.0, plain_next = false;
     }
-    if (result.iterations < 3) return;
+    result.chebyshev_beta = beta;
+    if (beta > 0.0 || result.iterations < 3) return;
     std::array<float, 3> tail{};
     for (size_t k = 0; k < 3; ++k) {
       const double l = ratio[k];

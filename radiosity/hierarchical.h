@@ -81,6 +81,7 @@ struct HierarchicalResult {
   int iterations = 0;
   double residual = 0.0;  ///< relative change of the last iteration
   bool tail_added = false;  ///< whether the iteration's geometric tail was added (see solve_hierarchical)
+  double chebyshev_beta = 0.0;  ///< the bound on the iteration's spectrum Chebyshev's steps used (0: none)
   size_t clamped_elements = 0;  ///< elements whose links promised more light than they can reflect (scaled down)
   uint64_t shadow_rays = 0, form_factors = 0;
   uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated

@@ -141,13 +141,15 @@ TEST(HierarchicalRadiosity, CoarseLinksDoNotBrightenTheFurnace) {
   EXPECT_NEAR(coarse / fine, 1.0, 0.01);
 }
 
-// The Jacobi iteration converges from below, each change λ times the last (λ = ρ in a white
-// furnace, where every element sees the same). Stopping at relative change T leaves about
-// T λ / (1 − λ) ungathered: 3 % dark at T = 1e-2 and ρ = 0.8, 0.3 % at 1e-3. The solver adds
-// that geometric tail once two successive ratios agree. In the furnace the error is that one
-// mode alone, so the tail's sum is exact but for rounding: the stopped solution must agree with
-// the converged one (T = 1e-6) to 0.1 %, thirty times closer than without the tail.
-TEST(HierarchicalRadiosity, StoppedIterationAddsItsTail) {
+// In a white furnace every element sees the same, so the iteration matrix ρ·gather has the one
+// eigenvalue λ = ρ that matters, and plain Jacobi steps shrink the error by ρ each: from a
+// residual of 0.44 to 10⁻⁶ at ρ = 0.8 takes about ln(10⁻⁶ · 0.2 / 0.44) / ln 0.8 = 66 gathers.
+// Chebyshev's iteration, once it has read β = 0.8 from the first steps' ratios, shrinks it by
+// β / (1 + √(1 − β²)) = 0.5 per gather: about 3 + ln(10⁻⁶ · 0.2 / 0.12) / ln 0.5 = 22 gathers
+// (measured 24). It stops at a residual r < T (1 − β), so the error r / (1 − λ) is below T:
+// the solution stopped at T = 10⁻² must lie within 1 % of the converged one (measured 0.32 %),
+// and take fewer gathers.
+TEST(HierarchicalRadiosity, StoppedIterationKeepsItsTolerance) {
   rc::Scene scene = rc::furnace_scene(0.5f, 0.8f);
   scene.commit();
   rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 600, 0);
@@ -157,11 +159,11 @@ TEST(HierarchicalRadiosity, StoppedIterationAddsItsTail) {
   const rad::Solution stopped = rad::solve(scene, s);
   s.tolerance = 1e-6;
   const rad::Solution converged = rad::solve(scene, s);
-  EXPECT_TRUE(stopped.tail_added);
-  EXPECT_GT(converged.iterations, stopped.iterations + 20);
+  EXPECT_LE(converged.iterations, 30) << "plain Jacobi steps need about 66";
+  EXPECT_LT(stopped.iterations + 10, converged.iterations);
   const double ratio = mean_radiance(stopped) / mean_radiance(converged);
   RecordProperty("stopped_over_converged", std::to_string(ratio));
-  EXPECT_NEAR(ratio, 1.0, 1e-3);
+  EXPECT_NEAR(ratio, 1.0, 1e-2);
 }
 
 /// Mean over vertices of |b − a| / a, where a is lit.
