@@ -34,6 +34,7 @@
 #include <stdexcept>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <tuple>
 #include <utility>
 
@@ -354,14 +355,15 @@ struct Moments {
 /// face ω or all face away (always for a flat node); where they split, the parts cancel and the
 /// bin gives less. The bins keep a wall's sunlit outer face from shining through to its inner
 /// face, which a two-band model of the node (¼ Σ B A + ½ ω·Σ B A n) sends a quarter of its power.
-Rgb intensity(const Moments& moment, const Vec3& omega) {
+Rgb intensity(std::span<const RgbVec> bins, const Vec3& omega) {
   Rgb out(0.0f);
-  for (const RgbVec& bin : moment.bins) {
+  for (const RgbVec& bin : bins) {
     const Rgb along = bin.dot(omega);
     for (int k = 0; k < 3; ++k) out[k] += std::max(0.0f, along[k]);
   }
   return out * (1.0f / kPi);
 }
+Rgb intensity(const Moments& moment, const Vec3& omega) { return intensity(std::span<const RgbVec>(moment.bins), omega); }
 
 /// What a node sends towards (or receives from) unit direction ω, by the cluster models above:
 /// `total` is Σ x_k A_k and `moment` Σ x_k A_k n_k for some per-element x (radiosity, or 1).
@@ -769,12 +771,7 @@ struct PackedSources {
 
   /// intensity() of node s towards ω.
   Rgb intensity(uint32_t s, const Vec3& omega) const {
-    Rgb out(0.0f);
-    for (uint32_t b = nodes[s].first; b < nodes[s + 1].first; ++b) {
-      const Rgb along = bins[b].dot(omega);
-      for (int k = 0; k < 3; ++k) out[k] += std::max(0.0f, along[k]);
-    }
-    return out * (1.0f / kPi);
+    return gilt::radiosity::intensity(std::span(bins).subspan(nodes[s].first, nodes[s + 1].first - nodes[s].first), omega);
   }
 };
 
