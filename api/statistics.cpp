@@ -52,6 +52,17 @@ nlohmann::json run_statistics(const rc::Scene& scene, const std::string& method,
 
 nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosity::SolverSettings& settings) {
   const double secs = std::max(sol.seconds, 1e-9);
+  nlohmann::json ladder = nlohmann::json::array();
+  for (const radiosity::LadderLevel& l : sol.ladder)
+    ladder.push_back({{"link_tolerance", l.link_tolerance},
+                      {"open_pairs", l.open_pairs},
+                      {"links", l.links},
+                      {"link_seconds", l.link_seconds},
+                      {"iterations", l.iterations},
+                      {"finishing_iterations", l.finishing_iterations},
+                      {"first_residual", l.first_residual},
+                      {"residual", l.residual},
+                      {"iterate_seconds", l.iterate_seconds}});
   return {{"ranks", rc::processes().count()},
           {"elements", sol.mesh.element_count()},
           {"meshed_elements", sol.mesh_report.elements},
@@ -77,6 +88,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
           {"residual", sol.residual},
           {"tail_added", sol.tail_added},
           {"chebyshev_beta", sol.chebyshev_beta},
+          {"ladder", ladder},
           {"tolerance", settings.tolerance},
           {"form_factors", sol.form_factors},
           {"form_factors_per_second", double(sol.form_factors) / secs},

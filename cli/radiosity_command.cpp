@@ -244,6 +244,14 @@ void run_radiosity(RadiosityOptions& o) {
   else
     std::printf("  solve:   progressive (%s): %llu shots, residual %.3g (tolerance %.3g)\n", sol.solver_reason.c_str(),
                 static_cast<unsigned long long>(sol.shots), sol.residual, o.solver.tolerance);
+  // A timed solve's ladder, level by level, when it had more than one.
+  if (sol.ladder.size() > 1 || (sol.ladder.size() == 1 && sol.linking_stopped))
+    for (const radiosity::LadderLevel& l : sol.ladder)
+      std::printf("  ladder:  tolerance %.3g: %zu links (%zu of %zu open pairs split) in %.3g s; %d iterations%s to "
+                  "residual %.3g in %.3g s\n",
+                  l.link_tolerance, l.links, l.splits, l.open_pairs, l.link_seconds, l.iterations + l.finishing_iterations,
+                  l.finishing_iterations > 0 ? (" (" + std::to_string(l.finishing_iterations) + " finishing)").c_str() : "",
+                  l.residual, l.iterate_seconds);
   std::printf("  work:    %llu form factors (%.3g/s), %llu shadow rays%s\n",
               static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
               static_cast<unsigned long long>(sol.shadow_rays),

@@ -38,6 +38,8 @@
 #include <tuple>
 #include <utility>
 
+#include <oneapi/tbb/parallel_sort.h>
+
 #include "radiosity/element_scene.h"
 #include "radiosity/cluster_kernel.h"
 #include "radiosity/form_factor.h"
@@ -79,6 +81,8 @@ constexpr int kChebyshevWarmUp = 6;
 constexpr double kChebyshevLeast = 0.2, kChebyshevMost = 0.99;
 /// It reads β again when the residual falls this much (relatively) slower than β allows.
 constexpr double kChebyshevSlack = 0.05;
+/// A timed solve iterates its ladder's levels above the last to this many times the tolerance.
+constexpr double kLadderLoosening = 10.0;
 /// The final gather's probe takes every this-many-th vertex.
 constexpr uint32_t kGatherProbeStride = 61;
 /// `auto` skips the final gather when it would trace more than this many times the links' rays.
@@ -437,6 +441,7 @@ struct Counters {
 struct OpenPair {
   uint32_t receiver, source;
   float visible = -1.0f, estimate = -1.0f;
+  float error = 0.0f;  ///< for an accepted pair: the error bound it was accepted with
 };
 
 /// What linking to one tolerance made: exact element-to-element links (final at any
@@ -460,7 +465,9 @@ size_t count_as_one_process(const Items& items, std::span<const int> owner) {
 
 class Linker {
  public:
-  bool out_of_time() const { return in_.out_of_time && in_.out_of_time(); }
+  bool out_of_time() const {
+    return (in_.out_of_time && in_.out_of_time()) || (keep_back_ > 0.0 && in_.seconds_left && in_.seconds_left() < keep_back_);
+  }
 
   Linker(const HierarchicalInput& in, const Tree& tree, std::span<const float> power_estimate,
          std::span<const Vec3> moment_estimate, double epsilon, const HierarchicalSettings& settings,
@@ -484,6 +491,21 @@ class Linker {
   Linker& keeping_open_pairs(bool keep) {
     keep_open_ = keep;
     return *this;
+  }
+
+  /// Under a time limit: stop (link() returns nothing) once fewer than `seconds` are left.
+  Linker& keeping_back(double seconds) {
+    keep_back_ = seconds;
+    return *this;
+  }
+
+  /// How many of the accepted pairs `open` (a coarser level's) this linker would split rather
+  /// than accept again: those whose error or pilot no longer passes (see refine).
+  size_t splits(std::span<const OpenPair> open) const {
+    size_t n = 0;
+    for (const OpenPair& p : open)
+      n += !(p.error <= epsilon_ && (p.error * kPartialVisibility <= epsilon_ || p.visible == 1.0f));
+    return n;
   }
 
   /// The links made by refining every pair of `start` to this linker's tolerance (the root
@@ -634,7 +656,7 @@ class Linker {
                                                         : visibility(r, s, kEstimateStream);
           // From one level of a time ladder to the next a pair keeps only the fresh fraction: a
           // pilot that any reading would have passed here may decide at a finer tolerance.
-          if (keep_open_) out.open.push_back({r, s, pilot, any_accepted ? -1.0f : visible});
+          if (keep_open_) out.open.push_back({r, s, pilot, any_accepted ? -1.0f : visible, float(error)});
           if (visible > 0.0f) split_mixed(r, s, 0, 0, visible, out.far);
           return;
         }
@@ -718,6 +740,7 @@ class Linker {
   std::span<const int> owner_;
   int rank_ = 0;
   bool keep_open_ = false;
+  double keep_back_ = 0.0;
 };
 
 /// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
@@ -1044,8 +1067,10 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // it, each level's iteration started from the last level's solution (below: while time is
   // left): a coarse solution in time beats a fine one cut off before it iterates. Each level
   // refines the pairs the last one accepted rather than linking again from the root: the split
-  // decisions above them would be the same, and their visible fractions are kept, so the whole
-  // ladder costs about what its last level costs alone, and makes the same links.
+  // decisions above them would be the same, and their visible fractions are kept, so the ladder
+  // makes the same links as linking once at its last tolerance. It spends more doing so, on the
+  // rays of pairs a later level splits and on the upper levels' iterations: on Šibenik's nave
+  // the four levels to 2e-5 took 57 s where one link at 2e-5 took 44 s.
   const double link_tolerance = settings.link_tolerance > 0.0 ? settings.link_tolerance : kDefaultLinkTolerance;
   const bool timed = bool(in.seconds_left);
   std::vector<double> ladder;
@@ -1186,17 +1211,26 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // (Aitken's extrapolation, per channel).
   std::vector<Rgb> next(ne), last_indirect(ne), older_indirect(ne);
   double beta = 0.0;  // Chebyshev's bound on the spectrum, once read
-  auto iterate = [&] {
-    result.iterations = 0;
-    result.residual = 0.0;
-    result.tail_added = false;
+  // The iteration's state over one level's links: a level iterated loosely and then to the
+  // tolerance goes on as one iteration.
+  struct IterationState {
+    int steps = 0;
     std::array<double, 3> step{}, last_step{}, ratio{}, last_ratio{};
     // Chebyshev's state: omega = 0 while the steps are plain Jacobi; 1 after the plain step that
     // is its x_1 = J(x_0); ω_k after that. A restart makes the next step plain again.
     double omega = 0.0, last_residual = 0.0;
     int chebyshev_steps = 0;
     bool plain_next = false;
-    for (int it = 0; it < settings.max_iterations; ++it) {
+    double first_residual = 0.0;  // the residual after the first gather on these links
+  } state;
+  // Iterates over the present links from the present solution until the residual is below
+  // `tolerance` (or time runs out), going on from where the last call on these links stopped;
+  // the gathers add to result.iterations.
+  auto iterate = [&](double tolerance) {
+    result.tail_added = false;
+    auto& [steps, step, last_step, ratio, last_ratio, omega, last_residual, chebyshev_steps, plain_next,
+           first_residual] = state;
+    while (result.iterations < settings.max_iterations) {
       if (out_of_time()) break;
       older_indirect.swap(last_indirect);  // x_{k−1}'s
       last_indirect.swap(indirect);        // x_k's
@@ -1219,7 +1253,8 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       for (size_t k = 0; k < 3; ++k) ratio[k] = last_step[k] > 0.0 ? step[k] / last_step[k] : 0.0;
       last_residual = result.residual;
       result.residual = total > 0.0 ? change / area : 0.0;
-      ++result.iterations;
+      ++result.iterations, ++steps;
+      if (steps == 1) first_residual = result.residual;
       const bool chebyshev = omega >= 1.0 && !plain_next;
       if (chebyshev) {
         omega = omega == 1.0 ? 1.0 / (1.0 - 0.5 * beta * beta) : 1.0 / (1.0 - 0.25 * beta * beta * omega);
@@ -1231,8 +1266,8 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
         }
       }
       radiosity.swap(next);
-      if (beta > 0.0 ? result.residual < settings.tolerance * (1.0 - beta) : result.residual < settings.tolerance) break;
-      if (beta == 0.0 && result.iterations >= 3) {
+      if (beta > 0.0 ? result.residual < tolerance * (1.0 - beta) : result.residual < tolerance) break;
+      if (beta == 0.0 && steps >= 3) {
         // λ from the Jacobi steps' ratios, once two successive ones agree to a fifth, or after
         // kChebyshevWarmUp steps; a later level of the ladder starts with the last level's.
         double lambda = 0.0;
@@ -1241,7 +1276,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
           lambda = std::max(lambda, ratio[k]);
           settled = settled && std::abs(ratio[k] - last_ratio[k]) <= 0.2 * ratio[k];
         }
-        if (settled || result.iterations >= kChebyshevWarmUp) beta = std::clamp(lambda, kChebyshevLeast, kChebyshevMost);
+        if (settled || steps >= kChebyshevWarmUp) beta = std::clamp(lambda, kChebyshevLeast, kChebyshevMost);
       } else if (chebyshev && chebyshev_steps >= 3 && last_residual > 0.0) {
         // The power iteration reads λ low while faster components still decay beside it. An
         // eigenvalue μ above β decays by q = (t + √(t² − 1)) / a per step, t = μ / β and
@@ -1261,7 +1296,7 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
       if (!chebyshev && beta > 0.0) omega = 1.0, plain_next = false;
     }
     result.chebyshev_beta = beta;
-    if (beta > 0.0 || result.iterations < 3) return;
+    if (beta > 0.0 || steps < 3 || tolerance > settings.tolerance) return;
     std::array<float, 3> tail{};
     for (size_t k = 0; k < 3; ++k) {
       const double l = ratio[k];
@@ -1278,69 +1313,144 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   const auto seconds_since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
-  // A level is started only when it looks likely to finish: one cut off by the clock while it
-  // links is time lost, since the last level's solution stays as it was (on Šibenik at --time 42,
-  // the fourth level's linking ran 8.6 s and was thrown away). A level refines what the last one
-  // made, so its cost is foretold from the last one's, link and iteration time together, times
-  // the growth in links from the level before (on Šibenik the levels took 13.1, 5.9 and 11.3 s,
-  // with 8.6, 11.1 and 18.9 million links); the second level, with no growth to go by, from the
-  // first one's iteration alone. One that links in time but iterates only partly still moves the
-  // solution towards its own.
-  double last_iterate = 0.0, last_cost = 0.0;
-  size_t last_links = 0, links_before = 0;
+  // The ladder's levels above the last are iterated only to kLadderLoosening times the
+  // tolerance: the next level starts from that solution and its own iteration takes it the rest
+  // of the way, so the cheap coarse gathers do the bulk of the converging. The level where the
+  // ladder stops is then iterated on to the tolerance. On Šibenik's nave (2e-2 down to 2e-5,
+  // no time limit to speak of) the three upper levels took 9, 4 and 5 gathers.
+  //
+  // A level is started only when it is foretold to finish, linking and iterating, in the time
+  // left: one cut off while it links is time lost. Its linking refines the last level's
+  // accepted pairs, of which those it will split are counted beforehand (Linker::splits, no
+  // rays needed); it is foretold to cost what the last level did per pair split, and to add as
+  // many links per split. A gather costs what the last level's did per link, and the gathers
+  // needed bring the residual the last level's first gather left down to the target at
+  // Chebyshev's rate. On Šibenik all of these fell from level to level (10.7 µs and 15 links
+  // per split at 2e-4, 8.2 µs and 8 at 2e-5), so the foretelling errs long: 38 s for a level
+  // that took 30 s. Where the next decade is foretold too long, three quarters, half or a
+  // quarter of it may fit, and is then the ladder's last level. While a level links, the time
+  // the last level needs to finish its iteration is kept back: a linking that runs into it
+  // stops, and the last level finishes instead.
+  bool finished = true;  // whether the present links' iteration reached the tolerance
+  const auto chebyshev_rate = [&] {
+    const double b = beta > 0.0 ? beta : kChebyshevMost;
+    return b / (1.0 + std::sqrt(1.0 - b * b));
+  };
+  // Gathers, a plain restart step included, to bring the residual down by `factor`.
+  const auto gathers_to = [&](double factor) {
+    return 1.0 + std::ceil(std::log(std::max(factor, 1.0)) / -std::log(chebyshev_rate()));
+  };
   for (size_t level = 0; level < ladder.size(); ++level) {
+    bool last = level + 1 == ladder.size();
+    double tolerance = ladder[level], reserve = 0.0;
+    auto linker_at = [&](double t) {
+      return Linker(in, tree, power_estimate, moment_estimate, t * total_estimate, settings, counters);
+    };
+    // Pairs split, counted as one process would (the splits of pairs above the cut each time).
+    const auto splits_at = [&](double t) { return size_t(group.total(linker_at(t).splits(open_pairs))); };
+    size_t splits = 1;
     if (level > 0) {
-      const double foretold = level == 1 || links_before == 0
-                                  ? last_iterate
-                                  : last_cost * std::max(1.0, double(last_links) / double(links_before));
-      if (group.broadcast_value(foretold > in.seconds_left())) {
+      const LadderLevel& before = result.ladder.back();
+      const double per_gather = before.iterate_seconds / std::max(1, before.iterations + 1);  // bounding the gains: one
+      reserve = finished ? 0.0 : per_gather * gathers_to(kLadderLoosening);
+      splits = splits_at(tolerance);
+      // The first refinement has no refinement before it to go by: it is foretold by the first
+      // level's iteration alone (on Šibenik it linked in 2.3 s, the first level in 8.1 s).
+      if (level == 1 && group.broadcast_value(before.iterate_seconds > in.seconds_left())) {
         result.linking_stopped = true;
         break;
       }
     }
+    if (level > 1) {
+      const LadderLevel& before = result.ladder.back();
+      const LadderLevel& older = result.ladder[result.ladder.size() - 2];
+      const double per_gather = before.iterate_seconds / std::max(1, before.iterations + 1);
+      const double per_split = before.link_seconds / double(std::max<size_t>(1, before.splits));
+      const double links_per_split =
+          (double(before.links) - double(older.links)) / double(std::max<size_t>(1, before.splits)) + 1.0;
+      bool fits = false;
+      for (int quarters = 4; quarters >= 1 && !fits; --quarters) {
+        const double t = std::max(ladder[level], result.ladder.back().link_tolerance * std::pow(10.0, -0.25 * quarters));
+        const size_t n = splits_at(t);
+        const bool final_level = last || quarters < 4;
+        const double target = (final_level ? 1.0 : kLadderLoosening) * settings.tolerance * (1.0 - beta);
+        const double link_foretold = per_split * double(n);
+        const double growth = 1.0 + double(n) * links_per_split / double(std::max<size_t>(1, before.links));
+        const double iterate_foretold =
+            per_gather * growth * (1.0 + gathers_to(before.first_residual / std::max(target, 1e-30)));
+        fits = group.broadcast_value(link_foretold + iterate_foretold <= in.seconds_left());
+        if (fits) tolerance = t, last = final_level, splits = n;
+      }
+      if (!fits) {
+        result.linking_stopped = true;
+        break;
+      }
+    }
+    LadderLevel record;
+    record.link_tolerance = tolerance;
+    record.open_pairs = count_as_one_process(open_pairs, cut.owner);
+    record.splits = splits;
+    Linker linker = linker_at(tolerance);
+    linker.owned_by(cut.owner, group.rank()).keeping_open_pairs(!last).keeping_back(reserve);
     const auto link_start = std::chrono::steady_clock::now();
-    const bool last = level + 1 == ladder.size();
-    std::optional<LinkLevel> made = Linker(in, tree, power_estimate, moment_estimate,
-                                           ladder[level] * total_estimate, settings, counters)
-                                        .owned_by(cut.owner, group.rank())
-                                        .keeping_open_pairs(!last)
-                                        .link(open_pairs);
-    result.link_seconds += seconds_since(link_start);
-    // Sorting the links and bounding their gains cost about what an iteration does: a level that
-    // finished linking without that much time left is dropped too.
-    if (!made || (level > 0 && group.broadcast_value(last_iterate > in.seconds_left()))) {
+    std::optional<LinkLevel> made = linker.link(open_pairs);
+    if (!made) {
+      result.link_seconds += seconds_since(link_start);
       result.linking_stopped = true;
       break;
     }
+    // Links in order of receiver: the exact ones stay in order from level to level, and each
+    // level's new exact and far links are sorted on their own and merged in.
+    tbb::parallel_sort(made->exact.begin(), made->exact.end());
+    const size_t exact_before = exact_links.size();
     exact_links.insert(exact_links.end(), made->exact.begin(), made->exact.end());
     made->exact = {};
+    std::inplace_merge(exact_links.begin(), exact_links.begin() + std::ptrdiff_t(exact_before), exact_links.end());
     open_pairs = std::move(made->open);
+    tbb::parallel_sort(made->far.begin(), made->far.end());
     if (last)
       links = std::move(exact_links);
     else
       links = exact_links;
-    links.reserve(links.size() + made->far.size());
+    const size_t exact_count = links.size();
     links.insert(links.end(), made->far.begin(), made->far.end());
     made->far = {};
-    // In place: a stable sort would need a buffer as large as the links.
-    std::sort(links.begin(), links.end());
+    std::inplace_merge(links.begin(), links.begin() + std::ptrdiff_t(exact_count), links.end());
     receivers.clear();
     first_link.clear();
     for (uint32_t i = 0; i < links.size(); ++i)
       if (i == 0 || links[i].receiver != links[i - 1].receiver)
         receivers.push_back(links[i].receiver), first_link.push_back(i);
     first_link.push_back(uint32_t(links.size()));
-    result.links = count_as_one_process(links, cut.owner);
-    result.link_tolerance = ladder[level];
+    record.link_seconds = seconds_since(link_start);
+    result.link_seconds += record.link_seconds;
+    result.links = record.links = count_as_one_process(links, cut.owner);
+    result.link_tolerance = tolerance;
     result.link_rays = counters.rays;
     const auto iterate_start = std::chrono::steady_clock::now();
+    result.iterations = 0;
+    result.residual = 0.0;
+    state = IterationState{};
     bound_gains();
-    iterate();
-    last_iterate = seconds_since(iterate_start);
-    result.iterate_seconds += last_iterate;
-    last_cost = seconds_since(link_start);
-    links_before = last_links;
-    last_links = result.links;
+    iterate(last ? settings.tolerance : kLadderLoosening * settings.tolerance);
+    finished = last;
+    record.iterations = result.iterations;
+    record.first_residual = state.first_residual;
+    record.residual = result.residual;
+    record.iterate_seconds = seconds_since(iterate_start);
+    result.iterate_seconds += record.iterate_seconds;
+    result.ladder.push_back(record);
+    if (last) break;
+  }
+  if (!finished) {
+    const auto iterate_start = std::chrono::steady_clock::now();
+    const int before = result.iterations;
+    iterate(settings.tolerance);
+    LadderLevel& record = result.ladder.back();
+    record.finishing_iterations = result.iterations - before;
+    record.residual = result.residual;
+    record.iterate_seconds += seconds_since(iterate_start);
+    result.iterate_seconds += seconds_since(iterate_start);
   }
   pull(tree, mesh, radiosity, power, moment);
   lap();

@@ -74,6 +74,19 @@ struct HierarchicalInput {
   std::span<const Rgb> element_direct = {};
 };
 
+/// One level of a timed solve's ladder of link tolerances (see solve_hierarchical).
+struct LadderLevel {
+  double link_tolerance = 0.0;
+  size_t open_pairs = 0;  ///< the last level's pairs this one refined (1: the root pair)
+  size_t splits = 0;      ///< of those, the ones it split rather than accepted again
+  size_t links = 0;
+  double link_seconds = 0.0;  ///< linking, and ordering the links by receiver
+  int iterations = 0;         ///< gathers to the level's own tolerance
+  int finishing_iterations = 0;  ///< gathers on to the solve's tolerance where the ladder stopped here
+  double first_residual = 0.0, residual = 0.0;  ///< after the first gather and the last
+  double iterate_seconds = 0.0;  ///< bounding the gains and iterating
+};
+
 /// The reflected (indirect) irradiance at every vertex, and what it took.
 struct HierarchicalResult {
   std::vector<Rgb> vertex_irradiance;  ///< indirect only, W·m⁻²
@@ -92,6 +105,7 @@ struct HierarchicalResult {
   bool linking_stopped = false; ///< time ran out while linking at link_tolerance / 10 (or at all)
   uint64_t link_rays = 0;       ///< shadow rays traced while linking
   double link_seconds = 0.0, iterate_seconds = 0.0, gather_seconds = 0.0;  ///< tree and links; iterations; final gather
+  std::vector<LadderLevel> ladder;  ///< the levels linked, coarsest first (one without a time limit)
 };
 
 /// Direct irradiance at vertices first_vertex.. from elements that emit `emitted` radiosity

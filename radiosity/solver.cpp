@@ -988,6 +988,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
     sol.residual = h.residual;
     sol.tail_added = h.tail_added;
     sol.chebyshev_beta = h.chebyshev_beta;
+    sol.ladder = h.ladder;
     sol.gather_nodes = h.gather_nodes;
     sol.final_gather = h.final_gather;
     sol.final_gather_note = h.final_gather_note;

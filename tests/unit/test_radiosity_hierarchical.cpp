@@ -364,6 +364,23 @@ TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
   // so the last level makes exactly the links the untimed solve makes.
   EXPECT_EQ(ample.links, untimed.links);
   EXPECT_NEAR(mean_radiance(ample) / mean_radiance(untimed), 1.0, 0.01);
+  // The ladder went through all four decades, the upper levels iterated only to ten times the
+  // tolerance (their residual below it: Chebyshev's stop is tolerance × (1 − β)), the last one
+  // to the tolerance itself; each level split only pairs the last one had accepted.
+  ASSERT_EQ(untimed.ladder.size(), 1u);
+  ASSERT_EQ(ample.ladder.size(), 4u);
+  for (size_t l = 0; l < ample.ladder.size(); ++l) {
+    const rad::LadderLevel& level = ample.ladder[l];
+    EXPECT_NEAR(level.link_tolerance, rad::kDefaultLinkTolerance * std::pow(10.0, 3.0 - double(l)),
+                1e-6 * level.link_tolerance);
+    EXPECT_LT(level.residual, (l + 1 < ample.ladder.size() ? 10.0 : 1.0) * s.hierarchical.tolerance);
+    EXPECT_EQ(level.finishing_iterations, 0);
+    if (l == 0) continue;
+    EXPECT_LE(level.splits, level.open_pairs);
+    EXPECT_GE(level.links, ample.ladder[l - 1].links);
+  }
+  EXPECT_EQ(ample.ladder.back().links, ample.links);
+  EXPECT_EQ(untimed.ladder[0].links, untimed.links);
   s.time_limit = 1e-6;
   const rad::Solution none = rad::solve(scene, s);
   EXPECT_FALSE(none.final_gather);
