@@ -83,6 +83,8 @@ constexpr double kChebyshevLeast = 0.2, kChebyshevMost = 0.99;
 constexpr double kChebyshevSlack = 0.05;
 /// A timed solve iterates its ladder's levels above the last to this many times the tolerance.
 constexpr double kLadderLoosening = 10.0;
+/// A timed solve foretells a level by refining every this-many-th of the pairs it refines.
+constexpr size_t kTrialStride = 50;
 /// The final gather's probe takes every this-many-th vertex.
 constexpr uint32_t kGatherProbeStride = 61;
 /// `auto` skips the final gather when it would trace more than this many times the links' rays.
@@ -1320,17 +1322,13 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
   // no time limit to speak of) the three upper levels took 9, 4 and 5 gathers.
   //
   // A level is started only when it is foretold to finish, linking and iterating, in the time
-  // left: one cut off while it links is time lost. Its linking refines the last level's
-  // accepted pairs, of which those it will split are counted beforehand (Linker::splits, no
-  // rays needed); it is foretold to cost what the last level did per pair split, and to add as
-  // many links per split. A gather costs what the last level's did per link, and the gathers
-  // needed bring the residual the last level's first gather left down to the target at
-  // Chebyshev's rate. On Šibenik all of these fell from level to level (10.7 µs and 15 links
-  // per split at 2e-4, 8.2 µs and 8 at 2e-5), so the foretelling errs long: 38 s for a level
-  // that took 30 s. Where the next decade is foretold too long, three quarters, half or a
-  // quarter of it may fit, and is then the ladder's last level. While a level links, the time
-  // the last level needs to finish its iteration is kept back: a linking that runs into it
-  // stops, and the last level finishes instead.
+  // left: one cut off while it links is time lost. Its linking is foretold by a trial on a
+  // fiftieth of the pairs it refines (below). An extrapolation from the last level's cost per
+  // pair split erred long by about 2 on Šibenik (19.3, 10.7 and 8.2 µs per split from level to
+  // level; 16.6 s foretold for a quarter decade that took 8.7 s), and so stopped the ladder
+  // a quarter decade short or more. While a level links, the time the last level needs to
+  // finish its iteration is kept back: a linking that runs into it stops, and the last level
+  // finishes instead.
   bool finished = true;  // whether the present links' iteration reached the tolerance
   const auto chebyshev_rate = [&] {
     const double b = beta > 0.0 ? beta : kChebyshevMost;
@@ -1346,45 +1344,44 @@ HierarchicalResult solve_hierarchical(const HierarchicalInput& in, const Hierarc
     auto linker_at = [&](double t) {
       return Linker(in, tree, power_estimate, moment_estimate, t * total_estimate, settings, counters);
     };
-    // Pairs split, counted as one process would (the splits of pairs above the cut each time).
-    const auto splits_at = [&](double t) { return size_t(group.total(linker_at(t).splits(open_pairs))); };
     size_t splits = 1;
     if (level > 0) {
+      // The level is foretold by a trial: every kTrialStride-th pair it would refine is refined
+      // (and the result dropped), and the whole is foretold at the trial's seconds and links
+      // per pair. A gather costs what the last level's did per link, and the gathers needed
+      // bring the residual the last level's first gather left down to the target at
+      // Chebyshev's rate. Where the whole decade is foretold too long, three quarters, half or
+      // a quarter of it may fit, and is then the ladder's last level.
       const LadderLevel& before = result.ladder.back();
       const double per_gather = before.iterate_seconds / std::max(1, before.iterations + 1);  // bounding the gains: one
       reserve = finished ? 0.0 : per_gather * gathers_to(kLadderLoosening);
-      splits = splits_at(tolerance);
-      // The first refinement has no refinement before it to go by: it is foretold by the first
-      // level's iteration alone (on Šibenik it linked in 2.3 s, the first level in 8.1 s).
-      if (level == 1 && group.broadcast_value(before.iterate_seconds > in.seconds_left())) {
-        result.linking_stopped = true;
-        break;
-      }
-    }
-    if (level > 1) {
-      const LadderLevel& before = result.ladder.back();
-      const LadderLevel& older = result.ladder[result.ladder.size() - 2];
-      const double per_gather = before.iterate_seconds / std::max(1, before.iterations + 1);
-      const double per_split = before.link_seconds / double(std::max<size_t>(1, before.splits));
-      const double links_per_split =
-          (double(before.links) - double(older.links)) / double(std::max<size_t>(1, before.splits)) + 1.0;
+      std::vector<OpenPair> trial_pairs;
+      for (size_t i = 0; i < open_pairs.size(); i += kTrialStride) trial_pairs.push_back(open_pairs[i]);
+      const double scale = double(open_pairs.size()) / double(std::max<size_t>(1, trial_pairs.size()));
       bool fits = false;
       for (int quarters = 4; quarters >= 1 && !fits; --quarters) {
-        const double t = std::max(ladder[level], result.ladder.back().link_tolerance * std::pow(10.0, -0.25 * quarters));
-        const size_t n = splits_at(t);
+        const double t = std::max(ladder[level], before.link_tolerance * std::pow(10.0, -0.25 * quarters));
         const bool final_level = last || quarters < 4;
+        const uint64_t rays = counters.rays, form_factors = counters.form_factors;
+        const auto trial_start = std::chrono::steady_clock::now();
+        const std::optional<LinkLevel> trial = linker_at(t).owned_by(cut.owner, group.rank()).link(trial_pairs);
+        const double trial_seconds = seconds_since(trial_start);
+        result.link_seconds += trial_seconds;
+        counters.rays = rays, counters.form_factors = form_factors;
+        if (!trial) break;
+        const double made = double(trial->exact.size() + trial->far.size()) * scale;
         const double target = (final_level ? 1.0 : kLadderLoosening) * settings.tolerance * (1.0 - beta);
-        const double link_foretold = per_split * double(n);
-        const double growth = 1.0 + double(n) * links_per_split / double(std::max<size_t>(1, before.links));
+        const double growth = (double(exact_links.size()) + made) / double(std::max<size_t>(1, links.size()));
         const double iterate_foretold =
             per_gather * growth * (1.0 + gathers_to(before.first_residual / std::max(target, 1e-30)));
-        fits = group.broadcast_value(link_foretold + iterate_foretold <= in.seconds_left());
-        if (fits) tolerance = t, last = final_level, splits = n;
+        fits = group.broadcast_value(trial_seconds * scale + iterate_foretold <= in.seconds_left());
+        if (fits) tolerance = t, last = final_level;
       }
       if (!fits) {
         result.linking_stopped = true;
         break;
       }
+      splits = size_t(group.total(linker_at(tolerance).splits(open_pairs)));
     }
     LadderLevel record;
     record.link_tolerance = tolerance;
