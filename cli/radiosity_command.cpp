@@ -130,6 +130,7 @@ void run_radiosity(RadiosityOptions& o) {
   }
   std::optional<radiosity::CheckResult> check;
   std::optional<radiosity::SurfaceCheckResult> surface_check;
+  std::optional<radiosity::SurfaceCheckResult> element_surface_check;  ///< --onto elements, beside `check`
   if (o.check_points > 0) {
     o.check.points = o.check_points;
     o.check.seed = o.solver.seed;
@@ -150,6 +151,12 @@ void run_radiosity(RadiosityOptions& o) {
       surface_check = radiosity::check_input_colours(scene, e, o.check);
     } else {
       check = radiosity::check_against_path_tracer(scene, exported(), o.check);
+      // And at random points inside the input's faces, read from the elements as written: the
+      // mesh write_solution exports (snapped, coincident faces dropped), in irradiance.
+      const radiosity::Solution& e = exported();
+      const radiosity::RadiosityMesh written = radiosity::without_coincident(
+          radiosity::snapped_to_input(scene, e.mesh, 0.5f * e.mesh_report.max_edge));
+      element_surface_check = radiosity::check_element_colours(scene, written, e.vertex_irradiance, o.check);
     }
     if (surface_check && !o.check_points_file.empty())
       radiosity::write_check_points(o.check_points_file, scene, *surface_check);
@@ -209,6 +216,7 @@ void run_radiosity(RadiosityOptions& o) {
                     {"relative_mse", surface_check->relative_mse},
                     {"reference_share", surface_check->reference_share},
                     {"mean_relative_error", surface_check->mean_relative_error},
+                    {"mean_ratio", surface_check->mean_ratio},
                     {"seconds", surface_check->seconds}};
     if (check)
       j["check"] = {{"points", check->points},
@@ -217,6 +225,20 @@ void run_radiosity(RadiosityOptions& o) {
                     {"relative_mean_absolute_error", check->relative_mean_absolute_error},
                     {"reference_noise", check->reference_noise},
                     {"seconds", check->seconds}};
+    if (element_surface_check)
+      j["surface_check"] = {
+          {"points", element_surface_check->points},
+          {"samples", o.check.samples},
+          {"where", "random points inside the input's faces, read from the exported elements"},
+          {"covered", element_surface_check->covered},
+          {"uncovered", element_surface_check->uncovered},
+          {"covered_share", element_surface_check->covered_share()},
+          {"unlit_points_left_out", element_surface_check->unlit},
+          {"relative_mse", element_surface_check->relative_mse},
+          {"reference_share", element_surface_check->reference_share},
+          {"mean_relative_error", element_surface_check->mean_relative_error},
+          {"mean_ratio", element_surface_check->mean_ratio},
+          {"seconds", element_surface_check->seconds}};
     std::cout << j.dump() << std::endl;
     return;
   }
@@ -276,6 +298,22 @@ void run_radiosity(RadiosityOptions& o) {
                 "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
                 100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
+  if (element_surface_check) {
+    const radiosity::SurfaceCheckResult& e = *element_surface_check;
+    if (e.points + e.unlit + e.uncovered == 0)
+      std::printf("  check:   nothing compared at points inside the input's faces: none could be drawn and "
+                  "seen (spheres, mirrors and glass are not drawn from; points with something lying on them are "
+                  "left out)\n");
+    else
+      std::printf(
+          "  check:   irradiance at %zu random points inside the input's faces, read from the exported "
+          "elements, against the path tracer (%d samples each; %zu points no light reaches left out): "
+          "relMSE %.4g (of which the reference's own noise %.4g), mean relative error %.3g %%, mean ratio "
+          "%.4g, covered %.4g %% of points (%zu of %zu) (%.2f s)\n",
+          e.points, o.check.samples, e.unlit, e.relative_mse, e.reference_share,
+          100.0 * e.mean_relative_error, e.mean_ratio, 100.0 * e.covered_share(), e.covered,
+          e.covered + e.uncovered, e.seconds);
+  }
   if (vertex_gather)
     std::printf("  gather:  %llu of %zu vertices traced from the input surface under them, %d rays each (%llu read "
                 "from the solution after the deadline), %.3g s\n",
@@ -308,12 +346,13 @@ void run_radiosity(RadiosityOptions& o) {
   if (surface_check && surface_check->points == 0 && surface_check->unlit == 0)
     std::printf(kNothingChecked, "sampled point");
   else if (surface_check)
-    std::printf("  check:   irradiance at %zu random points inside the input's faces against the path tracer (%d "
-                "samples each; %zu points no light reaches left out): relMSE %.4g (of which the reference's own "
-                "noise %.4g), mean relative error %.3g %% (%.2f s)\n",
-                surface_check->points, o.check.samples, surface_check->unlit, surface_check->relative_mse,
-                surface_check->reference_share,
-                100.0 * surface_check->mean_relative_error, surface_check->seconds);
+    std::printf(
+        "  check:   irradiance at %zu random points inside the input's faces against the path tracer (%d "
+        "samples each; %zu points no light reaches left out): relMSE %.4g (of which the reference's own "
+        "noise %.4g), mean relative error %.3g %%, mean ratio %.4g (%.2f s)\n",
+        surface_check->points, o.check.samples, surface_check->unlit, surface_check->relative_mse,
+        surface_check->reference_share, 100.0 * surface_check->mean_relative_error, surface_check->mean_ratio,
+        surface_check->seconds);
   std::printf("  wrote %s (%s)\n", o.output.c_str(), o.quantity.c_str());
 }
 
@@ -414,9 +453,11 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
   cmd->add_option("--threads", o->solver.threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--seed", o->solver.seed, "Random seed for the visibility samples")
       ->check(unsigned_integer());
-  cmd->add_option("--check", o->check_points,
-                  "After solving, compare the irradiance at N vertices (with --onto input: at N random points "
-                  "inside the input's faces, as baked) with path-traced estimates")
+  cmd->add_option(
+         "--check", o->check_points,
+         "After solving, compare the irradiance at N vertices, and at N random points inside the input's "
+         "faces read from the exported elements (with --onto input or --lightmap: at N random points "
+         "inside the input's faces, as baked), with path-traced estimates")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--check-samples", o->check.samples, "Path-traced samples per checked vertex (default 4096)")
       ->check(CLI::Range(2, 100000000));

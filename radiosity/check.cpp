@@ -8,29 +8,32 @@
 // fill a disk around the vertex, half as wide as the distance to its nearest element centroid,
 // on the vertex's side of any crease: a vertex colour stands for that much surface, and a finely
 // detailed input (a scan) varies within it in ways no vertex colour can follow.
+// The surface checks draw random points inside the input's faces instead, look at each the same
+// way, and read the bake there: the input's own vertex colours, its lightmap, or the exported
+// element lying on the point (found by a BVH point query, as snapped_to_input finds the input).
 
 #include "radiosity/check.h"
 
-#include <functional>
-
-#include "radiosity/lightmap.h"
-
 #include <algorithm>
+#include <array>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
+#include <functional>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "radiosity/element_scene.h"
+#include "radiosity/lightmap.h"
 #include "radiosity/onto_input.h"
 #include "raytrace_core/error.h"
+#include "raytrace_core/io/staged_file.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/sampling.h"
-#include "raytrace_core/io/staged_file.h"
 
 namespace gilt::radiosity {
 
@@ -126,14 +129,33 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
 
 namespace {
 
-/// The check behind check_input_colours and check_lightmap: `covered(m)` says whether scene mesh
-/// m was baked, `baked(m, t, w)` is the baked irradiance at barycentrics w of its face t.
-SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::function<bool(size_t)>& covered_mesh,
-                               const std::function<Rgb(size_t, size_t, const float*)>& baked_at,
-                               const CheckSettings& settings) {
+/// A point drawn for a surface check: face `triangle` of scene mesh `mesh`, at barycentrics
+/// `weight`, position `position`, unit face normal `normal`.
+struct DrawnPoint {
+  uint32_t mesh, triangle;
+  float weight[3];
+  Vec3 position, normal;
+};
+
+/// The baked irradiance at a drawn point, or nothing where the bake has no value there.
+using BakedAt = std::function<std::optional<Rgb>(const DrawnPoint&)>;
+
+/// What became of a drawn point.
+enum class Outcome : uint8_t {
+  skipped,    ///< something lies on it: not counted
+  compared,   ///< compared with the path tracer
+  unlit,      ///< buried, or no path-traced sample found light
+  uncovered,  ///< would have been compared, but the bake has no value there
+};
+
+/// The check behind check_input_colours, check_lightmap and check_element_colours: draws
+/// settings.points points by area over the faces of the scene meshes `drawn_from(m)` accepts
+/// (mirrors and glass never), path-traces the irradiance at each and compares it with `baked_at`.
+SurfaceCheckResult check_baked(const rc::Scene& scene, const std::function<bool(size_t)>& drawn_from,
+                               const BakedAt& baked_at, const CheckSettings& settings) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
-  // The faces the colours cover, weighted by area (mirror and glass faces, which carry no
+  // The faces the bake covers, weighted by area (mirror and glass faces, which carry no
   // radiosity of their own, weigh nothing).
   struct Face {
     uint32_t mesh, triangle;
@@ -142,9 +164,8 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
   std::vector<float> area;
   for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
     const rc::TriangleMesh& mesh = scene.meshes[m];
-    const bool covered = mesh.origin.file == file && covered_mesh(m);
     const rc::Material& mat = scene.materials[mesh.material];
-    if (!covered || mat.is_traced_through()) continue;
+    if (!drawn_from(m) || mat.is_traced_through()) continue;
     for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
       const Vec3 &a = mesh.positions[mesh.indices[3 * t]], &b = mesh.positions[mesh.indices[3 * t + 1]],
                  &c = mesh.positions[mesh.indices[3 * t + 2]];
@@ -159,7 +180,7 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
   const size_t count = size_t(settings.points);
   std::vector<Rgb> baked(count), mean(count), variance(count);
   std::vector<SurfaceCheckPoint> where(count);
-  std::vector<char> usable(count, 0);
+  std::vector<Outcome> outcome(count, Outcome::skipped);
   const rc::PathSettings path = irradiance_probe();
   rc::parallel_for(count, [&](size_t i) {
     rc::Rng rng = rc::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
@@ -168,15 +189,15 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     const rc::Material& m = scene.materials[mesh.material];
     const uint32_t* corner = &mesh.indices[3 * size_t(f.triangle)];
     const rc::Vec2 uv = rc::sample_uniform_triangle(rng.uniform2());
-    const float w[3] = {1.0f - uv.x - uv.y, uv.x, uv.y};
-    Vec3 p(0.0f);
-    for (int k = 0; k < 3; ++k) p += w[k] * mesh.positions[corner[k]];
-    const Rgb value = baked_at(f.mesh, f.triangle, w);
-    const Vec3 n = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
+    DrawnPoint point{f.mesh, f.triangle, {1.0f - uv.x - uv.y, uv.x, uv.y}, Vec3(0.0f), Vec3(0.0f)};
+    for (int k = 0; k < 3; ++k) point.position += point.weight[k] * mesh.positions[corner[k]];
+    point.normal = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
                                              mesh.positions[corner[2]] - mesh.positions[corner[0]]));
+    const Vec3 &p = point.position, &n = point.normal;
     if (input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]], mesh.positions[corner[2]]) ||
         input_point_buried(scene, p, n)) {
-      usable[i] = 2;  // inside a solid or under an object: no one sees it (the fit leaves buried faces out too)
+      // Inside a solid or under an object: no one sees it (the fit leaves buried faces out too).
+      outcome[i] = Outcome::unlit;
       return;
     }
     Rgb sum(0.0f), sum_squares(0.0f);
@@ -193,41 +214,52 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
       ++taken;
     }
     if (sum.is_black()) {  // no light at all: inside a closed solid, where no one looks
-      usable[i] = 2;
+      outcome[i] = Outcome::unlit;
+      return;
+    }
+    // Whether the bake has a value here is asked last, of points that would be compared: a
+    // buried or unlit point is no hole in it.
+    const std::optional<Rgb> value = baked_at(point);
+    if (!value) {
+      outcome[i] = Outcome::uncovered;
       return;
     }
     const float ns = float(taken);
     mean[i] = sum / ns;
     for (int c = 0; c < 3; ++c)
       variance[i][c] = std::max(0.0f, (sum_squares[c] - sum[c] * sum[c] / ns) / (ns - 1.0f)) / ns;
-    baked[i] = value;
+    baked[i] = *value;
     SurfaceCheckPoint& at = where[i];
     at.mesh = f.mesh;
     at.triangle = f.triangle;
     for (int k = 0; k < 3; ++k) {
       at.file_vertex[k] = mesh.origin.vertex.empty() ? corner[k] : mesh.origin.vertex[corner[k]];
-      at.weight[k] = w[k];
+      at.weight[k] = point.weight[k];
     }
     at.position = p;
     at.albedo = m.albedo;
-    usable[i] = 1;
+    outcome[i] = Outcome::compared;
   });
   double reference_mean = 0.0;
   size_t used = 0;
   for (size_t i = 0; i < count; ++i) {
-    if (usable[i] == 1) reference_mean += mean[i].average(), ++used;
-    if (usable[i] == 2) ++result.unlit;
+    if (outcome[i] == Outcome::compared) reference_mean += mean[i].average(), ++used;
+    if (outcome[i] == Outcome::unlit) ++result.unlit;
+    if (outcome[i] == Outcome::uncovered) ++result.uncovered;
   }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (used == 0) return result;
   const double floor = 0.01 * reference_mean / double(used);
-  double squared = 0.0, share = 0.0, relative = 0.0;
+  double squared = 0.0, share = 0.0, relative = 0.0, baked_sum = 0.0, reference_sum = 0.0;
   for (size_t i = 0; i < count; ++i) {
-    if (usable[i] != 1) continue;
+    if (outcome[i] != Outcome::compared) continue;
     for (int c = 0; c < 3; ++c) {
       const double r = mean[i][c], d = double(baked[i][c]) - r;
       squared += d * d / (r * r + floor * floor);
       share += double(variance[i][c]) / (r * r + floor * floor);
       relative += std::abs(d) / (r + floor);
+      baked_sum += double(baked[i][c]);
+      reference_sum += r;
     }
     SurfaceCheckPoint& at = where[i];
     at.reference = mean[i];
@@ -236,10 +268,11 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, int32_t file, const std::
     result.compared.push_back(at);
   }
   result.points = used;
+  result.covered = used;
   result.relative_mse = squared / (3.0 * double(used));
   result.reference_share = share / (3.0 * double(used));
   result.mean_relative_error = relative / (3.0 * double(used));
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.mean_ratio = reference_sum > 0.0 ? baked_sum / reference_sum : 0.0;
   return result;
 }
 
@@ -289,27 +322,66 @@ void write_check_points(const std::string& path, const CheckResult& result) {
 
 SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings) {
-  const auto covered = [&](size_t m) {
+  const auto baked_on = [&](size_t m) {
     return irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty() : !irradiance.per_mesh[m].empty();
   };
-  const auto baked = [&](size_t m, size_t t, const float* w) {
-    const rc::TriangleMesh& mesh = scene.meshes[m];
+  const auto baked_at = [&](const DrawnPoint& at) -> std::optional<Rgb> {
+    const rc::TriangleMesh& mesh = scene.meshes[at.mesh];
     Rgb value(0.0f);
     for (int k = 0; k < 3; ++k) {
-      const uint32_t v = mesh.indices[3 * t + size_t(k)];
-      value += w[k] * (irradiance.per_mesh.empty()
-                           ? irradiance.per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]]
-                           : irradiance.per_mesh[m][v]);
+      const uint32_t v = mesh.indices[3 * size_t(at.triangle) + size_t(k)];
+      value += at.weight[k] *
+               (irradiance.per_mesh.empty()
+                    ? irradiance.per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]]
+                    : irradiance.per_mesh[at.mesh][v]);
     }
     return value;
   };
-  return check_baked(scene, irradiance.file, covered, baked, settings);
+  return check_baked(
+      scene, [&](size_t m) { return scene.meshes[m].origin.file == irradiance.file && baked_on(m); },
+      baked_at, settings);
 }
 
 SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings) {
   return check_baked(
-      scene, irradiance.file, [&](size_t m) { return !irradiance.corner_uv[m].empty(); },
-      [&](size_t m, size_t t, const float* w) { return irradiance.at(m, t, w[1], w[2]); }, settings);
+      scene,
+      [&](size_t m) {
+        return scene.meshes[m].origin.file == irradiance.file && !irradiance.corner_uv[m].empty();
+      },
+      [&](const DrawnPoint& at) -> std::optional<Rgb> {
+        return irradiance.at(at.mesh, at.triangle, at.weight[1], at.weight[2]);
+      },
+      settings);
+}
+
+SurfaceCheckResult check_element_colours(const rc::Scene& scene, const RadiosityMesh& exported,
+                                         const std::vector<Rgb>& vertex_irradiance,
+                                         const CheckSettings& settings) {
+  if (vertex_irradiance.size() != exported.vertex_count())
+    throw std::logic_error("check_element_colours: " + std::to_string(vertex_irradiance.size()) +
+                           " irradiance values for " + std::to_string(exported.vertex_count()) + " vertices");
+  const auto start = std::chrono::steady_clock::now();
+  // The elements in a BVH (geometry 0 of element_scene, its primitive ids the element indices).
+  std::optional<rc::Scene> elements;
+  if (exported.element_count() > 0) elements.emplace(element_scene(scene, exported));
+  const float reach = 1e-4f * glm::length(scene.bounds().diagonal());
+  const float facing = std::cos(2.5f * rc::kPi / 180.0f);
+  const auto baked_at = [&](const DrawnPoint& at) -> std::optional<Rgb> {
+    if (!elements) return std::nullopt;
+    const std::optional<rc::Hit> near = elements->nearest_triangle(0, at.position, reach, at.normal, facing);
+    if (!near) return std::nullopt;
+    const std::array<uint32_t, 3>& corner = exported.elements[near->prim_id];
+    return (1.0f - near->u - near->v) * vertex_irradiance[corner[0]] +
+           near->u * vertex_irradiance[corner[1]] + near->v * vertex_irradiance[corner[2]];
+  };
+  // Every input mesh of every file (check_baked leaves out mirrors and glass, which are not meshed).
+  SurfaceCheckResult result = check_baked(scene, [](size_t) { return true; }, baked_at, settings);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+double SurfaceCheckResult::covered_share() const {
+  return covered + uncovered > 0 ? double(covered) / double(covered + uncovered) : 0.0;
 }
 
 }  // namespace gilt::radiosity

@@ -56,8 +56,6 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
 
 struct InputColours;  // radiosity/onto_input.h
 
-/// How colours baked onto the input model (`--onto input`) compare with the path tracer at random
-/// points inside the input's faces, where the baked colour is its face's corners interpolated.
 /// One point of a surface check, as `gilt radiosity --check-points` writes it: enough to score
 /// another bake (Blender's, an older gilt's) against the same path-traced reference.
 struct SurfaceCheckPoint {
@@ -73,14 +71,27 @@ struct SurfaceCheckPoint {
   Rgb baked{0.0f};                ///< the bake's irradiance
 };
 
+/// How a bake (colours on the input's vertices, a lightmap, the exported elements) compares with
+/// the path tracer at random points inside the input's faces, over the compared points and the
+/// three channels; every figure is 0 when no point was compared.
 struct SurfaceCheckResult {
   size_t points = 0;           ///< points compared
   size_t unlit = 0;            ///< points left out: on buried faces, or no path-traced sample found light
+  /// Points whose baked value was found, of those that are neither buried nor unlit: the ones
+  /// compared, so always `points`. Only the element check can miss one (no exported face within
+  /// reach, see check_element_colours), counted in `uncovered`; the input and lightmap checks
+  /// read their bake on the very face drawn from, and leave `uncovered` at 0.
+  size_t covered = 0;
+  size_t uncovered = 0;        ///< points the check would have compared but the bake has no value for
   double relative_mse = 0.0;   ///< mean (E_baked − E_path)² / (E_path² + (0.01 Ē_path)²)
   double reference_share = 0.0;  ///< what the estimates' own variance adds to it (same mean of se²)
   double mean_relative_error = 0.0;  ///< mean |E_baked − E_path| / (E_path + 0.01 Ē_path)
+  double mean_ratio = 0.0;           ///< Σ E_baked / Σ E_path: the bake's bias in brightness (1 = none)
   double seconds = 0.0;
   std::vector<SurfaceCheckPoint> compared;  ///< the points compared, in drawing order
+
+  /// covered / (covered + uncovered), 0 when both are 0.
+  double covered_share() const;
 };
 
 /// Writes `result.compared` as CSV with a header line (atomically); throws rc::InputError when
@@ -107,5 +118,20 @@ struct Lightmap;  // radiosity/lightmap.h
 /// The same check for a lightmap of irradiance (`--lightmap`): the baked value at each point is
 /// the atlas read bilinearly at the point's UV, as a viewer reads it.
 SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings);
+
+/// The same check for gilt's element mesh as exported (`--onto elements`), at the same random
+/// points inside the input's faces, drawn over every input mesh the mesher meshes (mirrors and
+/// glass aside). `exported` is the mesh write_solution writes (the solution's mesh
+/// snapped_to_input, then without_coincident) and `vertex_irradiance` its irradiance per vertex
+/// (Solution::vertex_irradiance: without_coincident keeps the vertex numbering). A point's value
+/// is read from the nearest exported element within 10⁻⁴ of the scene's bounding-box diagonal
+/// that faces the way its input face does (geometric normals within 2.5°), interpolated
+/// barycentrically at the point of the element nearest to it, found by a point query of a BVH
+/// over the elements (O(log n) a point). A point with no such element is counted in `uncovered`
+/// and left out of the figures: on a flat input, a share below 1 is a hole or a flipped element
+/// in the export. Throws std::logic_error when vertex_irradiance does not match the mesh.
+SurfaceCheckResult check_element_colours(const rc::Scene& scene, const RadiosityMesh& exported,
+                                         const std::vector<Rgb>& vertex_irradiance,
+                                         const CheckSettings& settings);
 
 }  // namespace gilt::radiosity

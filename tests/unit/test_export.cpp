@@ -1,6 +1,7 @@
 // Radiosity export: every format read back by an independent reader (OpenMesh and a minimal PLY
 // parser, tinyobjloader, tinygltf), quantity selection, and the failure cases (unsupported
-// extension, missing folder, no temporaries left, existing files kept).
+// extension, missing folder, no temporaries left, existing files kept); the exported elements
+// checked at random points of the input (check_element_colours) against a scan of every element.
 
 #include "radiosity/export.h"
 
@@ -20,10 +21,13 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "radiosity/check.h"
+#include "raytrace_core/closest_point.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
@@ -759,6 +763,200 @@ TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
   EXPECT_EQ(stats.not_moved, 0u);
   // On the surface within float rounding: a few ulps of coordinates of size 1.
   for (size_t v = 0; v < snapped.vertex_count(); ++v) EXPECT_LE(off(snapped.positions[v], snapped.normals[v]), 1e-6f) << v;
+}
+
+// --- The exported elements at random points of the input (check_element_colours) ----------------
+
+/// The mesh write_solution writes for a solution.
+RadiosityMesh exported_mesh(const rc::Scene& scene, const Solution& solution) {
+  return without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge));
+}
+
+/// The furnace (every face emits 0.5 and reflects 0.5; E = π·0.5 / (1 − 0.5) everywhere inside),
+/// solved as tests/unit/test_radiosity.cpp solves it, to within 0.2 % at every vertex.
+struct Furnace {
+  rc::Scene scene;
+  Solution solution;
+  RadiosityMesh exported;
+};
+
+const Furnace& furnace() {
+  static const Furnace f = [] {
+    Furnace out{rc::furnace_scene(0.5f, 0.5f), {}, {}};
+    out.scene.commit();
+    SolverSettings settings;
+    settings.tolerance = 1e-5;
+    settings.mesh.elements = 300;
+    settings.progress = false;
+    out.solution = solve(out.scene, settings);
+    out.exported = exported_mesh(out.scene, out.solution);
+    return out;
+  }();
+  return f;
+}
+
+/// Where the brute-force twin of check_element_colours' point query reads: the element and the
+/// barycentrics (of its second and third corner) of its point nearest to p.
+struct Scanned {
+  size_t element;
+  rc::Vec2 uv;
+};
+
+/// Every element scanned for the nearest within `reach` of p whose geometric normal is within
+/// 2.5° of n (the first of equals); nothing where none qualifies.
+std::optional<Scanned> scan_elements(const RadiosityMesh& mesh, const Vec3& p, const Vec3& n, float reach) {
+  const float facing = std::cos(2.5f * rc::kPi / 180.0f);
+  std::optional<Scanned> best;
+  float best_distance2 = reach * reach;
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const Vec3 &a = mesh.positions[mesh.elements[e][0]], &b = mesh.positions[mesh.elements[e][1]],
+               &c = mesh.positions[mesh.elements[e][2]];
+    const Vec3 normal = glm::cross(b - a, c - a);
+    if (!(glm::dot(normal, n) > facing * glm::length(normal))) continue;
+    const rc::Vec2 uv = rc::closest_point_on_triangle(p, a, b, c);
+    const Vec3 x = (1.0f - uv.x - uv.y) * a + uv.x * b + uv.y * c;
+    const float d2 = glm::dot(x - p, x - p);
+    if (d2 > best_distance2 || (best && d2 == best_distance2)) continue;
+    best_distance2 = d2;
+    best = Scanned{e, uv};
+  }
+  return best;
+}
+
+/// The unit normal of the input face a checked point was drawn on.
+Vec3 face_normal(const rc::Scene& scene, const SurfaceCheckPoint& at) {
+  const rc::TriangleMesh& m = scene.meshes[at.mesh];
+  const uint32_t* c = &m.indices[3 * size_t(at.triangle)];
+  return glm::normalize(
+      glm::cross(m.positions[c[1]] - m.positions[c[0]], m.positions[c[2]] - m.positions[c[0]]));
+}
+
+TEST(ElementSurfaceCheck, CoversTheFurnaceAndAgreesWithThePathTracerOnAverage) {
+  const Furnace& f = furnace();
+  CheckSettings settings;
+  settings.points = 400;
+  settings.samples = 256;
+  settings.seed = 7;
+  const SurfaceCheckResult r =
+      check_element_colours(f.scene, f.exported, f.solution.vertex_irradiance, settings);
+  // Six flat faces: the elements cover every point that is compared.
+  EXPECT_EQ(r.unlit, 0u);
+  EXPECT_GT(r.points, 390u);
+  EXPECT_EQ(r.covered, r.points);
+  EXPECT_GE(r.covered_share(), 0.99);
+  EXPECT_EQ(r.uncovered, 0u);
+  ASSERT_EQ(r.compared.size(), r.points);
+  // Tolerance of the mean ratio Σ E_baked / Σ E_path. Each point's reference is a mean of
+  // independent samples with standard errors se_c per channel; the channels come from the same
+  // paths, so the standard error of their sum is at most Σ_c se_c, and the points are
+  // independent: σ(Σ E_path) ≤ √(Σ_points (Σ_c se_c)²), and the ratio's relative σ is that over
+  // Σ E_path. 4σ (a normal deviate beyond it: 6·10⁻⁵) plus the solve's own error at every vertex
+  // in this furnace, 0.2 % (tests/unit/test_radiosity.cpp), taken in full.
+  double reference = 0.0, variance = 0.0;
+  for (const SurfaceCheckPoint& at : r.compared) {
+    reference += double(at.reference.r) + at.reference.g + at.reference.b;
+    const double se = double(at.standard_error.r) + at.standard_error.g + at.standard_error.b;
+    variance += se * se;
+  }
+  const double sigma = std::sqrt(variance) / reference;
+  std::printf("[ measured ] furnace: %zu points, %zu uncovered, mean ratio %.5f (sigma %.5f), relMSE %.3g "
+              "(reference's %.3g)\n",
+              r.points, r.uncovered, r.mean_ratio, sigma, r.relative_mse, r.reference_share);
+  EXPECT_GT(sigma, 0.0);
+  EXPECT_LT(sigma, 0.005) << "too few samples for the ratio to tell anything";
+  EXPECT_NEAR(r.mean_ratio, 1.0, 4.0 * sigma + 2e-3);
+}
+
+TEST(ElementSurfaceCheck, ReadsTheElementAScanFindsAndCountsHolesExactly) {
+  const Furnace& f = furnace();
+  const float reach = 1e-4f * glm::length(f.scene.bounds().diagonal());
+  // A value that changes over every face, linear in position: the wrong element or the wrong
+  // barycentrics would show, and the right ones give the point's own value.
+  std::vector<rc::Rgb> field(f.exported.vertex_count());
+  for (size_t v = 0; v < field.size(); ++v) {
+    const Vec3& p = f.exported.positions[v];
+    field[v] = rc::Rgb(2.0f + p.x, 2.0f + p.y, 2.0f + p.z);
+  }
+  CheckSettings settings;
+  settings.points = 300;
+  settings.samples = 8;  // the reference's noise does not matter here, nor does it decide which points count
+  const SurfaceCheckResult whole = check_element_colours(f.scene, f.exported, field, settings);
+  ASSERT_GT(whole.points, 290u);
+  EXPECT_EQ(whole.uncovered, 0u);
+  const auto scan = [&](const RadiosityMesh& mesh, const SurfaceCheckPoint& at) {
+    return scan_elements(mesh, at.position, face_normal(f.scene, at), reach);
+  };
+  for (const SurfaceCheckPoint& at : whole.compared) {
+    const std::optional<Scanned> found = scan(f.exported, at);
+    ASSERT_TRUE(found) << "point " << at.position.x << " " << at.position.y << " " << at.position.z;
+    const auto& corner = f.exported.elements[found->element];
+    const rc::Rgb scanned = (1.0f - found->uv.x - found->uv.y) * field[corner[0]] +
+                            found->uv.x * field[corner[1]] + found->uv.y * field[corner[2]];
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(at.baked[c], scanned[c], 1e-5f);
+      EXPECT_NEAR(at.baked[c], 2.0f + at.position[c], 1e-4f);
+    }
+  }
+  const auto uncovered_by_scan = [&](const RadiosityMesh& mesh) {
+    size_t n = 0;
+    for (const SurfaceCheckPoint& at : whole.compared)
+      if (!scan(mesh, at)) ++n;
+    return n;
+  };
+
+  // The elements under the first ten compared points taken out: exactly the points the scan no
+  // longer finds a face for are uncovered (those inside them, but for any within reach of a
+  // neighbour), the others compared as before.
+  std::vector<char> removed(f.exported.element_count(), 0);
+  for (size_t i = 0; i < 10; ++i) removed[scan(f.exported, whole.compared[i])->element] = 1;
+  RadiosityMesh holed = f.exported;
+  holed.elements.clear();
+  for (size_t e = 0; e < f.exported.element_count(); ++e)
+    if (!removed[e]) holed.elements.push_back(f.exported.elements[e]);
+  const size_t expected = uncovered_by_scan(holed);
+  ASSERT_GT(expected, 0u) << "the holes hold no point: nothing to test";
+  const SurfaceCheckResult with_hole = check_element_colours(f.scene, holed, field, settings);
+  EXPECT_EQ(with_hole.uncovered, expected);
+  EXPECT_EQ(with_hole.points, whole.points - expected);
+  EXPECT_EQ(with_hole.covered, with_hole.points);
+  EXPECT_EQ(with_hole.unlit, whole.unlit);
+
+  // The top face's elements turned over (facing out of the box): every point drawn on it is
+  // uncovered, since an element must face the way its input face does.
+  RadiosityMesh flipped = f.exported;
+  size_t turned = 0;
+  for (auto& e : flipped.elements) {
+    const Vec3 n = glm::cross(flipped.positions[e[1]] - flipped.positions[e[0]],
+                              flipped.positions[e[2]] - flipped.positions[e[0]]);
+    if (n.y < -0.99f * glm::length(n)) {
+      std::swap(e[1], e[2]);
+      ++turned;
+    }
+  }
+  ASSERT_GT(turned, 0u);
+  size_t on_top = 0;
+  for (const SurfaceCheckPoint& at : whole.compared)
+    if (face_normal(f.scene, at).y < -0.99f) ++on_top;
+  ASSERT_GT(on_top, 0u);
+  EXPECT_EQ(uncovered_by_scan(flipped), on_top);
+  std::printf("[ measured ] %zu points compared: %zu in the hole, %zu on the turned face\n", whole.points, expected,
+              on_top);
+  const SurfaceCheckResult upside_down = check_element_colours(f.scene, flipped, field, settings);
+  EXPECT_EQ(upside_down.uncovered, on_top);
+  EXPECT_EQ(upside_down.points, whole.points - on_top);
+  EXPECT_NEAR(upside_down.covered_share(), double(whole.points - on_top) / double(whole.points), 1e-12);
+
+  // No elements at all: nothing covered, and no figure is NaN.
+  RadiosityMesh empty = f.exported;
+  empty.elements.clear();
+  const SurfaceCheckResult none = check_element_colours(f.scene, empty, field, settings);
+  EXPECT_EQ(none.points, 0u);
+  EXPECT_EQ(none.uncovered, whole.points);
+  EXPECT_EQ(none.covered_share(), 0.0);
+  EXPECT_EQ(none.mean_ratio, 0.0);
+  EXPECT_EQ(none.relative_mse, 0.0);
+  EXPECT_THROW(check_element_colours(f.scene, f.exported, std::vector<rc::Rgb>(3), settings),
+               std::logic_error);
 }
 
 }  // namespace
