@@ -692,7 +692,13 @@ def make_furnace(s, albedo, emission):
     emission / (1 − albedo), whatever the geometry and winding."""
     w, h, d = s.bounds
     margin = 0.05 * max(w, h, d)
-    s.mesh("enclosure").box((-margin, -margin, -margin), (w + margin, h + margin, d + margin))
+    m = s.mesh("enclosure")
+    m.box((-margin, -margin, -margin), (w + margin, h + margin, d + margin))
+    # The enclosure is a shell like the building's walls: it faces in, out or either way as the
+    # scene's winding says (box() made it face out).
+    for i, (a, b, c) in enumerate(m.triangles):
+        if s.winding == "inward" or (s.winding == "mixed" and s.rng.random() < 0.5):
+            m.triangles[i] = (a, c, b)
     s.lights = []
     white = {"kind": "diffuse", "albedo": albedo, "emission": emission, "two_sided": True}
     s.materials = {m: dict(white) for m in s.meshes}
