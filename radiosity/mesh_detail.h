@@ -62,8 +62,11 @@ class RepairedMeshes {
 
   /// Imprints on mesh m the lines where the `touching` meshes (repaired too) and its own pieces
   /// meet it, and keeps the result for remesh(). Returns the imprinted surface, which lies on the
-  /// input's, and fills `counts` with the repairs and what imprinting found. Reads the other
-  /// meshes only: calls for different m may run in parallel.
+  /// input's, and fills `counts` with the repairs and what imprinting found. The first call finds
+  /// which faces of which pieces meet (one box-intersection pass over every repaired mesh: call
+  /// it after every repair()); each piece is then corefined with the faces that meet it alone,
+  /// in parallel over pieces. Reads the other meshes only: calls for different m may run in
+  /// parallel.
   TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts);
 
   /// Mesh m as imprinted, without the triangles of the imprinted surface that `remove` marks,

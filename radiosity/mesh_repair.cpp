@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
+#include <mutex>
 #include <numeric>
 #include <span>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/box_intersection_d.h>
 #include <CGAL/Polygon_mesh_processing/bbox.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
@@ -32,6 +34,7 @@
 
 #include "radiosity/mesh_detail.h"
 #include "radiosity/ordered_heap.h"
+#include "raytrace_core/parallel.h"
 
 namespace gilt::radiosity::detail {
 namespace {
@@ -225,44 +228,111 @@ using Constrained = SurfaceMesh::Property_map<edge_descriptor, bool>;
 /// imprinted by other meshes only.
 constexpr size_t kMaxImprintedParts = 4096;
 
+/// A piece of some mesh that may imprint another piece, cropped to the faces whose boxes meet
+/// the other piece's faces' boxes (found by find_contacts): only they can cut it, so
+/// corefinement reads them alone, whatever the size of the tool.
+struct ToolContact {
+  uint32_t mesh = 0, part = 0;
+  std::vector<uint32_t> faces;  ///< ascending
+};
+
+/// Appends the faces `faces` of `from` to `to`, sharing vertices as `from` does.
+void append_faces(const SurfaceMesh& from, std::span<const uint32_t> faces, SurfaceMesh& to) {
+  std::unordered_map<uint32_t, SurfaceMesh::Vertex_index> copied;
+  for (uint32_t f : faces) {
+    std::array<SurfaceMesh::Vertex_index, 3> corners;
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(from.halfedge(face_descriptor(f)), from)) {
+      if (k == 3) break;
+      auto [it, fresh] = copied.try_emplace(static_cast<uint32_t>(v.idx()));
+      if (fresh) it->second = to.add_vertex(from.point(v));
+      corners[k++] = it->second;
+    }
+    if (k == 3) to.add_face(corners[0], corners[1], corners[2]);
+  }
+}
+
+CGAL::Bbox_3 faces_box(const SurfaceMesh& mesh, std::span<const uint32_t> faces) {
+  CGAL::Bbox_3 box;
+  for (uint32_t f : faces)
+    for (auto v : CGAL::vertices_around_face(mesh.halfedge(face_descriptor(f)), mesh)) box += mesh.point(v).bbox();
+  return box;
+}
+
 /// Imprints on `part` the lines where other surfaces touch or cross it (a block standing on a
 /// floor leaves its outline there) and marks them as constrained edges. Radiosity jumps across
 /// such a line (Heckbert 1992 and Lischinski, Tampieri & Greenberg 1992 call it a D0
 /// discontinuity: the floor is lit on one side and buried on the other); an element that
 /// straddles it would average the two, and Gouraud interpolation would smear the dark into the
 /// lit floor. CGAL's corefinement computes the intersection exactly and splits the faces along
-/// it; the tools are only read. Pieces that intersect themselves take no part, on either side:
-/// corefinement needs the modified mesh free of self-intersections, and CGAL 5.5 crashes on a
-/// self-intersecting tool even though it promises to read one (two boxes of one mesh sharing a
-/// face, tests/stress/test_pathological.cpp). Returns the number of imprinted edges.
-size_t imprint_contacts(Part& part, const std::vector<const Part*>& tools, Constrained& constrained,
-                        RepairCounts& counts) {
+/// it; the tools are only read, each cropped to the faces that can meet the piece. Tools whose
+/// crops lie apart (their boxes do not meet) are read as one mesh, so a floor under a thousand
+/// chair legs is corefined a few times, not a thousand: their union is free of
+/// self-intersections because each of them is and they do not meet. Pieces that intersect
+/// themselves take no part, on either side: corefinement needs the modified mesh free of
+/// self-intersections, and CGAL 5.5 crashes on a self-intersecting tool even though it promises
+/// to read one (two boxes of one mesh sharing a face, tests/stress/test_pathological.cpp).
+/// Returns the number of imprinted edges.
+size_t imprint_contacts(Part& part, const std::vector<std::pair<const Part*, const ToolContact*>>& tools,
+                        Constrained& constrained, RepairCounts& counts) {
   if (part.self_intersecting > 0) return 0;
   size_t before = 0;
   for (edge_descriptor e : part.mesh.edges()) before += constrained[e];
-  for (const Part* tool : tools) {
-    if (!CGAL::do_overlap(part.box, tool->box)) continue;
+
+  // Batches of tools whose crops lie apart, in the tools' order.
+  struct Batch {
+    std::vector<size_t> tools;
+    std::vector<CGAL::Bbox_3> boxes;
+  };
+  std::vector<Batch> batches;
+  for (size_t t = 0; t < tools.size(); ++t) {
+    const auto& [tool, contact] = tools[t];
     if (tool->self_intersecting > 0) {
       ++counts.contacts_failed;
       continue;
     }
+    const CGAL::Bbox_3 box = faces_box(tool->mesh, contact->faces);
+    auto apart = [&](const Batch& b) {
+      return std::none_of(b.boxes.begin(), b.boxes.end(), [&](const CGAL::Bbox_3& o) { return CGAL::do_overlap(o, box); });
+    };
+    auto it = std::find_if(batches.begin(), batches.end(), apart);
+    if (it == batches.end()) it = batches.insert(batches.end(), Batch{});
+    it->tools.push_back(t);
+    it->boxes.push_back(box);
+  }
+
+  // Corefines the piece with the union of the crops of `members`; false when CGAL gives up.
+  const auto corefine_with = [&](std::span<const size_t> members) {
     // Corefinement orders what it cuts by memory addresses (see OrderedHeap): it runs in a heap
     // of its own, so the cuts depend on the two meshes alone. Nothing made in it may outlive it:
     // the exception is caught and the result copied out inside.
     OrderedHeap heap;
     try {
-      // corefine() takes the tool by non-const reference even when it leaves it unmodified, and
-      // the shared tools are read by other threads: it works on a copy. The piece is cut as a
-      // copy too, kept only if corefinement finishes: one that throws half-way has cut some faces.
-      SurfaceMesh tool_copy = tool->mesh, cut = part.mesh;
+      // The piece is cut as a copy, kept only if corefinement finishes: one that throws half-way
+      // has cut some faces. corefine() takes the tool by non-const reference even when it leaves
+      // it unmodified; the crops are copies, so the shared tools stay untouched.
+      SurfaceMesh tool_union, cut = part.mesh;
+      for (size_t t : members) append_faces(tools[t].first->mesh, tools[t].second->faces, tool_union);
       Constrained cut_constrained = cut.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
-      PMP::corefine(cut, tool_copy, CGAL::parameters::edge_is_constrained_map(cut_constrained),
+      PMP::corefine(cut, tool_union, CGAL::parameters::edge_is_constrained_map(cut_constrained),
                     CGAL::parameters::do_not_modify(true));
       const OrderedHeap::Outside outside(heap);
       part.mesh = cut;
+      return true;
     } catch (const std::exception&) {
-      ++counts.contacts_failed;  // corefinement gave up on this pair; the piece is meshed without it
+      return false;
     }
+  };
+  for (const Batch& batch : batches) {
+    if (corefine_with(batch.tools)) continue;
+    // Corefinement gave up on the union: try its tools one by one, so one bad contact costs
+    // only itself; the piece is meshed without the contacts that fail alone too.
+    if (batch.tools.size() == 1) {
+      ++counts.contacts_failed;
+      continue;
+    }
+    for (size_t t : batch.tools)
+      if (!corefine_with(std::span<const size_t>(&t, 1))) ++counts.contacts_failed;
   }
   constrained = part.mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
   size_t after = 0;
@@ -518,7 +588,56 @@ struct RepairedMeshes::Impl {
   std::vector<RepairCounts> counts;       ///< per mesh, what repair() did
   std::vector<std::vector<Part>> parts;   ///< per mesh, its connected pieces (empty until repaired)
   std::vector<std::vector<Part>> imprinted;  ///< per mesh, its pieces imprinted, until remeshed
+  /// Per mesh and piece, the pieces that may imprint it, cropped (find_contacts), in order of
+  /// (mesh, piece).
+  std::vector<std::vector<std::vector<ToolContact>>> contacts;
+  std::once_flag contacts_found;
+
+  void find_contacts();
 };
+
+/// Finds, for every piece of every repaired mesh, the pieces whose faces' boxes meet its own
+/// faces' boxes, and which of their faces do: one box-intersection pass over all faces of all
+/// pieces (Zomorodian & Edelsbrunner's streamed segment tree, CGAL's box_intersection_d),
+/// O((n + k) log n) for n faces and k meeting pairs, where testing every piece against every
+/// other costs the product of their sizes. Pieces of one mesh of more than kMaxImprintedParts
+/// pieces (foliage, gravel) do not imprint each other. Boxes are closed, so faces that only
+/// touch are found; their ids are explicit, given in the order of (mesh, piece, face), so the
+/// result does not depend on memory addresses.
+void RepairedMeshes::Impl::find_contacts() {
+  struct FaceRef {
+    uint32_t mesh, part, face;
+  };
+  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, FaceRef, CGAL::Box_intersection_d::ID_EXPLICIT>;
+  std::vector<Box> boxes;
+  for (size_t m = 0; m < parts.size(); ++m)
+    for (size_t p = 0; p < parts[m].size(); ++p) {
+      const SurfaceMesh& mesh = parts[m][p].mesh;
+      for (face_descriptor f : mesh.faces()) {
+        CGAL::Bbox_3 box;
+        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) box += mesh.point(v).bbox();
+        boxes.emplace_back(box, FaceRef{static_cast<uint32_t>(m), static_cast<uint32_t>(p),
+                                        static_cast<uint32_t>(f.idx())});
+      }
+    }
+  // (receiving mesh, piece, tool mesh, piece, tool face), both ways round.
+  std::vector<std::array<uint32_t, 5>> pairs;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& a, const Box& b) {
+    const FaceRef x = a.info(), y = b.info();
+    if (x.mesh == y.mesh && (x.part == y.part || parts[x.mesh].size() > kMaxImprintedParts)) return;
+    pairs.push_back({x.mesh, x.part, y.mesh, y.part, y.face});
+    pairs.push_back({y.mesh, y.part, x.mesh, x.part, x.face});
+  });
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  contacts.assign(parts.size(), {});
+  for (size_t m = 0; m < parts.size(); ++m) contacts[m].resize(parts[m].size());
+  for (const auto& [m, p, tm, tp, tf] : pairs) {
+    std::vector<ToolContact>& list = contacts[m][p];
+    if (list.empty() || list.back().mesh != tm || list.back().part != tp) list.push_back({tm, tp, {}});
+    list.back().faces.push_back(tf);
+  }
+}
 
 RepairedMeshes::RepairedMeshes(size_t mesh_count) : impl_(std::make_unique<Impl>()) {
   impl_->counts.resize(mesh_count);
@@ -537,22 +656,23 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
   c = impl_->counts[m];
+  std::call_once(impl_->contacts_found, [this] { impl_->find_contacts(); });
   const std::vector<Part>& own = impl_->parts[m];
-  // Tools: the other pieces of this mesh, unless there are too many, and those of its neighbours.
-  std::vector<const Part*> others;
-  for (size_t t : touching)
-    for (const Part& part : impl_->parts[t]) others.push_back(&part);
   std::vector<Part>& imprinted = impl_->imprinted[m];
-  imprinted.clear();
-  TriangleSoup soup;
-  for (size_t i = 0; i < own.size(); ++i) {
-    Part& part = imprinted.emplace_back(own[i]);  // the shared copy stays as it is, a tool for the others
-    c.self_intersecting += part.self_intersecting;
-    std::vector<const Part*> tools;
-    if (own.size() <= kMaxImprintedParts)
-      for (size_t j = 0; j < own.size(); ++j)
-        if (j != i) tools.push_back(&own[j]);
-    tools.insert(tools.end(), others.begin(), others.end());
+  imprinted.assign(own.begin(), own.end());  // the shared copies stay as they are, tools for the others
+  // Pieces are imprinted in parallel, each reading only the shared copies; the soup is put
+  // together in piece order, so it does not depend on the thread count.
+  std::vector<TriangleSoup> soups(own.size());
+  std::vector<RepairCounts> piece_counts(own.size());
+  rc::parallel_for(own.size(), [&](size_t i) {
+    Part& part = imprinted[i];
+    std::vector<std::pair<const Part*, const ToolContact*>> tools;
+    for (const ToolContact& contact : impl_->contacts[m][i]) {
+      // Only the meshes this one touches lend tools (every contact lies within them, but a
+      // caller may ask for fewer).
+      if (contact.mesh != m && std::find(touching.begin(), touching.end(), contact.mesh) == touching.end()) continue;
+      tools.emplace_back(&impl_->parts[contact.mesh][contact.part], &contact);
+    }
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
     std::vector<std::array<double, 3>> input;
     for (auto v : part.mesh.vertices()) {
@@ -561,13 +681,21 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
     }
     std::sort(input.begin(), input.end());
     const size_t faces = part.mesh.number_of_faces();
-    c.contact_edges += imprint_contacts(part, tools, constrained, c);
+    RepairCounts& pc = piece_counts[i];
+    pc.contact_edges += imprint_contacts(part, tools, constrained, pc);
     if (part.mesh.number_of_faces() != faces) {
       snap_new_points(part.mesh, input);
       canonicalize(part.mesh, constrained);
     }
     if (part.mesh.has_garbage()) part.mesh.collect_garbage();  // face f is soup triangle f
-    append_soup(soup, to_soup(part.mesh));
+    soups[i] = to_soup(part.mesh);
+  });
+  TriangleSoup soup;
+  for (size_t i = 0; i < own.size(); ++i) {
+    c.self_intersecting += own[i].self_intersecting;
+    c.contact_edges += piece_counts[i].contact_edges;
+    c.contacts_failed += piece_counts[i].contacts_failed;
+    append_soup(soup, soups[i]);
   }
   return soup;
 }
