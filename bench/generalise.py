@@ -214,9 +214,13 @@ def write_tables(args, rows, header):
         w.writeheader()
         w.writerows(rows)
     with open(os.path.join(args.out, "table.md"), "w") as f:
-        f.write(f"Family seed {header['family_seed']}, budget {args.time} s, reference {args.reference_time} s, "
-                f"{args.width} × {args.height}, untimed at {args.untimed_spp} spp, checks of {args.check} points × "
-                f"{args.check_samples} samples.\n\n")
+        if header.get("furnace"):
+            f.write(f"Furnace family seed {header['family_seed']}, {args.width} × {args.height}, path tracer at "
+                    f"{max(args.untimed_spp, 32)} spp, radiosity views at {args.untimed_spp} spp, default tolerances.\n\n")
+        else:
+            f.write(f"Family seed {header['family_seed']}, budget {args.time} s, reference {args.reference_time} s, "
+                    f"{args.width} × {args.height}, untimed at {args.untimed_spp} spp, checks of {args.check} points × "
+                    f"{args.check_samples} samples.\n\n")
         columns = FURNACE_COLUMNS if header.get("furnace") else COLUMNS
         f.write("| " + " | ".join(c[1] for c in columns) + " |\n")
         f.write("|" + "---|" * len(columns) + "\n")
@@ -240,8 +244,11 @@ def main():
     ap.add_argument("--only", nargs="*", help="scene names or indices")
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--timeout", type=float, default=3600, help="per command, seconds")
+    ap.add_argument("--timeout", type=float, default=0,
+                    help="per command, seconds (default 5 × --time + 600: a command past it is recorded as a failure)")
     args = ap.parse_args()
+    if args.timeout <= 0:
+        args.timeout = 5 * args.time + 600
     args.exports = [e for e in args.exports.split(",") if e]
     bad = [e for e in args.exports if e not in ("elements", "input", "lightmap")]
     if bad:
