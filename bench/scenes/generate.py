@@ -485,7 +485,7 @@ def build_storeys(s, density):
     # Slabs of every upper floor and the roof: closed boxes `gap` from the walls, a stair opening.
     for k in range(1, n + 1):
         y = k * storey
-        sx0, sx1 = rng.uniform(0.2, 0.5) * w, 0.0
+        sx0 = rng.uniform(0.2, 0.5) * w
         sx1 = sx0 + rng.uniform(0.15, 0.25) * w
         sz0 = rng.uniform(0.1, 0.6) * d
         sz1 = sz0 + 0.25 * d
@@ -519,18 +519,17 @@ def furniture(s, rng, x, z, rot, kind, pierce, seg):
             lo, hi = (lo[2], lo[1], lo[0]), (hi[2], hi[1], hi[0])
         m.box((x + lo[0], lo[1], z + lo[2]), (x + hi[0], hi[1], z + hi[2]))
     y0 = -pierce
+    def legs(half_x, half_z, leg, top):
+        # Four square legs at the corners of a 2·half_x × 2·half_z footprint, from y0 to top.
+        for dx in (-half_x, half_x - leg):
+            for dz in (-half_z, half_z - leg):
+                put((dx, y0, dz), (dx + leg, top, dz + leg))
     if kind == "chair":
-        leg = 0.04
-        for dx in (-0.2, 0.2 - leg):
-            for dz in (-0.2, 0.2 - leg):
-                put((dx, y0, dz), (dx + leg, 0.45, dz + leg))
+        legs(0.2, 0.2, 0.04, 0.45)
         put((-0.2, 0.45, -0.2), (0.2, 0.5, 0.2))
         put((-0.2, 0.5, 0.16), (0.2, 0.95, 0.2))
     elif kind == "table":
-        leg = 0.06
-        for dx in (-0.7, 0.7 - leg):
-            for dz in (-0.4, 0.4 - leg):
-                put((dx, y0, dz), (dx + leg, 0.72, dz + leg))
+        legs(0.7, 0.4, 0.06, 0.72)
         put((-0.75, 0.72, -0.45), (0.75, 0.76, 0.45))
     elif kind == "round":
         s.mesh("wood").cylinder((x, z), 0.05, y0, 0.72, seg)
@@ -560,7 +559,6 @@ def build_furnished(s, density):
     for i in range(int(w / 1.2)):
         s.mesh("wood").box((0.6 + 1.2 * i, 0.0, d - 0.35), (1.4 + 1.2 * i, rng.uniform(1.2, 2.2), d))
     placed = 0
-    attempts = 0
     cell = 1.1
     nx, nz = int((w - 2) / cell), int((d - 2) / cell)
     free = [(i, j) for i in range(nx) for j in range(nz)]
@@ -568,7 +566,6 @@ def build_furnished(s, density):
     for (i, j) in free:
         if placed >= pieces:
             break
-        attempts += 1
         kind = rng.choice(["chair", "chair", "chair", "table", "round", "cabinet"])
         pierce = 0.02 if rng.random() < 0.3 else 0.0
         furniture(s, rng, 1 + (i + 0.5) * cell, 1 + (j + 0.5) * cell, rng.random() < 0.5, kind, pierce, seg)
