@@ -267,6 +267,7 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.duplicated_vertices, "vertices duplicated to make the surface manifold");
   warn(c.self_intersecting, "pairs of faces intersect each other (meshed as they are)");
   warn(c.contacts_failed, "touching surfaces whose contact lines could not be imprinted");
+  warn(c.contact_segments_lost, "pieces of contact line left out (an end outside its face by rounding)");
   warn(c.remesh_failed, "pieces could not be remeshed and keep their input triangles");
 }
 

@@ -36,6 +36,7 @@ struct RepairCounts {
   size_t self_intersecting = 0;    ///< pairs of faces that intersect away from a shared vertex or edge
   size_t contact_edges = 0;        ///< edges imprinted where another surface touches or crosses this one
   size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
+  size_t contact_segments_lost = 0;  ///< pieces of contact line left out: an end outside its face by rounding
   size_t remesh_failed = 0;        ///< pieces CGAL could not remesh, kept as they were
 };
 
@@ -64,7 +65,7 @@ class RepairedMeshes {
   /// meet it, and keeps the result for remesh(). Returns the imprinted surface, which lies on the
   /// input's, and fills `counts` with the repairs and what imprinting found. The first call finds
   /// which faces of which pieces meet (one box-intersection pass over every repaired mesh: call
-  /// it after every repair()); each piece is then corefined with the faces that meet it alone,
+  /// it after every repair()); each piece is then cut by the faces that meet it alone (imprint.h),
   /// in parallel over pieces. Reads the other meshes only: calls for different m may run in
   /// parallel.
   TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts);

@@ -21,7 +21,6 @@
 #include <CGAL/box_intersection_d.h>
 #include <CGAL/Polygon_mesh_processing/bbox.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
-#include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/detect_features.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -33,7 +32,7 @@
 #include <CGAL/Surface_mesh.h>
 
 #include "radiosity/mesh_detail.h"
-#include "radiosity/ordered_heap.h"
+#include "radiosity/imprint.h"
 #include "raytrace_core/parallel.h"
 
 namespace gilt::radiosity::detail {
@@ -230,118 +229,72 @@ constexpr size_t kMaxImprintedParts = 4096;
 
 /// A piece of some mesh that may imprint another piece, cropped to the faces whose boxes meet
 /// the other piece's faces' boxes (found by find_contacts): only they can cut it, so
-/// corefinement reads them alone, whatever the size of the tool.
+/// imprinting reads them alone, whatever the size of the tool.
 struct ToolContact {
   uint32_t mesh = 0, part = 0;
   std::vector<uint32_t> faces;  ///< ascending
 };
 
-/// Appends the faces `faces` of `from` to `to`, sharing vertices as `from` does.
-void append_faces(const SurfaceMesh& from, std::span<const uint32_t> faces, SurfaceMesh& to) {
-  std::unordered_map<uint32_t, SurfaceMesh::Vertex_index> copied;
-  for (uint32_t f : faces) {
-    std::array<SurfaceMesh::Vertex_index, 3> corners;
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(from.halfedge(face_descriptor(f)), from)) {
-      if (k == 3) break;
-      auto [it, fresh] = copied.try_emplace(static_cast<uint32_t>(v.idx()));
-      if (fresh) it->second = to.add_vertex(from.point(v));
-      corners[k++] = it->second;
-    }
-    if (k == 3) to.add_face(corners[0], corners[1], corners[2]);
-  }
-}
-
-CGAL::Bbox_3 faces_box(const SurfaceMesh& mesh, std::span<const uint32_t> faces) {
-  CGAL::Bbox_3 box;
-  for (uint32_t f : faces)
-    for (auto v : CGAL::vertices_around_face(mesh.halfedge(face_descriptor(f)), mesh)) box += mesh.point(v).bbox();
-  return box;
-}
+/// The mesh as a soup (face f is triangle f), with its constrained edges as cuts when given.
+TriangleSoup to_soup(const SurfaceMesh& mesh, const Constrained* constrained = nullptr);
 
 /// Imprints on `part` the lines where other surfaces touch or cross it (a block standing on a
 /// floor leaves its outline there) and marks them as constrained edges. Radiosity jumps across
 /// such a line (Heckbert 1992 and Lischinski, Tampieri & Greenberg 1992 call it a D0
 /// discontinuity: the floor is lit on one side and buried on the other); an element that
 /// straddles it would average the two, and Gouraud interpolation would smear the dark into the
-/// lit floor. CGAL's corefinement computes the intersection exactly and splits the faces along
-/// it; the tools are only read, each cropped to the faces that can meet the piece. Tools whose
-/// crops lie apart (their boxes do not meet) are read as one mesh, so a floor under a thousand
-/// chair legs is corefined a few times, not a thousand: their union is free of
-/// self-intersections because each of them is and they do not meet. Pieces that intersect
-/// themselves take no part, on either side: corefinement needs the modified mesh free of
-/// self-intersections, and CGAL 5.5 crashes on a self-intersecting tool even though it promises
-/// to read one (two boxes of one mesh sharing a face, tests/stress/test_pathological.cpp).
-/// Returns the number of imprinted edges.
+/// lit floor. The tools are read as triangles, only the faces of each that can meet the piece
+/// (found by find_contacts); imprint() cuts each face of the piece along them on its own, so the
+/// cost grows with the faces and the contacts, not with the tools' sizes, and a piece or tool
+/// that intersects itself is imprinted like any other. Returns the number of imprinted edges.
 size_t imprint_contacts(Part& part, const std::vector<std::pair<const Part*, const ToolContact*>>& tools,
                         Constrained& constrained, RepairCounts& counts) {
-  if (part.self_intersecting > 0) return 0;
-  size_t before = 0;
-  for (edge_descriptor e : part.mesh.edges()) before += constrained[e];
+  std::vector<std::array<DVec3, 3>> triangles;
+  for (const auto& [tool, contact] : tools)
+    for (uint32_t f : contact->faces) {
+      std::array<DVec3, 3> t;
+      int k = 0;
+      for (auto v : CGAL::vertices_around_face(tool->mesh.halfedge(face_descriptor(f)), tool->mesh)) {
+        if (k == 3) break;
+        const Point& p = tool->mesh.point(v);
+        t[k++] = DVec3(p.x(), p.y(), p.z());
+      }
+      if (k == 3) triangles.push_back(t);
+    }
+  if (triangles.empty()) return 0;
+  if (part.mesh.has_garbage()) part.mesh.collect_garbage();
+  ImprintCounts imprinted;
+  const TriangleSoup cut = imprint(to_soup(part.mesh), triangles, &imprinted);
+  counts.contact_segments_lost += imprinted.segments_lost;
+  if (imprinted.faces_cut == 0) return 0;
 
-  // Batches of tools whose crops lie apart, in the tools' order.
-  struct Batch {
-    std::vector<size_t> tools;
-    std::vector<CGAL::Bbox_3> boxes;
-  };
-  std::vector<Batch> batches;
-  for (size_t t = 0; t < tools.size(); ++t) {
-    const auto& [tool, contact] = tools[t];
-    if (tool->self_intersecting > 0) {
-      ++counts.contacts_failed;
-      continue;
+  SurfaceMesh mesh;
+  std::vector<SurfaceMesh::Vertex_index> vertex;
+  vertex.reserve(cut.points.size());
+  for (const DVec3& p : cut.points) vertex.push_back(mesh.add_vertex(Point(p.x, p.y, p.z)));
+  for (const auto& t : cut.triangles)
+    if (mesh.add_face(vertex[t[0]], vertex[t[1]], vertex[t[2]]) == SurfaceMesh::null_face()) {
+      // The cut faces do not fit together (a rounding case imprint() did not foresee): the piece
+      // is meshed without its contact lines, and the report says how many tools were left out.
+      counts.contacts_failed += tools.size();
+      return 0;
     }
-    const CGAL::Bbox_3 box = faces_box(tool->mesh, contact->faces);
-    auto apart = [&](const Batch& b) {
-      return std::none_of(b.boxes.begin(), b.boxes.end(), [&](const CGAL::Bbox_3& o) { return CGAL::do_overlap(o, box); });
-    };
-    auto it = std::find_if(batches.begin(), batches.end(), apart);
-    if (it == batches.end()) it = batches.insert(batches.end(), Batch{});
-    it->tools.push_back(t);
-    it->boxes.push_back(box);
+  Constrained marks = mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
+  size_t lines = 0;
+  for (const auto& [a, b] : cut.cuts) {
+    const auto [h, found] = CGAL::halfedge(vertex[a], vertex[b], mesh);
+    if (found && !marks[mesh.edge(h)]) {
+      marks[mesh.edge(h)] = true;
+      ++lines;
+    }
   }
-
-  // Corefines the piece with the union of the crops of `members`; false when CGAL gives up.
-  const auto corefine_with = [&](std::span<const size_t> members) {
-    // Corefinement orders what it cuts by memory addresses (see OrderedHeap): it runs in a heap
-    // of its own, so the cuts depend on the two meshes alone. Nothing made in it may outlive it:
-    // the exception is caught and the result copied out inside.
-    OrderedHeap heap;
-    try {
-      // The piece is cut as a copy, kept only if corefinement finishes: one that throws half-way
-      // has cut some faces. corefine() takes the tool by non-const reference even when it leaves
-      // it unmodified; the crops are copies, so the shared tools stay untouched.
-      SurfaceMesh tool_union, cut = part.mesh;
-      for (size_t t : members) append_faces(tools[t].first->mesh, tools[t].second->faces, tool_union);
-      Constrained cut_constrained = cut.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
-      PMP::corefine(cut, tool_union, CGAL::parameters::edge_is_constrained_map(cut_constrained),
-                    CGAL::parameters::do_not_modify(true));
-      const OrderedHeap::Outside outside(heap);
-      part.mesh = cut;
-      return true;
-    } catch (const std::exception&) {
-      return false;
-    }
-  };
-  for (const Batch& batch : batches) {
-    if (corefine_with(batch.tools)) continue;
-    // Corefinement gave up on the union: try its tools one by one, so one bad contact costs
-    // only itself; the piece is meshed without the contacts that fail alone too.
-    if (batch.tools.size() == 1) {
-      ++counts.contacts_failed;
-      continue;
-    }
-    for (size_t t : batch.tools)
-      if (!corefine_with(std::span<const size_t>(&t, 1))) ++counts.contacts_failed;
-  }
-  constrained = part.mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
-  size_t after = 0;
-  for (edge_descriptor e : part.mesh.edges()) after += constrained[e];
-  return after - before;
+  part.mesh = std::move(mesh);
+  constrained = marks;
+  return lines;
 }
 
 /// Whether the triangles (a, b, c) and (b, a, d), which share the edge a–b, lie in one plane up to
-/// the rounding of corefinement's constructed points to float (snap_new_points): each far corner
+/// the rounding of imprinting's constructed points to float (snap_new_points): each far corner
 /// within 1e-9 of the longest edge, or four float steps of the largest coordinate, of the other
 /// triangle's plane, and the two facing the same way.
 bool flat_pair(const Point& a, const Point& b, const Point& c, const Point& d) {
@@ -358,9 +311,9 @@ bool flat_pair(const Point& a, const Point& b, const Point& c, const Point& d) {
   return volume <= tolerance * std::sqrt(n1.squared_length()) && volume <= tolerance * std::sqrt(n2.squared_length());
 }
 
-/// Rounds the points that corefinement added to `mesh` (those not among `input`, sorted) to
-/// float. Corefinement may construct one intersection point from different pairs of faces in
-/// different runs (its order depends on memory addresses), differing in the last bits of the
+/// Rounds the points that imprinting added to `mesh` (those not among `input`, sorted) to
+/// float. One contact point may be constructed from different pairs of faces (a leg's corner as
+/// the floor sees it and as the leg's own imprint does), differing in the last bits of the
 /// double; rounded to float, which is all gilt's elements keep, they agree (unless they straddle
 /// a float rounding boundary: a chance of about 2⁻²⁹ per coordinate for a one-ulp difference),
 /// and so do the floor's and the block's copies of one contact point. Input points are floats
@@ -390,11 +343,9 @@ Kernel::Point_2 project(const Point& p, const Kernel::Vector_3& normal) {
   return normal.y() > 0 ? Kernel::Point_2(p.z(), p.x()) : Kernel::Point_2(p.x(), p.z());
 }
 
-/// Corefinement reports intersecting face pairs in an order that depends on memory addresses
-/// (CGAL 5.5's Box_intersection_d with ID_FROM_BOX_ADDRESS), so the triangles it cuts a face
-/// into, the order of its new vertices and (after snap_new_points, rarely) which of two nearby
-/// nodes exist change from run to run, and the remesher follows all three. This rebuilds the
-/// piece in a form that depends on its points and constrained edges alone: one vertex per
+/// The remesher follows the order of a piece's vertices and faces and the diagonals of its flat
+/// regions, which imprinting chose face by face and snap_new_points may have pinched. This
+/// rebuilds the piece in a form that depends on its points and constrained edges alone: one vertex per
 /// position in lexicographic order, faces in order of their corners, and every flat region
 /// triangulated as its constrained Delaunay triangulation (Lawson flips with exact 2D
 /// predicates in the region's projection; a diagonal of four cocircular points avoids the
@@ -402,7 +353,7 @@ Kernel::Point_2 project(const Point& p, const Kernel::Vector_3& normal) {
 void canonicalize(SurfaceMesh& mesh, Constrained& constrained) {
   using vertex_descriptor = SurfaceMesh::Vertex_index;
   // Points in lexicographic order, each once: vertices that rounding put in one place (two
-  // corefinement nodes a float step apart) become one, or their order would depend on the run.
+  // imprinted points a float step apart) become one, or their order would depend on the input's order.
   const auto less = [](const Point& p, const Point& q) { return CGAL::compare_xyz(p, q) == CGAL::SMALLER; };
   std::vector<Point> points;
   points.reserve(mesh.number_of_vertices());
@@ -548,7 +499,7 @@ void remesh_part(SurfaceMesh& mesh, const RemeshParams& params, Constrained& con
   mesh.collect_garbage();
 }
 
-TriangleSoup to_soup(const SurfaceMesh& mesh, const Constrained* constrained = nullptr) {
+TriangleSoup to_soup(const SurfaceMesh& mesh, const Constrained* constrained) {
   TriangleSoup soup;
   // A contact line is where light may jump (one side lit, the other under a wall): the vertices
   // on it get a copy for each side (split_sharp_vertices), so that neither side's light is
@@ -695,6 +646,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
     c.self_intersecting += own[i].self_intersecting;
     c.contact_edges += piece_counts[i].contact_edges;
     c.contacts_failed += piece_counts[i].contacts_failed;
+    c.contact_segments_lost += piece_counts[i].contact_segments_lost;
     append_soup(soup, soups[i]);
   }
   return soup;

@@ -102,7 +102,8 @@ TEST(MeshRobust, ImprintingGivesTheSameMeshEveryRunAndThreadCount) {
 
 /// Šibenik (../shared/scenes): a piece cut by one tool after another, where a run's first cut
 /// decided where the next one's points fell, gave 12,890 or 12,891 contact edges and different
-/// element meshes, about one run in eight, until corefinement ran in an OrderedHeap.
+/// element meshes, about one run in eight, while CGAL's corefinement imprinted them (it orders
+/// its work by memory addresses); gilt's own imprinting depends on the input alone.
 TEST(MeshRobust, SibeniksContactLinesAreTheSameInEveryRun) {
   const std::string path = std::string(GILT_SOURCE_DIR) + "/../shared/scenes/wrap/sibenik-lit.json";
   if (!std::ifstream(path)) GTEST_SKIP() << "no " << path;
