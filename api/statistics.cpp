@@ -63,6 +63,8 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
                       {"first_residual", l.first_residual},
                       {"residual", l.residual},
                       {"iterate_seconds", l.iterate_seconds}});
+  nlohmann::json mesh_stages = nlohmann::json::object();
+  for (const auto& [stage, seconds] : sol.mesh_report.stage_seconds) mesh_stages[stage] = seconds;
   return {{"ranks", rc::processes().count()},
           {"elements", sol.mesh.element_count()},
           {"meshed_elements", sol.mesh_report.elements},
@@ -96,6 +98,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
           {"pairs_without_visibility_rays", sol.skipped_pairs},
           {"convex_enclosure", sol.convex_enclosure},
           {"seconds", sol.seconds},
+          {"mesh_stage_seconds", mesh_stages},
           {"phase_seconds",
            {{"mesh", sol.mesh_seconds},
             {"direct", sol.direct_seconds},

@@ -285,6 +285,13 @@ void run_radiosity(RadiosityOptions& o) {
   else
     std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, shooting %.3g)\n", sol.seconds, sol.mesh_seconds,
                 sol.direct_seconds, sol.shoot_seconds);
+  if (sol.mesh_seconds >= 1.0) {
+    std::printf("  mesh:    ");
+    const auto& stages = sol.mesh_report.stage_seconds;
+    for (size_t i = 0; i < stages.size(); ++i)
+      std::printf("%s%s %.3g s", i ? ", " : "", stages[i].first.c_str(), stages[i].second);
+    std::printf("\n");
+  }
   // The check inverts L = ρ E / π, which holds on Lambertian surfaces only: say so rather than
   // print errors of nothing.
   const char* kNothingChecked =

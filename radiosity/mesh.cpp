@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -18,6 +19,7 @@
 #include "radiosity/mesh_detail.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/progress.h"
 
 namespace gilt::radiosity {
 namespace detail {
@@ -522,17 +524,42 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
       meshed[m] = repair[m] = 1;
       for (size_t t : touching[m]) repair[t] = 1;
     }
+  // Each stage is timed, and shows its progress in input faces when asked to.
+  auto stage_start = std::chrono::steady_clock::now();
+  const auto end_stage = [&](const char* name) {
+    const auto now = std::chrono::steady_clock::now();
+    rep.stage_seconds.emplace_back(name, std::chrono::duration<double>(now - stage_start).count());
+    stage_start = now;
+  };
+  const auto faces_of = [&](const std::vector<char>& which) {
+    uint64_t faces = 0;
+    for (size_t m = 0; m < mesh_count; ++m)
+      if (which[m]) faces += scene.meshes[m].indices.size() / 3;
+    return faces;
+  };
   RepairedMeshes repaired(mesh_count);
-  rc::parallel_for(mesh_count, [&](size_t m) {
-    if (repair[m]) repaired.repair(m, scene.meshes[m]);
-  });
+  {
+    rc::Progress progress("mesh: repairing", faces_of(repair), "faces", settings.progress);
+    rc::parallel_for(mesh_count, [&](size_t m) {
+      if (!repair[m]) return;
+      repaired.repair(m, scene.meshes[m]);
+      progress.advance(scene.meshes[m].indices.size() / 3);
+    });
+  }
+  end_stage("repair");
   // Imprint, then find what is buried on the imprinted input surface (rays need the committed
   // scene). What is buried is removed before remeshing, so no element is made for it.
-  rc::parallel_for(mesh_count, [&](size_t m) {
-    if (!meshed[m]) return;
-    const TriangleSoup imprinted = repaired.imprint(m, touching[m], &counts[m]);
-    if (scene.committed()) buried_area[m] = mark_buried(scene, imprinted, buried[m]);
-  });
+  std::vector<size_t> imprinted_faces(mesh_count, 0);
+  {
+    rc::Progress progress("mesh: imprinting contact lines", faces_of(meshed), "faces", settings.progress);
+    rc::parallel_for(mesh_count, [&](size_t m) {
+      if (!meshed[m]) return;
+      const TriangleSoup imprinted = repaired.imprint(m, touching[m], &counts[m], &progress);
+      imprinted_faces[m] = imprinted.triangles.size();
+      if (scene.committed()) buried_area[m] = mark_buried(scene, imprinted, buried[m]);
+    });
+  }
+  end_stage("imprint and buried faces");
   const auto too_much = [&](double buried_total) {
     if (buried_total <= kMaxBuriedShare * area) return false;
     rep.warnings.push_back(std::to_string(static_cast<int>(std::lround(100.0 * buried_total / area))) +
@@ -550,10 +577,12 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   }
   std::vector<std::vector<char>> buried_elements(mesh_count);
   std::vector<double> buried_element_area(mesh_count, 0.0);
+  rc::Progress remeshing("mesh: remeshing", std::accumulate(imprinted_faces.begin(), imprinted_faces.end(), uint64_t{0}),
+                         "faces", settings.progress);
   rc::parallel_for(surface_count, [&](size_t s) {
     if (s < mesh_count) {
       if (!meshed[s]) return;
-      TriangleSoup soup = repaired.remesh(s, buried[s], params, &counts[s]);
+      TriangleSoup soup = repaired.remesh(s, buried[s], params, &counts[s], &remeshing);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
       if (scene.committed() && total_buried <= kMaxBuriedShare * area)
@@ -572,6 +601,8 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     }
   });
 
+  remeshing.finish();
+  end_stage("remesh");
   const double element_buried = std::accumulate(buried_element_area.begin(), buried_element_area.end(), 0.0);
   if (element_buried > 0.0 && !too_much(total_buried + element_buried)) {
     total_buried += element_buried;
@@ -593,6 +624,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     warn_counts(rep, mesh_label(scene.meshes[s], s), c);
   }
   rep.elements = out.element_count();
+  end_stage("assemble");
   // The remesher keeps the input's borders, creases and contact lines where they are, so a model
   // of many small faces cannot be meshed coarser than they allow.
   if (settings.elements > 0 && settings.max_edge == 0.0f && out.element_count() > 2 * size_t(settings.elements))

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "raytrace_core/scene.h"
@@ -21,6 +22,7 @@ struct MeshSettings {
   int elements = 0;             ///< approximate total element count (0: use max_edge or the default)
   float sharp_angle_degrees = 30.0f;  ///< dihedral angle above which an edge is sharp (vertices split)
   int remesh_iterations = 3;    ///< isotropic remeshing passes
+  bool progress = false;        ///< report each stage that runs longer than a second or two on stderr
 };
 
 /// Default element count when neither size is given: accurate on the built-in scenes.
@@ -51,6 +53,9 @@ struct MeshReport {
   size_t buried_elements = 0;  ///< flat elements removed after remeshing for the same reason (where no contact was imprinted)
   double buried_area = 0.0;    ///< area of both, scene units²
   double meshed_area = 0.0;    ///< area of the input surfaces that are meshed, scene units²
+  /// Seconds each stage took, in order: repair, imprint (with the test of the input faces for
+  /// being buried), remesh (with the flat elements' test), assemble.
+  std::vector<std::pair<std::string, double>> stage_seconds;
   std::vector<std::string> warnings;
 };
 

@@ -13,6 +13,10 @@
 #include "radiosity/mesh.h"
 #include "raytrace_core/math.h"
 
+namespace gilt::raytrace_core {
+class Progress;
+}
+
 namespace gilt::radiosity::detail {
 
 using rc::DVec3;
@@ -68,13 +72,17 @@ class RepairedMeshes {
   /// it after every repair()); each piece is then cut by the faces that meet it alone (imprint.h),
   /// in parallel over pieces. Reads the other meshes only: calls for different m may run in
   /// parallel.
-  TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts);
+  /// `progress`, when given, advances by each piece's faces as it is done.
+  TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
+                       rc::Progress* progress = nullptr);
 
   /// Mesh m as imprinted, without the triangles of the imprinted surface that `remove` marks,
   /// remeshed isotropically to `params.edge_length` with its border, sharp and contact edges
   /// protected. Returns the remeshed surface (empty when nothing is left) and adds to `counts`
   /// what remeshing mended. Calls for different m may run in parallel.
-  TriangleSoup remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params, RepairCounts* counts);
+  /// `progress`, when given, advances by each piece's faces as it is done.
+  TriangleSoup remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params, RepairCounts* counts,
+                      rc::Progress* progress = nullptr);
 
  private:
   struct Impl;

@@ -648,7 +648,9 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (!scene.committed()) throw std::logic_error("radiosity::plan_solve: the scene was not committed");
   SolvePlan plan;
   MeshReport report;
-  const RadiosityMesh mesh = build_mesh(scene, settings.mesh, &report);
+  MeshSettings mesh_settings = settings.mesh;
+  mesh_settings.progress = settings.progress;
+  const RadiosityMesh mesh = build_mesh(scene, mesh_settings, &report);
   plan.elements = mesh.element_count();
   plan.vertices = mesh.vertex_count();
   plan.max_edge = report.max_edge;
@@ -679,7 +681,9 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   const rc::ThreadLimit limit(settings.threads);
 
   Solution sol;
-  sol.mesh = build_mesh(scene, settings.mesh, &sol.mesh_report);
+  MeshSettings mesh_settings = settings.mesh;
+  mesh_settings.progress = settings.progress;
+  sol.mesh = build_mesh(scene, mesh_settings, &sol.mesh_report);
   sol.mesh_seconds = elapsed();
   RadiosityMesh& mesh = sol.mesh;
   Receivers receivers(scene, mesh);

@@ -1,4 +1,5 @@
-// Progress bar on stderr: "label [#####.....]  42%  12.3s elapsed, ETA 17.0s, 1.2M samples/s".
+// Progress bar on stderr: "label [#####.....]  42%  12.3s elapsed, ETA 17.0s, 1.2M samples/s";
+// where stderr is not a terminal, the same without the bar, as plain lines.
 //
 // Workers call advance() concurrently. Counting is one atomic add; drawing happens at most every
 // kRedrawInterval, by whichever worker first wins try_lock on the draw mutex, so no worker ever
@@ -19,6 +20,8 @@ namespace gilt::raytrace_core {
 namespace {
 
 constexpr int64_t kRedrawInterval = 200'000'000;  // ns: at most five redraws a second
+constexpr int64_t kFirstLine = 2'000'000'000;     // ns: plain lines start after two seconds
+constexpr int64_t kLineInterval = 10'000'000'000; // ns: and come every ten
 constexpr int kBarWidth = 30;
 
 /// Seconds as "12.3s", "4m05s" or "2h07m".
@@ -55,7 +58,8 @@ Progress::Progress(std::string label, uint64_t total, std::string unit, bool ena
     : label_(std::move(label)),
       unit_(std::move(unit)),
       total_(total),
-      enabled_(enabled && stderr_is_terminal()),
+      enabled_(enabled),
+      terminal_(stderr_is_terminal()),
       start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() { finish(); }
@@ -67,11 +71,13 @@ void Progress::advance(uint64_t done) {
   if (!enabled_) return;
   const int64_t now =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_).count();
-  if (now - last_draw_ns_.load(std::memory_order_relaxed) < kRedrawInterval) return;
+  const int64_t wait = terminal_ ? kRedrawInterval : last_draw_ns_.load(std::memory_order_relaxed) == 0 ? kFirstLine
+                                                                                                       : kLineInterval;
+  if (now - last_draw_ns_.load(std::memory_order_relaxed) < wait) return;
   std::unique_lock lock(draw_mutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;
   // Another worker may have drawn between the check above and taking the lock.
-  if (now - last_draw_ns_.load(std::memory_order_relaxed) < kRedrawInterval) return;
+  if (now - last_draw_ns_.load(std::memory_order_relaxed) < wait) return;
   last_draw_ns_.store(now, std::memory_order_relaxed);
   draw(false);
 }
@@ -88,8 +94,10 @@ void Progress::finish() {
 // Called with draw_mutex_ held. The final draw erases the bar, leaving the cursor at the start of
 // an empty line for whatever is printed next.
 void Progress::draw(bool final_draw) {
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (final_draw) {
-    std::fputs("\r\33[2K", stderr);
+    if (terminal_) std::fputs("\r\33[2K", stderr);
+    else if (drawn_) std::fprintf(stderr, "%s: done in %s\n", label_.c_str(), format_duration(elapsed).c_str());
     std::fflush(stderr);
     return;
   }
@@ -98,19 +106,23 @@ void Progress::draw(bool final_draw) {
   const uint64_t total = total_.load(std::memory_order_relaxed);
   const double fraction =
       total > 0 ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total)) : 0.0;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-
+  drawn_ = true;
   const int filled = static_cast<int>(fraction * kBarWidth);
-  std::string line =
-      "\r" + label_ + " [" + std::string(filled, '#') + std::string(kBarWidth - filled, '.') + "] ";
+  std::string line = terminal_ ? "\r" + label_ + " [" + std::string(filled, '#') +
+                                     std::string(kBarWidth - filled, '.') + "] "
+                               : label_ + ": ";
   char percent[8];
   std::snprintf(percent, sizeof(percent), "%3d%%", static_cast<int>(fraction * 100.0));
   line += percent;
+  char count[64];
+  std::snprintf(count, sizeof(count), " (%llu/%llu)", static_cast<unsigned long long>(done),
+                static_cast<unsigned long long>(total));
+  if (!terminal_) line += count;
   line += "  " + format_duration(elapsed) + " elapsed";
   if (fraction > 0.0 && fraction < 1.0)
     line += ", ETA " + format_duration(elapsed * (1.0 - fraction) / fraction);
   if (elapsed > 0.0) line += ", " + format_rate(static_cast<double>(done) / elapsed) + " " + unit_ + "/s";
-  line += "\33[K";  // erase whatever a longer previous line left behind
+  line += terminal_ ? "\33[K" : "\n";  // erase whatever a longer previous line left behind
   std::fputs(line.c_str(), stderr);
   std::fflush(stderr);
 }

@@ -1,5 +1,6 @@
 #pragma once
-// A progress bar on stderr (elapsed, ETA, rate) that stays quiet when stderr is not a terminal.
+// Progress on stderr (elapsed, ETA, rate): one bar redrawn in place on a terminal; elsewhere (a
+// log, a pipe) a plain line once the work has run two seconds and then every ten.
 
 #include <atomic>
 #include <chrono>
@@ -19,7 +20,7 @@ class Progress {
   void advance(uint64_t done);
   /// Changes the total (time-budgeted runs learn it as they go).
   void set_total(uint64_t total);
-  /// Clears the bar line.
+  /// Clears the bar line; in plain lines, says how long the work took if it said anything.
   void finish();
   /// True when stderr is an interactive terminal.
   static bool stderr_is_terminal();
@@ -29,8 +30,8 @@ class Progress {
   std::string label_, unit_;
   std::atomic<uint64_t> done_{0};
   std::atomic<uint64_t> total_;
-  bool enabled_;
-  bool finished_ = false;
+  bool enabled_, terminal_;
+  bool finished_ = false, drawn_ = false;
   std::chrono::steady_clock::time_point start_;
   std::atomic<int64_t> last_draw_ns_{0};
   std::mutex draw_mutex_;
