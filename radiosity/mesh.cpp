@@ -271,6 +271,7 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.contacts_failed, "touching surfaces whose contact lines could not be imprinted");
   warn(c.contact_segments_lost, "pieces of contact line left out (an end outside its face by rounding)");
   warn(c.remesh_failed, "pieces could not be remeshed and keep their input triangles");
+  warn(c.not_remeshed, "pieces keep their input triangles: --time left no time to remesh them");
 }
 
 double meshed_area(const rc::Scene& scene) {
@@ -549,17 +550,23 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   end_stage("repair");
   // Imprint, then find what is buried on the imprinted input surface (rays need the committed
   // scene). What is buried is removed before remeshing, so no element is made for it.
-  std::vector<size_t> imprinted_faces(mesh_count, 0);
+  repaired.find_contacts();
+  end_stage("contacts");
+  std::vector<TriangleSoup> imprinted(mesh_count);
   {
     rc::Progress progress("mesh: imprinting contact lines", faces_of(meshed), "faces", settings.progress);
     rc::parallel_for(mesh_count, [&](size_t m) {
-      if (!meshed[m]) return;
-      const TriangleSoup imprinted = repaired.imprint(m, touching[m], &counts[m], &progress);
-      imprinted_faces[m] = imprinted.triangles.size();
-      if (scene.committed()) buried_area[m] = mark_buried(scene, imprinted, buried[m]);
+      if (meshed[m]) imprinted[m] = repaired.imprint(m, touching[m], &counts[m], &progress);
     });
   }
-  end_stage("imprint and buried faces");
+  end_stage("imprint");
+  std::vector<size_t> imprinted_faces(mesh_count, 0);
+  rc::parallel_for(mesh_count, [&](size_t m) {
+    imprinted_faces[m] = imprinted[m].triangles.size();
+    if (meshed[m] && scene.committed()) buried_area[m] = mark_buried(scene, imprinted[m], buried[m]);
+    imprinted[m] = TriangleSoup();
+  });
+  end_stage("buried faces");
   const auto too_much = [&](double buried_total) {
     if (buried_total <= kMaxBuriedShare * area) return false;
     rep.warnings.push_back(std::to_string(static_cast<int>(std::lround(100.0 * buried_total / area))) +
@@ -582,7 +589,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   rc::parallel_for(surface_count, [&](size_t s) {
     if (s < mesh_count) {
       if (!meshed[s]) return;
-      TriangleSoup soup = repaired.remesh(s, buried[s], params, &counts[s], &remeshing);
+      TriangleSoup soup = repaired.remesh(s, buried[s], params, &counts[s], &remeshing, settings.deadline);
       drop_flat_triangles(soup);
       surfaces[s] = split_sharp_vertices(soup, settings.sharp_angle_degrees);
       if (scene.committed() && total_buried <= kMaxBuriedShare * area)
@@ -621,6 +628,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     rep.reoriented += c.reoriented;
     rep.self_intersecting += c.self_intersecting;
     rep.contact_edges += c.contact_edges;
+    rep.pieces_not_remeshed += c.not_remeshed;
     warn_counts(rep, mesh_label(scene.meshes[s], s), c);
   }
   rep.elements = out.element_count();

@@ -4,6 +4,7 @@
 // the surface normal changes sharply; light is received at vertices, shot from elements.
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -23,6 +24,9 @@ struct MeshSettings {
   float sharp_angle_degrees = 30.0f;  ///< dihedral angle above which an edge is sharp (vertices split)
   int remesh_iterations = 3;    ///< isotropic remeshing passes
   bool progress = false;        ///< report each stage that runs longer than a second or two on stderr
+  /// When remeshing must end (a solve under --time): pieces not begun by then keep their
+  /// imprinted triangles, and MeshReport::pieces_not_remeshed counts them.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 
 /// Default element count when neither size is given: accurate on the built-in scenes.
@@ -53,8 +57,9 @@ struct MeshReport {
   size_t buried_elements = 0;  ///< flat elements removed after remeshing for the same reason (where no contact was imprinted)
   double buried_area = 0.0;    ///< area of both, scene units²
   double meshed_area = 0.0;    ///< area of the input surfaces that are meshed, scene units²
-  /// Seconds each stage took, in order: repair, imprint (with the test of the input faces for
-  /// being buried), remesh (with the flat elements' test), assemble.
+  size_t pieces_not_remeshed = 0;  ///< pieces that kept their imprinted triangles: the deadline had passed
+  /// Seconds each stage took, in order: repair, contacts (which faces meet), imprint, buried
+  /// faces (the imprinted input's test), remesh (with the flat elements' test), assemble.
   std::vector<std::pair<std::string, double>> stage_seconds;
   std::vector<std::string> warnings;
 };

@@ -4,6 +4,7 @@
 // without CGAL's headers.
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -42,6 +43,7 @@ struct RepairCounts {
   size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
   size_t contact_segments_lost = 0;  ///< pieces of contact line left out: an end outside its face by rounding
   size_t remesh_failed = 0;        ///< pieces CGAL could not remesh, kept as they were
+  size_t not_remeshed = 0;         ///< pieces left as imprinted: the deadline had passed
 };
 
 /// Remeshing parameters for one surface.
@@ -65,13 +67,15 @@ class RepairedMeshes {
   /// Mends mesh m; calls for different m may run in parallel.
   void repair(size_t m, const rc::TriangleMesh& mesh);
 
+  /// Finds which faces of which pieces meet: one box-intersection pass over every repaired mesh,
+  /// so call it after every repair(). imprint() calls it on first use.
+  void find_contacts();
+
   /// Imprints on mesh m the lines where the `touching` meshes (repaired too) and its own pieces
   /// meet it, and keeps the result for remesh(). Returns the imprinted surface, which lies on the
-  /// input's, and fills `counts` with the repairs and what imprinting found. The first call finds
-  /// which faces of which pieces meet (one box-intersection pass over every repaired mesh: call
-  /// it after every repair()); each piece is then cut by the faces that meet it alone (imprint.h),
-  /// in parallel over pieces. Reads the other meshes only: calls for different m may run in
-  /// parallel.
+  /// input's, and fills `counts` with the repairs and what imprinting found. Each piece is cut by
+  /// the faces that meet it alone (imprint.h), in parallel over pieces. Reads the other meshes
+  /// only: calls for different m may run in parallel.
   /// `progress`, when given, advances by each piece's faces as it is done.
   TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
                        rc::Progress* progress = nullptr);
@@ -81,8 +85,10 @@ class RepairedMeshes {
   /// protected. Returns the remeshed surface (empty when nothing is left) and adds to `counts`
   /// what remeshing mended. Calls for different m may run in parallel.
   /// `progress`, when given, advances by each piece's faces as it is done.
+  /// Pieces not begun by `deadline` keep their imprinted triangles (counts->not_remeshed).
   TriangleSoup remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params, RepairCounts* counts,
-                      rc::Progress* progress = nullptr);
+                      rc::Progress* progress = nullptr,
+                      std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
  private:
   struct Impl;

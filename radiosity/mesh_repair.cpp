@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -626,6 +627,10 @@ RepairedMeshes::RepairedMeshes(size_t mesh_count) : impl_(std::make_unique<Impl>
 
 RepairedMeshes::~RepairedMeshes() = default;
 
+void RepairedMeshes::find_contacts() {
+  std::call_once(impl_->contacts_found, [this] { impl_->find_contacts(); });
+}
+
 void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh) {
   const SurfaceMesh repaired = detail::repair(mesh, impl_->counts[m]);
   if (repaired.number_of_faces() > 0) impl_->parts[m] = split_parts(repaired);
@@ -636,7 +641,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
   c = impl_->counts[m];
-  std::call_once(impl_->contacts_found, [this] { impl_->find_contacts(); });
+  find_contacts();
   const std::vector<Part>& own = impl_->parts[m];
   std::vector<Part>& imprinted = impl_->imprinted[m];
   imprinted.assign(own.begin(), own.end());  // the shared copies stay as they are, tools for the others
@@ -683,7 +688,8 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
 }
 
 TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params,
-                                    RepairCounts* counts, rc::Progress* progress) {
+                                    RepairCounts* counts, rc::Progress* progress,
+                                    std::chrono::steady_clock::time_point deadline) {
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
   std::vector<Part> imprinted = std::move(impl_->imprinted[m]);
@@ -703,7 +709,13 @@ TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, c
     if (!removed.empty()) mesh.collect_garbage();
     if (mesh.number_of_faces() > 0) {
       Constrained constrained = mesh.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
-      remesh_part(mesh, params, constrained, piece_counts[i]);
+      if (std::chrono::steady_clock::now() < deadline) {
+        remesh_part(mesh, params, constrained, piece_counts[i]);
+      } else {
+        // Out of time: the piece keeps its imprinted triangles, as one CGAL cannot remesh does.
+        piece_counts[i].removed_degenerate += remove_flat_faces(mesh);
+        ++piece_counts[i].not_remeshed;
+      }
       soups[i] = to_soup(mesh, &constrained);
     }
     mesh = SurfaceMesh();  // freed as soon as it is copied out
@@ -713,6 +725,7 @@ TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, c
   for (size_t i = 0; i < imprinted.size(); ++i) {
     c.removed_degenerate += piece_counts[i].removed_degenerate;
     c.remesh_failed += piece_counts[i].remesh_failed;
+    c.not_remeshed += piece_counts[i].not_remeshed;
     append_soup(soup, soups[i]);
   }
   return soup;

@@ -33,14 +33,19 @@ const char* to_string(SolverKind kind);
 /// At and above this many elements `automatic` picks the hierarchical solver.
 inline constexpr size_t kHierarchicalElements = 20000;
 
+/// Share of --time after which remeshing stops (the pieces not yet remeshed keep their imprinted
+/// triangles): meshing is preparation, and the solve needs the rest.
+inline constexpr double kMeshShare = 0.2;
+
 /// Solver parameters; the defaults are the documented defaults.
 struct SolverSettings {
   SolverKind solver = SolverKind::automatic;
   HierarchicalSettings hierarchical;  ///< its tolerance and seed are taken from the fields below
   MeshSettings mesh;
   double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
-  double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); refinement
-                             ///< stops after 30 % of it, and no shot starts that would end past it
+  double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); remeshing
+                             ///< stops after kMeshShare of it, refinement after 30 %, and no shot
+                             ///< starts that would end past it
   int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (a quarter in
                                 ///< each quarter of the source); pairs a 4-ray probe finds all open or all blocked take 4
   int reflected_visibility_probe = 1;  ///< probe side (rays = side²) for patches that only reflect light
