@@ -72,6 +72,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
           {"max_edge", sol.mesh_report.max_edge},
           {"refined_elements", sol.refined_elements},
           {"contact_edges", sol.mesh_report.contact_edges},
+          {"pieces_not_imprinted", sol.mesh_report.pieces_not_imprinted},
           {"pieces_not_remeshed", sol.mesh_report.pieces_not_remeshed},
           {"buried_faces", sol.mesh_report.buried_faces},
           {"buried_elements", sol.mesh_report.buried_elements},

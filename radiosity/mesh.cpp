@@ -271,6 +271,7 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.contacts_failed, "touching surfaces whose contact lines could not be imprinted");
   warn(c.contact_segments_lost, "pieces of contact line left out (an end outside its face by rounding)");
   warn(c.remesh_failed, "pieces could not be remeshed and keep their input triangles");
+  warn(c.not_imprinted, "pieces that touch other surfaces keep no contact lines: --time left no time to imprint them");
   warn(c.not_remeshed, "pieces keep their input triangles: --time left no time to remesh them");
 }
 
@@ -556,7 +557,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   {
     rc::Progress progress("mesh: imprinting contact lines", faces_of(meshed), "faces", settings.progress);
     rc::parallel_for(mesh_count, [&](size_t m) {
-      if (meshed[m]) imprinted[m] = repaired.imprint(m, touching[m], &counts[m], &progress);
+      if (meshed[m]) imprinted[m] = repaired.imprint(m, touching[m], &counts[m], &progress, settings.deadline);
     });
   }
   end_stage("imprint");
@@ -628,6 +629,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
     rep.reoriented += c.reoriented;
     rep.self_intersecting += c.self_intersecting;
     rep.contact_edges += c.contact_edges;
+    rep.pieces_not_imprinted += c.not_imprinted;
     rep.pieces_not_remeshed += c.not_remeshed;
     warn_counts(rep, mesh_label(scene.meshes[s], s), c);
   }

@@ -24,8 +24,10 @@ struct MeshSettings {
   float sharp_angle_degrees = 30.0f;  ///< dihedral angle above which an edge is sharp (vertices split)
   int remesh_iterations = 3;    ///< isotropic remeshing passes
   bool progress = false;        ///< report each stage that runs longer than a second or two on stderr
-  /// When remeshing must end (a solve under --time): pieces not begun by then keep their
-  /// imprinted triangles, and MeshReport::pieces_not_remeshed counts them.
+  /// When meshing must end (a solve under --time). Imprinting goes piece by piece, those with the
+  /// most contact faces first; pieces not begun by then keep their input triangles, without
+  /// contact lines (MeshReport::pieces_not_imprinted). Remeshing then goes on until the same
+  /// time; pieces not begun by then keep their imprinted triangles (pieces_not_remeshed).
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 
@@ -57,6 +59,7 @@ struct MeshReport {
   size_t buried_elements = 0;  ///< flat elements removed after remeshing for the same reason (where no contact was imprinted)
   double buried_area = 0.0;    ///< area of both, scene units²
   double meshed_area = 0.0;    ///< area of the input surfaces that are meshed, scene units²
+  size_t pieces_not_imprinted = 0;  ///< pieces that touch others but kept no contact lines: the deadline had passed
   size_t pieces_not_remeshed = 0;  ///< pieces that kept their imprinted triangles: the deadline had passed
   /// Seconds each stage took, in order: repair, contacts (which faces meet), imprint, buried
   /// faces (the imprinted input's test), remesh (with the flat elements' test), assemble.

@@ -43,6 +43,7 @@ struct RepairCounts {
   size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
   size_t contact_segments_lost = 0;  ///< pieces of contact line left out: an end outside its face by rounding
   size_t remesh_failed = 0;        ///< pieces CGAL could not remesh, kept as they were
+  size_t not_imprinted = 0;        ///< pieces with contacts left as they were: the deadline had passed
   size_t not_remeshed = 0;         ///< pieces left as imprinted: the deadline had passed
 };
 
@@ -76,9 +77,12 @@ class RepairedMeshes {
   /// input's, and fills `counts` with the repairs and what imprinting found. Each piece is cut by
   /// the faces that meet it alone (imprint.h), in parallel over pieces. Reads the other meshes
   /// only: calls for different m may run in parallel.
-  /// `progress`, when given, advances by each piece's faces as it is done.
+  /// `progress`, when given, advances by each piece's faces as it is done. Pieces are begun in
+  /// order of their contact faces, most first; those not begun by `deadline` are left as they
+  /// were (counts->not_imprinted).
   TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
-                       rc::Progress* progress = nullptr);
+                       rc::Progress* progress = nullptr,
+                       std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   /// Mesh m as imprinted, without the triangles of the imprinted surface that `remove` marks,
   /// remeshed isotropically to `params.edge_length` with its border, sharp and contact edges

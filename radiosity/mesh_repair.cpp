@@ -655,7 +655,7 @@ void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh) {
 }
 
 TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
-                                     rc::Progress* progress) {
+                                     rc::Progress* progress, std::chrono::steady_clock::time_point deadline) {
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
   c = impl_->counts[m];
@@ -667,16 +667,33 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
   // together in piece order, so it does not depend on the thread count.
   std::vector<TriangleSoup> soups(own.size());
   std::vector<RepairCounts> piece_counts(own.size());
-  rc::parallel_for(own.size(), [&](size_t i) {
-    Part& part = imprinted[i];
-    std::vector<std::pair<const Part*, const ToolContact*>> tools;
+  // Only the meshes this one touches lend tools (every contact lies within them, but a caller
+  // may ask for fewer).
+  std::vector<std::vector<std::pair<const Part*, const ToolContact*>>> tools(own.size());
+  std::vector<std::pair<size_t, size_t>> order;  // (contact faces, piece), most first
+  for (size_t i = 0; i < own.size(); ++i) {
+    size_t faces = 0;
     for (const ToolContact& contact : impl_->contacts[m][i]) {
-      // Only the meshes this one touches lend tools (every contact lies within them, but a
-      // caller may ask for fewer).
       if (contact.mesh != m && std::find(touching.begin(), touching.end(), contact.mesh) == touching.end()) continue;
-      tools.emplace_back(&impl_->parts[contact.mesh][contact.part], &contact);
+      tools[i].emplace_back(&impl_->parts[contact.mesh][contact.part], &contact);
+      faces += contact.faces.size();
     }
+    order.emplace_back(faces, i);
+  }
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  rc::parallel_for(order.size(), [&](size_t k) {
+    const size_t i = order[k].second;
+    Part& part = imprinted[i];
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
+    if (!tools[i].empty() && std::chrono::steady_clock::now() >= deadline) {
+      // Out of time: the piece keeps its input triangles, remeshed without contact lines.
+      ++piece_counts[i].not_imprinted;
+      soups[i] = to_soup(part.mesh);
+      if (progress) progress->advance(part.mesh.number_of_faces());
+      return;
+    }
     std::vector<std::array<double, 3>> input;
     for (auto v : part.mesh.vertices()) {
       const Point& p = part.mesh.point(v);
@@ -685,7 +702,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
     std::sort(input.begin(), input.end());
     const size_t faces = part.mesh.number_of_faces();
     RepairCounts& pc = piece_counts[i];
-    pc.contact_edges += imprint_contacts(part, tools, constrained, pc);
+    pc.contact_edges += imprint_contacts(part, tools[i], constrained, pc);
     if (part.mesh.number_of_faces() != faces) {
       snap_new_points(part.mesh, input);
       canonicalize(part.mesh, constrained);
@@ -700,6 +717,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
     c.contact_edges += piece_counts[i].contact_edges;
     c.contacts_failed += piece_counts[i].contacts_failed;
     c.contact_segments_lost += piece_counts[i].contact_segments_lost;
+    c.not_imprinted += piece_counts[i].not_imprinted;
     append_soup(soup, soups[i]);
   }
   return soup;

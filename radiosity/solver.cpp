@@ -683,8 +683,8 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   Solution sol;
   MeshSettings mesh_settings = settings.mesh;
   mesh_settings.progress = settings.progress;
-  // Under --time, remeshing ends at its share of the budget; the pieces not begun by then keep
-  // their imprinted triangles. Processes must all mesh alike, so several never cut it short.
+  // Under --time, imprinting and remeshing end at meshing's share of the budget; the pieces not
+  // begun by then are left as they were. Processes must all mesh alike, so several never cut it short.
   if (settings.time_limit > 0.0 && rc::processes().count() == 1)
     mesh_settings.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                          std::chrono::duration<double>(kMeshShare * settings.time_limit));

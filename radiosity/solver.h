@@ -33,8 +33,9 @@ const char* to_string(SolverKind kind);
 /// At and above this many elements `automatic` picks the hierarchical solver.
 inline constexpr size_t kHierarchicalElements = 20000;
 
-/// Share of --time after which remeshing stops (the pieces not yet remeshed keep their imprinted
-/// triangles): meshing is preparation, and the solve needs the rest.
+/// Share of --time after which imprinting and remeshing stop (pieces not yet imprinted keep their
+/// input triangles, pieces not yet remeshed their imprinted ones): meshing is preparation, and
+/// the solve needs the rest.
 inline constexpr double kMeshShare = 0.2;
 
 /// Solver parameters; the defaults are the documented defaults.
@@ -43,8 +44,8 @@ struct SolverSettings {
   HierarchicalSettings hierarchical;  ///< its tolerance and seed are taken from the fields below
   MeshSettings mesh;
   double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
-  double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); remeshing
-                             ///< stops after kMeshShare of it, refinement after 30 %, and no shot
+  double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); imprinting
+                             ///< and remeshing stop after kMeshShare of it, refinement after 30 %, and no shot
                              ///< starts that would end past it
   int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (a quarter in
                                 ///< each quarter of the source); pairs a 4-ray probe finds all open or all blocked take 4

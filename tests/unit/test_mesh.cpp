@@ -600,6 +600,45 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   EXPECT_EQ(shared, 0u) << "vertices on the line shared by the sunk box's elements above and below it";
 }
 
+// Under --time, meshing stops at its share of the budget: a deadline already past leaves every
+// piece as it came, the pieces with contacts unimprinted and none remeshed, and says so.
+TEST(Mesh, APassedDeadlineLeavesPiecesAsTheyCame) {
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+  TriangleMesh floor;
+  floor.name = "floor";
+  floor.positions = {Vec3(-2, -2, 0), Vec3(2, -2, 0), Vec3(2, 2, 0), Vec3(-2, 2, 0)};
+  floor.indices = {0, 1, 2, 0, 2, 3};
+  scene.meshes.push_back(floor);
+  scene.meshes.push_back(closed_box("standing", -0.9, -0.8, 0.45, 0.3, 0.5, 0.0f, 0.8f));
+  scene.meshes.push_back(closed_box("floating", 0.9, -1.1, 0.3, 0.3, 0.2, 0.05f, 0.5f));
+  scene.commit();
+  size_t input_triangles = 0;
+  for (const TriangleMesh& m : scene.meshes) input_triangles += m.indices.size() / 3;
+
+  MeshReport in_time, late;
+  build_mesh(scene, MeshSettings{.max_edge = 0.2f}, &in_time);
+  EXPECT_GT(in_time.contact_edges, 0u);
+  EXPECT_EQ(in_time.pieces_not_imprinted, 0u);
+  EXPECT_EQ(in_time.pieces_not_remeshed, 0u);
+
+  const RadiosityMesh mesh =
+      build_mesh(scene, MeshSettings{.max_edge = 0.2f, .deadline = std::chrono::steady_clock::now()}, &late);
+  // The floor and the standing box touch; the floating box touches nothing, so it has nothing
+  // to imprint. No piece is remeshed: the elements are the input's triangles, less those found
+  // buried (the standing box's bottom lies on the floor).
+  EXPECT_EQ(late.pieces_not_imprinted, 2u);
+  EXPECT_EQ(late.contact_edges, 0u);
+  EXPECT_EQ(late.pieces_not_remeshed, 3u);
+  EXPECT_EQ(mesh.element_count() + late.buried_faces + late.buried_elements, input_triangles);
+  const auto warned = [&](const std::string& what) {
+    return std::any_of(late.warnings.begin(), late.warnings.end(),
+                       [&](const std::string& w) { return w.find(what) != std::string::npos; });
+  };
+  EXPECT_TRUE(warned("no time to imprint"));
+  EXPECT_TRUE(warned("no time to remesh"));
+}
+
 // input_point_buried tests one point of a face that is only partly buried: the floor's two
 // triangles run under the standing and the sunk box, so neither is buried as a whole, but the
 // points under the boxes are, and those beside them and under the floating box are not.
