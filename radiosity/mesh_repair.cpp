@@ -27,7 +27,6 @@
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
-#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Surface_mesh.h>
 
@@ -167,6 +166,115 @@ struct Part {
   size_t self_intersecting = 0;  ///< pairs of its faces that intersect away from shared vertices and edges
 };
 
+/// Whether an edge of triangle `t` keeps the points `others`, which lie in its plane, strictly off
+/// `t`: all of them on the far side of the edge's line from `t`'s third corner, by far more than
+/// rounding (the cross products are taken in the plane of the two coordinates the normal leans
+/// on least). A cheap exit before CGAL's exact coplanar tests; false when unsure.
+bool apart_in_plane(const Kernel::Triangle_3& t, const std::array<Point, 3>& others) {
+  const Kernel::Vector_3 n = CGAL::cross_product(t[1] - t[0], t[2] - t[0]);
+  const int drop = std::abs(n.x()) >= std::abs(n.y()) ? (std::abs(n.x()) >= std::abs(n.z()) ? 0 : 2)
+                                                       : (std::abs(n.y()) >= std::abs(n.z()) ? 1 : 2);
+  const int u = drop == 0 ? 1 : 0, v = drop == 2 ? 1 : 2;
+  const auto cross = [&](const Point& a, const Point& b, const Point& p, double& scale) {
+    const double bx = b[u] - a[u], by = b[v] - a[v], px = p[u] - a[u], py = p[v] - a[v];
+    scale = (std::abs(bx) + std::abs(by)) * (std::abs(px) + std::abs(py));
+    return bx * py - by * px;
+  };
+  for (int e = 0; e < 3; ++e) {
+    const Point &a = t[e], &b = t[(e + 1) % 3], &c = t[(e + 2) % 3];
+    double scale = 0.0;
+    const double inside = cross(a, b, c, scale);
+    if (!(std::abs(inside) > 1e-9 * scale)) continue;
+    bool apart = true;
+    for (const Point& p : others) {
+      const double side = cross(a, b, p, scale);
+      if (!(side * inside < 0.0 && std::abs(side) > 1e-9 * scale)) {
+        apart = false;
+        break;
+      }
+    }
+    if (apart) return true;
+  }
+  return false;
+}
+
+/// The pairs of faces of `mesh` that intersect other than along the edge or at the vertex they
+/// share, as CGAL's PMP::self_intersections counts them (its do_faces_intersect, with a face
+/// whose corners are collinear counted once), but with cheap exits in front of its exact tests.
+/// On a furnished room most meeting boxes are of neighbours on one flat side of a piece, which
+/// CGAL settles with exact arithmetic on every call (the rotated box's quad halves are coplanar,
+/// so no filter can decide them); here two faces on an edge whose normals agree, or two faces on a
+/// vertex whose far corners lie strictly off the other's plane, are settled in floating point.
+size_t count_self_intersections(const SurfaceMesh& mesh) {
+  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, face_descriptor, CGAL::Box_intersection_d::ID_EXPLICIT>;
+  using HalfedgeIndex = SurfaceMesh::Halfedge_index;
+  size_t count = 0;
+  std::vector<Box> boxes;
+  boxes.reserve(mesh.number_of_faces());
+  for (face_descriptor f : mesh.faces()) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    const Point &p = mesh.point(mesh.target(h)), &q = mesh.point(mesh.target(mesh.next(h))),
+                &r = mesh.point(mesh.target(mesh.prev(h)));
+    if (CGAL::collinear(p, q, r))
+      ++count;
+    else
+      boxes.emplace_back(p.bbox() + q.bbox() + r.bbox(), f);
+  }
+  const auto corners = [&](face_descriptor f) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    return std::array<SurfaceMesh::Vertex_index, 3>{mesh.target(h), mesh.target(mesh.next(h)), mesh.source(h)};
+  };
+  const auto meet = [&](face_descriptor f, face_descriptor g) {
+    // A shared edge: they intersect only when folded onto each other (coplanar, the far corners
+    // on one side). Across a consistently wound edge, (p, q, r) and (q, p, s), a fold turns the
+    // normals opposite; normals that agree by far more than their rounding (a few ulps of the
+    // edges' products) rule it out.
+    for (auto h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+      if (mesh.face(mesh.opposite(h)) != g) continue;
+      const Point &p = mesh.point(mesh.source(h)), &q = mesh.point(mesh.target(h)),
+                  &r = mesh.point(mesh.target(mesh.next(h))),
+                  &s = mesh.point(mesh.target(mesh.next(mesh.opposite(h))));
+      const Kernel::Vector_3 pq = q - p, pr = r - p, ps = s - p;
+      const Kernel::Vector_3 n1 = CGAL::cross_product(pq, pr), n2 = CGAL::cross_product(ps, pq);
+      const double scale = pq.squared_length() * std::sqrt(pr.squared_length() * ps.squared_length());
+      if (n1 * n2 > 1e-9 * scale) return false;
+      return CGAL::coplanar(p, q, r, s) && CGAL::coplanar_orientation(p, q, r, s) == CGAL::POSITIVE;
+    }
+    const auto fv = corners(f), gv = corners(g);
+    const Kernel::Triangle_3 tf(mesh.point(fv[0]), mesh.point(fv[1]), mesh.point(fv[2])),
+        tg(mesh.point(gv[0]), mesh.point(gv[1]), mesh.point(gv[2]));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        if (fv[i] != gv[j]) continue;
+        // A shared vertex: they intersect when the edge opposite it in either crosses the other.
+        // An edge whose ends lie strictly on one side of the other's plane cannot.
+        // An edge whose ends lie strictly on one side of the other's plane cannot, nor one in
+        // that plane that an edge of the other face's keeps clear of it.
+        const auto clear = [](const Kernel::Triangle_3& t, const Point& a, const Point& b) {
+          const CGAL::Orientation oa = CGAL::orientation(t[0], t[1], t[2], a),
+                                  ob = CGAL::orientation(t[0], t[1], t[2], b);
+          if (oa != ob) return false;
+          return oa != CGAL::COPLANAR || apart_in_plane(t, std::array<Point, 3>{a, b, b});
+        };
+        const Point &f1 = mesh.point(fv[(i + 1) % 3]), &f2 = mesh.point(fv[(i + 2) % 3]),
+                    &g1 = mesh.point(gv[(j + 1) % 3]), &g2 = mesh.point(gv[(j + 2) % 3]);
+        if (!clear(tf, g1, g2) && CGAL::do_intersect(tf, Kernel::Segment_3(g1, g2))) return true;
+        return !clear(tg, f1, f2) && CGAL::do_intersect(tg, Kernel::Segment_3(f1, f2));
+      }
+    // No corner shared: faces strictly apart by a plane, or in one plane and apart in it.
+    std::array<CGAL::Orientation, 3> side;
+    for (int k = 0; k < 3; ++k) side[k] = CGAL::orientation(tf[0], tf[1], tf[2], tg[k]);
+    if (side[0] == side[1] && side[1] == side[2]) {
+      if (side[0] != CGAL::COPLANAR) return false;
+      if (apart_in_plane(tf, {tg[0], tg[1], tg[2]}) || apart_in_plane(tg, {tf[0], tf[1], tf[2]})) return false;
+    }
+    return CGAL::do_intersect(tf, tg);
+  };
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(),
+                                [&](const Box& a, const Box& b) { count += meet(a.info(), b.info()); });
+  return count;
+}
+
 /// Splits the mesh into its connected pieces. Pieces of one mesh that meet without sharing
 /// edges (a block standing on the floor, both in one OBJ material) are not a self-intersection
 /// but a contact, imprinted like a contact between meshes; only what intersects within a piece
@@ -206,9 +314,7 @@ std::vector<Part> split_parts(const SurfaceMesh& mesh) {
   }
   rc::parallel_for(parts.size(), [&](size_t i) {
     parts[i].box = PMP::bbox(parts[i].mesh);
-    std::vector<std::pair<face_descriptor, face_descriptor>> intersecting;
-    PMP::self_intersections(parts[i].mesh, std::back_inserter(intersecting));
-    parts[i].self_intersecting = intersecting.size();
+    parts[i].self_intersecting = count_self_intersections(parts[i].mesh);
   });
   return parts;
 }
@@ -617,24 +723,35 @@ void RepairedMeshes::Impl::find_contacts() {
     return s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[1]) &&
            s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[2]);
   };
-  // (receiving mesh, piece, tool mesh, piece, tool face), both ways round.
-  std::vector<std::array<uint32_t, 5>> pairs;
+  // Per receiving piece, its (tool mesh, piece, face) triples, both ways round; each piece's list
+  // is sorted on its own, in parallel, so no list of every pair is ever sorted.
+  std::vector<size_t> first_piece(parts.size() + 1, 0);
+  for (size_t m = 0; m < parts.size(); ++m) first_piece[m + 1] = first_piece[m] + parts[m].size();
+  std::vector<std::vector<std::array<uint32_t, 3>>> found(first_piece.back());
   CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& a, const Box& b) {
     const FaceRef x = refs[a.info()], y = refs[b.info()];
     if (x.mesh == y.mesh && (x.part == y.part || parts[x.mesh].size() > kMaxImprintedParts)) return;
     if (one_side(corners[a.info()], corners[b.info()]) || one_side(corners[b.info()], corners[a.info()])) return;
-    pairs.push_back({x.mesh, x.part, y.mesh, y.part, y.face});
-    pairs.push_back({y.mesh, y.part, x.mesh, x.part, x.face});
+    found[first_piece[x.mesh] + x.part].push_back({y.mesh, y.part, y.face});
+    found[first_piece[y.mesh] + y.part].push_back({x.mesh, x.part, x.face});
   });
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  boxes = {};
+  corners = {};
   contacts.assign(parts.size(), {});
   for (size_t m = 0; m < parts.size(); ++m) contacts[m].resize(parts[m].size());
-  for (const auto& [m, p, tm, tp, tf] : pairs) {
-    std::vector<ToolContact>& list = contacts[m][p];
-    if (list.empty() || list.back().mesh != tm || list.back().part != tp) list.push_back({tm, tp, {}});
-    list.back().faces.push_back(tf);
-  }
+  rc::parallel_for(found.size(), [&](size_t piece) {
+    const size_t m = static_cast<size_t>(std::upper_bound(first_piece.begin(), first_piece.end(), piece) -
+                                         first_piece.begin()) - 1;
+    std::vector<std::array<uint32_t, 3>>& tools = found[piece];
+    std::sort(tools.begin(), tools.end());
+    tools.erase(std::unique(tools.begin(), tools.end()), tools.end());
+    std::vector<ToolContact>& list = contacts[m][piece - first_piece[m]];
+    for (const auto& [tm, tp, tf] : tools) {
+      if (list.empty() || list.back().mesh != tm || list.back().part != tp) list.push_back({tm, tp, {}});
+      list.back().faces.push_back(tf);
+    }
+    tools = {};
+  });
 }
 
 RepairedMeshes::RepairedMeshes(size_t mesh_count) : impl_(std::make_unique<Impl>()) {
