@@ -600,6 +600,37 @@ TEST(Mesh, ContactLinesAreImprintedAndBuriedElementsRemoved) {
   EXPECT_EQ(shared, 0u) << "vertices on the line shared by the sunk box's elements above and below it";
 }
 
+// Pieces are remeshed patch by patch (the faces between sharp or contact edges) and welded back
+// at the patches' borders: a floating box's six sides come back as one closed surface, every
+// element edge shared by exactly two elements, with the box's area.
+TEST(Mesh, BoxRemeshedSideBySideStaysClosed) {
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+  scene.meshes.push_back(closed_box("box", 0.1, -0.2, 0.45, 0.3, 0.4, 0.05f, 0.8f));
+  scene.commit();
+  const RadiosityMesh mesh = build_mesh(scene, MeshSettings{.max_edge = 0.1f});
+  std::map<std::pair<PointKey, PointKey>, int> edges;
+  double area = 0.0;
+  for (size_t e = 0; e < mesh.element_count(); ++e) {
+    const auto& el = mesh.elements[e];
+    area += mesh.element_area[e];
+    for (int i = 0; i < 3; ++i) {
+      PointKey a = key_of(mesh.positions[el[i]]), b = key_of(mesh.positions[el[(i + 1) % 3]]);
+      if (b < a) std::swap(a, b);
+      ++edges[{a, b}];
+    }
+  }
+  size_t not_two = 0;
+  for (const auto& [edge, count] : edges) not_two += count != 2;
+  note("closed box", fmt("%.0f elements, %.0f edges, %.0f not shared by two", double(mesh.element_count()),
+                         double(edges.size()), double(not_two)));
+  EXPECT_GT(mesh.element_count(), 100u) << "the sides were remeshed to the 0.1 edge";
+  EXPECT_EQ(not_two, 0u);
+  // Sides 0.9 x 0.6 x 0.75; float corners of size ~1 round at ~1e-7 relative.
+  const double expected = 2.0 * (0.9 * 0.6 + 0.9 * 0.75 + 0.6 * 0.75);
+  EXPECT_NEAR(area, expected, 1e-5 * expected);
+}
+
 // Under --time, meshing stops at its share of the budget: a deadline already past leaves every
 // piece as it came, the pieces with contacts unimprinted and none remeshed, and says so.
 TEST(Mesh, APassedDeadlineLeavesPiecesAsTheyCame) {
