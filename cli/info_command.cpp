@@ -82,6 +82,20 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   const radiosity::SolvePlan rp = radiosity::plan_solve(scene, radiosity::SolverSettings{});
   rad.runs.push_back("mesh: about " + std::to_string(rp.elements) + " elements, " + std::to_string(rp.vertices) +
                      " vertices (edge " + short_number(rp.max_edge) + "), adaptive subdivision at steep direct light");
+  if (!rp.mesh_stage_seconds.empty()) {
+    const auto tenths = [](double seconds) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.1f", seconds);
+      return std::string(text);
+    };
+    double total = 0.0;
+    std::string stages;
+    for (const auto& [stage, seconds] : rp.mesh_stage_seconds) {
+      total += seconds;
+      stages += (stages.empty() ? "" : ", ") + stage + " " + tenths(seconds);
+    }
+    rad.runs.push_back("meshing took " + tenths(total) + " s on this machine (" + stages + ")");
+  }
   rad.runs.push_back(std::string("solver: ") + radiosity::to_string(rp.solver) + " (" + rp.solver_reason + ")");
   if (rp.contact_edges > 0)
     rad.runs.push_back("contact lines imprinted where surfaces touch (" + std::to_string(rp.contact_edges) + " edges)");

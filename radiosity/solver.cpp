@@ -659,6 +659,7 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.buried_elements = report.buried_elements;
   plan.buried_area = report.buried_area;
   plan.meshed_area = report.meshed_area;
+  plan.mesh_stage_seconds = report.stage_seconds;
   plan.occluder_boxes = occluder_boxes(scene, mesh).size();
   plan.convex_enclosure = plan.occluder_boxes == 0;
   plan.punctual_lights = scene.punctual_lights.size();

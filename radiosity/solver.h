@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <string>
@@ -148,6 +149,7 @@ struct SolvePlan {
   size_t specular_surfaces = 0;       ///< meshes and spheres left to ray tracing (mirror, glass)
   SolverKind solver = SolverKind::progressive;  ///< what `automatic` resolves to here
   std::string solver_reason;
+  std::vector<std::pair<std::string, double>> mesh_stage_seconds;  ///< see MeshReport::stage_seconds
 };
 SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings);
 

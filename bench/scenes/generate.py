@@ -723,7 +723,7 @@ def generate(index, seed, tri_range, folder_root, furnace=None):
         if abs(math.log(n / target)) < 0.08:
             break
         density *= (target / n) ** 0.5
-        density = min(max(density, 0.05), 40.0)
+        density = min(max(density, 0.05), 160.0)
     if furnace is not None:
         make_furnace(s, *furnace)
     for mat in s.meshes:
