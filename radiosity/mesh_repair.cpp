@@ -20,6 +20,7 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/box_intersection_d.h>
+#include <CGAL/intersections.h>
 #include <CGAL/Polygon_mesh_processing/bbox.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/detect_features.h>
@@ -848,6 +849,15 @@ void RepairedMeshes::Impl::find_contacts() {
     return s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[1]) &&
            s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[2]);
   };
+  // Whether the two closed triangles meet (exact), where each crosses the other's plane: a
+  // finely cut round table top's fan and its leg's strips cross each other's planes pairwise,
+  // nearly all far from the leg, and those pairs grow as the square of the tessellation (a
+  // million-triangle room kept 104 million of them, 2.5 GB, and imprinting re-tested each).
+  // A triangle with collinear corners is kept, as before: CGAL's test does not take it.
+  const auto meet = [](const std::array<Point, 3>& s, const std::array<Point, 3>& t) {
+    if (CGAL::collinear(s[0], s[1], s[2]) || CGAL::collinear(t[0], t[1], t[2])) return true;
+    return CGAL::do_intersect(Kernel::Triangle_3(s[0], s[1], s[2]), Kernel::Triangle_3(t[0], t[1], t[2]));
+  };
   // Per receiving piece, its (tool mesh, piece, face) triples, both ways round; each piece's list
   // is sorted on its own, in parallel, so no list of every pair is ever sorted.
   std::vector<size_t> first_piece(parts.size() + 1, 0);
@@ -857,6 +867,7 @@ void RepairedMeshes::Impl::find_contacts() {
     const FaceRef x = refs[a.info()], y = refs[b.info()];
     if (x.mesh == y.mesh && (x.part == y.part || parts[x.mesh].size() > kMaxImprintedParts)) return;
     if (one_side(corners[a.info()], corners[b.info()]) || one_side(corners[b.info()], corners[a.info()])) return;
+    if (!meet(corners[a.info()], corners[b.info()])) return;
     found[first_piece[x.mesh] + x.part].push_back({y.mesh, y.part, y.face});
     found[first_piece[y.mesh] + y.part].push_back({x.mesh, x.part, x.face});
   });
