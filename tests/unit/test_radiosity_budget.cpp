@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "radiosity/budget.h"
+#include "radiosity/mesh.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -71,7 +72,12 @@ TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
     EXPECT_EQ(sol.mesh.element_count(), fit.pilot_elements);
   } else {
     EXPECT_GT(fit.requested_elements, int(1.25 * double(fit.pilot_elements)) - 1);
-    EXPECT_NEAR(double(sol.mesh.element_count()), fit.requested_elements, 0.2 * fit.requested_elements);
+    // The final solve meshes at the request: its mesh is the one build_mesh makes for it. (How
+    // near a request the mesher lands depends on the count, as whole edges divide the walls: not
+    // this test's concern, and the request itself depends on this machine's speed.)
+    rad::SolverSettings asked = quiet();
+    asked.mesh.elements = fit.requested_elements;
+    EXPECT_EQ(sol.mesh.element_count(), rad::build_mesh(scene, asked.mesh).element_count());
   }
 }
 
