@@ -186,7 +186,7 @@ void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const Refere
 /// Radiosity against the path tracer in object space: at up to 64 element centroids (where the
 /// Gouraud value is the element's mean), outgoing radiance Le + ρE/π with E from 1,024
 /// cosine-distributed path-traced samples, mean |L_radiosity − L_path| / (L_path + 0.01).
-double object_space_error(const rc::Scene& scene, const radiosity::Solution& sol, uint64_t seed) {
+double object_space_error(const rc::Scene& scene, const radiosity::solver::Solution& sol, uint64_t seed) {
   const size_t ne = sol.mesh.element_count();
   if (ne == 0) return 0.0;
   const size_t stride = std::max<size_t>(1, ne / 64);

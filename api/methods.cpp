@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "radiosity/budget.h"
-#include "radiosity/view.h"
+#include "radiosity/solver/budget.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/path_tracer.h"
@@ -42,7 +42,7 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
   rc::RenderSettings settings = base;
   MethodResult result;
   rc::RadianceFunction radiance;
-  std::optional<radiosity::RadiosityView> view;
+  std::optional<radiosity::bake::RadiosityView> view;
   std::optional<photonmap::PhotonMapper> mapper;
   // What is left of a time budget after the preparation: at least one pass gets rendered.
   auto remaining = [&] { return std::max(1e-3, base.time_limit - elapsed()); };
@@ -82,14 +82,14 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
     radiance = [&mapper](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper->radiance(ray, ctx); };
     if (base.time_limit > 0.0) settings.time_limit = remaining();
   } else if (method == "radiosity") {
-    radiosity::SolverSettings solver = radiosity::solver_settings_for(options.radiosity_view, options.solver);
+    radiosity::solver::SolverSettings solver = radiosity::bake::solver_settings_for(options.radiosity_view, options.solver);
     solver.seed = settings.seed;
     solver.threads = settings.threads;
     solver.progress = settings.progress;
     // Under a budget the solve has 70 % of it, and a mesh left to gilt is sized to fit it.
-    radiosity::BudgetFit fit;
-    result.solution.emplace(base.time_limit > 0.0 ? radiosity::solve_within(scene, solver, 0.7 * base.time_limit, &fit)
-                                                  : radiosity::solve(scene, solver));
+    radiosity::solver::BudgetFit fit;
+    result.solution.emplace(base.time_limit > 0.0 ? radiosity::solver::solve_within(scene, solver, 0.7 * base.time_limit, &fit)
+                                                  : radiosity::solver::solve(scene, solver));
     result.notes = result.solution->mesh_report.warnings;
     if (!fit.note.empty()) result.notes.push_back(fit.note);
     view.emplace(scene, *result.solution, options.radiosity_view);

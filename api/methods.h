@@ -10,8 +10,8 @@
 
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/camera.h"
 #include "raytrace_core/film.h"
 #include "raytrace_core/render.h"
@@ -23,8 +23,8 @@ inline const std::vector<std::string> kMethods = {"path", "photon", "sppm", "rad
 
 /// Every method's own settings; `max_depth` 0 keeps each method's default.
 struct MethodOptions {
-  radiosity::SolverSettings solver;
-  radiosity::ViewMode radiosity_view = radiosity::ViewMode::two_pass;
+  radiosity::solver::SolverSettings solver;
+  radiosity::bake::ViewMode radiosity_view = radiosity::bake::ViewMode::two_pass;
   photonmap::PhotonMapperSettings photon;
   photonmap::SppmSettings sppm;
   int max_depth = 0;
@@ -49,7 +49,7 @@ struct PhotonOptions {
 struct MethodResult {
   raytrace_core::Film film;
   raytrace_core::RenderStats stats;  ///< seconds: the whole run, preparation included
-  std::optional<radiosity::Solution> solution;
+  std::optional<radiosity::solver::Solution> solution;
   std::optional<photonmap::PhotonMapperStats> photon;
   std::optional<photonmap::SppmStats> sppm;
   std::vector<std::string> notes;  ///< warnings and skipped passes

@@ -50,10 +50,10 @@ nlohmann::json run_statistics(const rc::Scene& scene, const std::string& method,
   return j;
 }
 
-nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosity::SolverSettings& settings) {
+nlohmann::json solution_statistics(const radiosity::solver::Solution& sol, const radiosity::solver::SolverSettings& settings) {
   const double secs = std::max(sol.seconds, 1e-9);
   nlohmann::json ladder = nlohmann::json::array();
-  for (const radiosity::LadderLevel& l : sol.ladder)
+  for (const radiosity::solver::LadderLevel& l : sol.ladder)
     ladder.push_back({{"link_tolerance", l.link_tolerance},
                       {"open_pairs", l.open_pairs},
                       {"links", l.links},
@@ -78,7 +78,7 @@ nlohmann::json solution_statistics(const radiosity::Solution& sol, const radiosi
           {"buried_elements", sol.mesh_report.buried_elements},
           {"buried_area", sol.mesh_report.buried_area},
           {"meshed_area", sol.mesh_report.meshed_area},
-          {"solver", radiosity::to_string(sol.solver)},
+          {"solver", radiosity::solver::to_string(sol.solver)},
           {"solver_reason", sol.solver_reason},
           {"patches", sol.patches},
           {"nodes", sol.nodes},

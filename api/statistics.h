@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/methods.h"
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/render.h"
 #include "raytrace_core/scene.h"
 
@@ -22,6 +22,6 @@ nlohmann::json run_statistics(const raytrace_core::Scene& scene, const std::stri
 /// A radiosity solve's statistics: the mesh (elements, vertices, what meshing repaired or
 /// removed), the solver and why it was chosen, its work (shots, links, form factors, shadow
 /// rays), the residual, and the seconds of each phase.
-nlohmann::json solution_statistics(const radiosity::Solution& solution, const radiosity::SolverSettings& settings);
+nlohmann::json solution_statistics(const radiosity::solver::Solution& solution, const radiosity::solver::SolverSettings& settings);
 
 }  // namespace gilt::api

@@ -44,10 +44,10 @@
 #include <utility>
 #include <vector>
 
-#include "radiosity/form_factor.h"
-#include "radiosity/mesh.h"
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
+#include "radiosity/solver/form_factor.h"
+#include "radiosity/mesh/mesh.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/io/image_error.h"
 #include "raytrace_core/io/image_io.h"
 #include "raytrace_core/parallel.h"
@@ -59,7 +59,7 @@
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
 namespace fs = std::filesystem;
-using rad::DVec3;
+using gilt::raytrace_core::DVec3;
 
 namespace {
 
@@ -180,7 +180,7 @@ Reference make_reference(const rc::Scene& scene, Pixels pixels, int half_spp, co
 }
 
 /// A radiosity render of a solution with the reference's camera, size and first seed.
-std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, const rad::RadiosityView& view, Pixels pixels,
+std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, const rad::bake::RadiosityView& view, Pixels pixels,
                                       int spp) {
   rc::RenderStats stats;
   const rc::Film film = rc::render_image(
@@ -212,17 +212,17 @@ double median(std::vector<double> values) {
 }
 
 /// Adaptive subdivision levels for every solve (--subdivision-levels=N; default: the solver's).
-int g_subdivision_levels = rad::SolverSettings{}.subdivision_levels;
-rad::SolverKind g_solver = rad::SolverKind::automatic;
+int g_subdivision_levels = rad::solver::SolverSettings{}.subdivision_levels;
+rad::solver::SolverKind g_solver = rad::solver::SolverKind::automatic;
 
 /// How the sweep shows each solution (--view=mesh|two-pass). The mesh view is exact at a pixel
 /// centre with one sample; the two-pass view takes the direct light per sample by shadow rays, so
 /// its centre render needs g_view_spp samples (--view-spp=N) and their time is counted.
-rad::ViewMode g_view = rad::ViewMode::mesh;
+rad::bake::ViewMode g_view = rad::bake::ViewMode::mesh;
 int g_view_spp = 16;
 
-rad::SolverSettings solver_settings(int elements) {
-  rad::SolverSettings s;
+rad::solver::SolverSettings solver_settings(int elements) {
+  rad::solver::SolverSettings s;
   s.subdivision_levels = g_subdivision_levels;
   s.solver = g_solver;
   s.mesh.elements = elements;
@@ -308,7 +308,7 @@ void report_time_to_target(const std::vector<SweepPoint>& points, Measure m, dou
 
 void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
   const rc::Scene scene = rc::load_scene("cornell");
-  const bool two_pass = g_view == rad::ViewMode::two_pass;
+  const bool two_pass = g_view == rad::bake::ViewMode::two_pass;
   std::printf("\n== Error against time on cornell, %d x %d: solver tolerance %g, %s view ==\n", kImageSize,
               kImageSize, kTolerance, two_pass ? "two-pass" : "mesh");
   const Reference refs[2] = {make_reference(scene, Pixels::filtered, half_spp, out_dir, fresh_reference),
@@ -316,8 +316,8 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
 
   // Untimed warm-up (thread pool, Embree), and the noise of a 16-spp display: the same solution
   // at 16 and at 1024 filtered spp differs only by where the pixel filter was sampled.
-  const rad::Solution warm = rad::solve(scene, solver_settings(1000));
-  const rad::RadiosityView warm_view(scene, warm, rad::ViewMode::mesh);
+  const rad::solver::Solution warm = rad::solver::solve(scene, solver_settings(1000));
+  const rad::bake::RadiosityView warm_view(scene, warm, rad::bake::ViewMode::mesh);
   const double display_noise =
       rc::mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
                           radiosity_render(scene, warm_view, Pixels::filtered, kDisplaySpp));
@@ -362,13 +362,13 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
     // The solve and render are deterministic, so the repeats give the same solution and image;
     // only their times differ, and the median of each is reported.
     std::vector<double> solve_times, render_times;
-    std::optional<rad::Solution> sol;
-    std::optional<rad::RadiosityView> view;
+    std::optional<rad::solver::Solution> sol;
+    std::optional<rad::bake::RadiosityView> view;
     std::vector<rc::Rgb> image, centres;
     for (int r = 0; r < g_repeats; ++r) {
       view.reset();
       const auto start = std::chrono::steady_clock::now();
-      sol = rad::solve(scene, rad::solver_settings_for(g_view, solver_settings(requested)));
+      sol = rad::solver::solve(scene, rad::bake::solver_settings_for(g_view, solver_settings(requested)));
       solve_times.push_back(seconds_since(start));
       const auto render_start = std::chrono::steady_clock::now();
       view.emplace(scene, *sol, g_view);
@@ -476,9 +476,9 @@ std::vector<Configuration> random_configurations() {
 /// as the solver meets them.
 std::vector<Configuration> cornell_configurations() {
   const rc::Scene scene = rc::load_scene("cornell");
-  rad::MeshSettings settings;
+  rad::mesh::MeshSettings settings;
   settings.elements = 1000;
-  const rad::RadiosityMesh mesh = rad::build_mesh(scene, settings);
+  const rad::mesh::RadiosityMesh mesh = rad::mesh::build_mesh(scene, settings);
   std::vector<Configuration> configs;
   configs.reserve(kConfigurations);
   for (size_t i = 0; configs.size() < kConfigurations; ++i) {
@@ -498,7 +498,7 @@ size_t check_configurations(const char* name, const std::vector<Configuration>& 
   size_t zero = 0;
   for (size_t i = 0; i < configs.size(); ++i) {
     const Configuration& c = configs[i];
-    const double f = rad::point_to_triangle_form_factor(c.p, c.n, c.a, c.b, c.c);
+    const double f = rad::solver::point_to_triangle_form_factor(c.p, c.n, c.a, c.b, c.c);
     if (!std::isfinite(f) || f < 0.0 || f > 1.0)
       fail(std::string(name) + " configuration " + std::to_string(i) + ": form factor " + std::to_string(f));
     zero += f == 0.0;
@@ -512,7 +512,7 @@ void check_howell() {
   const DVec3 p(0.0), n(0.0, 0.0, 1.0);
   const DVec3 a(0, 0, 1), b(0, 1, 1), c(1, 1, 1), d(1, 0, 1);  // counter-clockwise seen from below
   const double f =
-      rad::point_to_triangle_form_factor(p, n, a, b, c) + rad::point_to_triangle_form_factor(p, n, a, c, d);
+      rad::solver::point_to_triangle_form_factor(p, n, a, b, c) + rad::solver::point_to_triangle_form_factor(p, n, a, c, d);
   if (!(std::abs(f - 0.138532) <= 1e-6))
     fail("Howell's corner case gives " + std::to_string(f) + ", not 0.138532");
 }
@@ -520,7 +520,7 @@ void check_howell() {
 void BM_FormFactor(benchmark::State& state, const std::vector<Configuration>& configs) {
   for (auto _ : state)
     for (const Configuration& c : configs) {
-      double f = rad::point_to_triangle_form_factor(c.p, c.n, c.a, c.b, c.c);
+      double f = rad::solver::point_to_triangle_form_factor(c.p, c.n, c.a, c.b, c.c);
       benchmark::DoNotOptimize(f);
     }
   // Shown as "form_factors=…M/s".
@@ -574,18 +574,18 @@ void run_scaling(const fs::path& out_dir) {
   std::vector<Limited> limited_runs;
   double shots_per_element = 0.0;  // of the largest run that converged
   for (int requested : kScalingElements) {
-    rad::SolverSettings settings = solver_settings(requested);
-    settings.solver = rad::SolverKind::progressive;  // this part measures shooting
+    rad::solver::SolverSettings settings = solver_settings(requested);
+    settings.solver = rad::solver::SolverKind::progressive;  // this part measures shooting
     // The element count is the variable here: no adaptive subdivision, which would add elements.
     settings.subdivision_levels = 0;
     // solve() meshes too, and its time limit counts from its start: meshing is timed on its own
     // first, and the limit leaves about the same time to shoot at every size.
     const auto mesh_start = std::chrono::steady_clock::now();
-    const rad::RadiosityMesh mesh = rad::build_mesh(scene, settings.mesh);
+    const rad::mesh::RadiosityMesh mesh = rad::mesh::build_mesh(scene, settings.mesh);
     const double mesh_seconds = seconds_since(mesh_start);
     settings.time_limit = mesh_seconds + kShootingBudget;
     const auto solve_start = std::chrono::steady_clock::now();
-    const rad::Solution sol = rad::solve(scene, settings);
+    const rad::solver::Solution sol = rad::solver::solve(scene, settings);
     const double shooting = std::max(1e-9, seconds_since(solve_start) - mesh_seconds);
     if (sol.mesh.element_count() != mesh.element_count() || sol.mesh.vertex_count() != mesh.vertex_count())
       fail("build_mesh and solve meshed " + std::to_string(requested) + " elements differently");
@@ -648,11 +648,11 @@ void run_hierarchical(const fs::path& out_dir, int largest) {
   double last_elements = 0.0, last_seconds = 0.0;
   for (int requested : kHierarchicalElements) {
     if (requested > largest) break;
-    rad::SolverSettings settings = solver_settings(requested);
-    settings.solver = rad::SolverKind::hierarchical;
+    rad::solver::SolverSettings settings = solver_settings(requested);
+    settings.solver = rad::solver::SolverKind::hierarchical;
     settings.subdivision_levels = 0;
     const auto start = std::chrono::steady_clock::now();
-    const rad::Solution sol = rad::solve(scene, settings);
+    const rad::solver::Solution sol = rad::solver::solve(scene, settings);
     const double seconds = seconds_since(start);
     for (const rc::Rgb& b : sol.vertex_radiosity)
       if (!(b.r >= 0.0f && b.g >= 0.0f && b.b >= 0.0f && std::isfinite(b.r + b.g + b.b)))
@@ -704,13 +704,13 @@ int main(int argc, char** argv) {
     else if (arg.starts_with("--largest="))
       largest = std::max(1, std::atoi(argv[i] + 10));
     else if (arg == "--solver=progressive")
-      g_solver = rad::SolverKind::progressive;
+      g_solver = rad::solver::SolverKind::progressive;
     else if (arg == "--solver=hierarchical")
-      g_solver = rad::SolverKind::hierarchical;
+      g_solver = rad::solver::SolverKind::hierarchical;
     else if (arg == "--view=two-pass")
-      g_view = rad::ViewMode::two_pass;
+      g_view = rad::bake::ViewMode::two_pass;
     else if (arg == "--view=mesh")
-      g_view = rad::ViewMode::mesh;
+      g_view = rad::bake::ViewMode::mesh;
     else if (arg.starts_with("--view-spp="))
       g_view_spp = std::max(1, std::atoi(argv[i] + 11));
     else if (arg.starts_with("--subdivision-levels="))

@@ -10,7 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {
@@ -29,7 +29,7 @@ std::function<void()> add_info_command(CLI::App& app);
 
 /// Registers the radiosity meshing and solver options (--max-edge, --elements, --tolerance) on
 /// a subcommand; both `render --method radiosity` and `radiosity` use them.
-void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& settings);
+void add_solver_options(CLI::App& cmd, radiosity::solver::SolverSettings& settings);
 
 /// Registers --env, --env-scale and --env-rotate (light given on the command line) on a subcommand.
 void add_lighting_options(CLI::App& cmd, raytrace_core::ExtraLighting& lighting);

@@ -12,7 +12,7 @@
 
 #include "cli/commands.h"
 #include "photonmap/photon_map.h"
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {
@@ -79,7 +79,7 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   plans.push_back({"whitted", {"camera rays, shadow rays to point-sampled lights, mirror and glass recursion"}, {}});
 
   MethodPlan rad{"radiosity", {}, {}};
-  const radiosity::SolvePlan rp = radiosity::plan_solve(scene, radiosity::SolverSettings{});
+  const radiosity::solver::SolvePlan rp = radiosity::solver::plan_solve(scene, radiosity::solver::SolverSettings{});
   rad.runs.push_back("mesh: about " + std::to_string(rp.elements) + " elements, " + std::to_string(rp.vertices) +
                      " vertices (edge " + short_number(rp.max_edge) + "), adaptive subdivision at steep direct light");
   if (!rp.mesh_stage_seconds.empty()) {
@@ -96,7 +96,7 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
     }
     rad.runs.push_back("meshing took " + tenths(total) + " s on this machine (" + stages + ")");
   }
-  rad.runs.push_back(std::string("solver: ") + radiosity::to_string(rp.solver) + " (" + rp.solver_reason + ")");
+  rad.runs.push_back(std::string("solver: ") + radiosity::solver::to_string(rp.solver) + " (" + rp.solver_reason + ")");
   if (rp.contact_edges > 0)
     rad.runs.push_back("contact lines imprinted where surfaces touch (" + std::to_string(rp.contact_edges) + " edges)");
   if (rp.buried_faces > 0 || rp.buried_elements > 0)

@@ -10,12 +10,12 @@
 
 #include "api/statistics.h"
 #include "cli/commands.h"
-#include "radiosity/budget.h"
-#include "radiosity/check.h"
-#include "radiosity/export.h"
-#include "radiosity/lightmap.h"
-#include "radiosity/onto_input.h"
-#include "radiosity/solver.h"
+#include "radiosity/solver/budget.h"
+#include "radiosity/bake/check.h"
+#include "radiosity/bake/export.h"
+#include "radiosity/bake/lightmap.h"
+#include "radiosity/bake/onto_input.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/processes.h"
@@ -30,8 +30,8 @@ constexpr double kBakeGatherShare = 0.4;
 
 struct RadiosityOptions {
   std::string scene, output, quantity = "radiance", onto = "elements", fit = "least-squares", check_points_file;
-  radiosity::SolverSettings solver;
-  radiosity::CheckSettings check;
+  radiosity::solver::SolverSettings solver;
+  radiosity::bake::CheckSettings check;
   rc::ExtraLighting lighting;
   int check_points = 0;  ///< 0: no check
   int lightmap = 0;      ///< 0: no lightmap
@@ -52,8 +52,8 @@ void check_mesh_output(const std::string& path) {
 
 void run_radiosity(RadiosityOptions& o) {
   check_mesh_output(o.output);
-  radiosity::ExportSettings ex;
-  ex.quantity = radiosity::parse_quantity(o.quantity);
+  radiosity::bake::ExportSettings ex;
+  ex.quantity = radiosity::bake::parse_quantity(o.quantity);
   ex.srgb8 = o.srgb8;
   ex.exposure = o.exposure;
   const bool lightmap = o.lightmap > 0;
@@ -80,12 +80,12 @@ void run_radiosity(RadiosityOptions& o) {
   const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (lightmap) {
-    radiosity::check_lightmap_output(o.output, scene);
-    radiosity::check_lightmap_layout(scene, o.lightmap);  // before the solve, not after it
+    radiosity::bake::check_lightmap_output(o.output, scene);
+    radiosity::bake::check_lightmap_layout(scene, o.lightmap);  // before the solve, not after it
   } else if (onto_input)
-    radiosity::check_onto_output(o.output, scene);
+    radiosity::bake::check_onto_output(o.output, scene);
   o.solver.progress = !o.quiet && !o.json;
-  radiosity::BakeGather gather{o.bake_gather, o.solver.seed};
+  radiosity::bake::BakeGather gather{o.bake_gather, o.solver.seed};
   // --time covers the whole command: loading has used some of it. A final gather of the bake
   // takes what the solve leaves of kBakeGatherShare of it; points it cannot reach in time read
   // the solution.
@@ -95,42 +95,42 @@ void run_radiosity(RadiosityOptions& o) {
                                   std::chrono::duration<double>(o.solver.time_limit));
     o.solver.time_limit = std::max(1e-3, o.bake_gather > 0 ? (1.0 - kBakeGatherShare) * left : left);
   }
-  // Under a budget a mesh left to gilt is sized to fit it (radiosity/budget.h).
-  radiosity::BudgetFit budget_fit;
-  const radiosity::Solution sol = o.solver.time_limit > 0.0
-                                      ? radiosity::solve_within(scene, o.solver, o.solver.time_limit, &budget_fit)
-                                      : radiosity::solve(scene, o.solver);
+  // Under a budget a mesh left to gilt is sized to fit it (radiosity/solver/budget.h).
+  radiosity::solver::BudgetFit budget_fit;
+  const radiosity::solver::Solution sol = o.solver.time_limit > 0.0
+                                      ? radiosity::solver::solve_within(scene, o.solver, o.solver.time_limit, &budget_fit)
+                                      : radiosity::solver::solve(scene, o.solver);
   // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
   if (rc::processes().rank() > 0) return;
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (!budget_fit.note.empty() && !o.json) std::cerr << "gilt: " << budget_fit.note << "\n";
-  const radiosity::VertexFit fit =
-      o.fit == "point" ? radiosity::VertexFit::point : radiosity::VertexFit::least_squares;
-  std::optional<radiosity::InputColours> onto;
-  radiosity::SnapStats snap;
-  std::optional<radiosity::Lightmap> atlas;
+  const radiosity::bake::VertexFit fit =
+      o.fit == "point" ? radiosity::bake::VertexFit::point : radiosity::bake::VertexFit::least_squares;
+  std::optional<radiosity::bake::InputColours> onto;
+  radiosity::bake::SnapStats snap;
+  std::optional<radiosity::bake::Lightmap> atlas;
   // --onto elements --bake-gather N: the vertices' light traced from the input under them.
-  std::optional<radiosity::Solution> vertex_gather;
-  radiosity::BakeGatherCount vertex_gather_count;
+  std::optional<radiosity::solver::Solution> vertex_gather;
+  radiosity::bake::BakeGatherCount vertex_gather_count;
   double vertex_gather_seconds = 0.0;
-  const auto exported = [&]() -> const radiosity::Solution& { return vertex_gather ? *vertex_gather : sol; };
+  const auto exported = [&]() -> const radiosity::solver::Solution& { return vertex_gather ? *vertex_gather : sol; };
   if (lightmap) {
-    atlas = radiosity::bake_lightmap(scene, sol, ex.quantity, o.lightmap, gather);
-    radiosity::write_lightmap(o.output, scene, *atlas, ex);
+    atlas = radiosity::bake::bake_lightmap(scene, sol, ex.quantity, o.lightmap, gather);
+    radiosity::bake::write_lightmap(o.output, scene, *atlas, ex);
   } else if (onto_input) {
-    onto = radiosity::fit_input_colours(scene, sol, fit, ex.quantity, gather);
-    radiosity::write_onto_input(o.output, scene, *onto, ex);
+    onto = radiosity::bake::fit_input_colours(scene, sol, fit, ex.quantity, gather);
+    radiosity::bake::write_onto_input(o.output, scene, *onto, ex);
   } else {
     if (o.bake_gather > 0) {
       const auto gather_start = std::chrono::steady_clock::now();
-      vertex_gather.emplace(radiosity::gather_at_vertices(scene, sol, gather, &vertex_gather_count));
+      vertex_gather.emplace(radiosity::bake::gather_at_vertices(scene, sol, gather, &vertex_gather_count));
       vertex_gather_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - gather_start).count();
     }
-    radiosity::write_solution(o.output, scene, exported(), ex, &snap);
+    radiosity::bake::write_solution(o.output, scene, exported(), ex, &snap);
   }
-  std::optional<radiosity::CheckResult> check;
-  std::optional<radiosity::SurfaceCheckResult> surface_check;
-  std::optional<radiosity::SurfaceCheckResult> element_surface_check;  ///< --onto elements, beside `check`
+  std::optional<radiosity::bake::CheckResult> check;
+  std::optional<radiosity::bake::SurfaceCheckResult> surface_check;
+  std::optional<radiosity::bake::SurfaceCheckResult> element_surface_check;  ///< --onto elements, beside `check`
   if (o.check_points > 0) {
     o.check.points = o.check_points;
     o.check.seed = o.solver.seed;
@@ -138,29 +138,29 @@ void run_radiosity(RadiosityOptions& o) {
     // The check's own irradiance bake gathers every point, past any deadline.
     gather.deadline = std::chrono::steady_clock::time_point::max();
     if (lightmap) {
-      const radiosity::Lightmap e = ex.quantity == radiosity::Quantity::irradiance
+      const radiosity::bake::Lightmap e = ex.quantity == radiosity::bake::Quantity::irradiance
                                         ? *atlas
-                                        : radiosity::bake_lightmap(scene, sol, radiosity::Quantity::irradiance, o.lightmap, gather);
-      surface_check = radiosity::check_lightmap(scene, e, o.check);
+                                        : radiosity::bake::bake_lightmap(scene, sol, radiosity::bake::Quantity::irradiance, o.lightmap, gather);
+      surface_check = radiosity::bake::check_lightmap(scene, e, o.check);
     } else if (onto_input) {
       // The colours as irradiance, at random points inside the input's faces.
-      const radiosity::InputColours e =
-          ex.quantity == radiosity::Quantity::irradiance
+      const radiosity::bake::InputColours e =
+          ex.quantity == radiosity::bake::Quantity::irradiance
               ? *onto
-              : radiosity::fit_input_colours(scene, sol, fit, radiosity::Quantity::irradiance, gather);
-      surface_check = radiosity::check_input_colours(scene, e, o.check);
+              : radiosity::bake::fit_input_colours(scene, sol, fit, radiosity::bake::Quantity::irradiance, gather);
+      surface_check = radiosity::bake::check_input_colours(scene, e, o.check);
     } else {
-      check = radiosity::check_against_path_tracer(scene, exported(), o.check);
+      check = radiosity::bake::check_against_path_tracer(scene, exported(), o.check);
       // And at random points inside the input's faces, read from the elements as written: the
       // mesh write_solution exports (snapped, coincident faces dropped), in irradiance.
-      const radiosity::Solution& e = exported();
-      const radiosity::RadiosityMesh written = radiosity::without_coincident(
-          radiosity::snapped_to_input(scene, e.mesh, 0.5f * e.mesh_report.max_edge));
-      element_surface_check = radiosity::check_element_colours(scene, written, e.vertex_irradiance, o.check);
+      const radiosity::solver::Solution& e = exported();
+      const radiosity::mesh::RadiosityMesh written = radiosity::bake::without_coincident(
+          radiosity::bake::snapped_to_input(scene, e.mesh, 0.5f * e.mesh_report.max_edge));
+      element_surface_check = radiosity::bake::check_element_colours(scene, written, e.vertex_irradiance, o.check);
     }
     if (surface_check && !o.check_points_file.empty())
-      radiosity::write_check_points(o.check_points_file, scene, *surface_check);
-    if (check && !o.check_points_file.empty()) radiosity::write_check_points(o.check_points_file, *check);
+      radiosity::bake::write_check_points(o.check_points_file, scene, *surface_check);
+    if (check && !o.check_points_file.empty()) radiosity::bake::write_check_points(o.check_points_file, *check);
   }
 
   const double secs = std::max(sol.seconds, 1e-9);
@@ -195,7 +195,7 @@ void run_radiosity(RadiosityOptions& o) {
                             {"seconds", vertex_gather_seconds}};
     if (atlas)
       j["lightmap"] = {{"size", atlas->size},
-                       {"image", radiosity::lightmap_image_path(o.output)},
+                       {"image", radiosity::bake::lightmap_image_path(o.output)},
                        {"uvs", atlas->stats.uv_source},
                        {"uv_set", atlas->stats.uv_set},
                        {"charts", atlas->stats.charts},
@@ -255,7 +255,7 @@ void run_radiosity(RadiosityOptions& o) {
                 sol.mesh_report.buried_faces, sol.mesh_report.buried_elements);
   char chebyshev[48] = "";
   if (sol.chebyshev_beta > 0.0) std::snprintf(chebyshev, sizeof chebyshev, " (Chebyshev, beta %.3g)", sol.chebyshev_beta);
-  if (sol.solver == radiosity::SolverKind::hierarchical)
+  if (sol.solver == radiosity::solver::SolverKind::hierarchical)
     std::printf("  solve:   hierarchical (%s): %zu nodes, %zu links at tolerance %.3g%s, %d iterations%s, residual %.3g "
                 "(tolerance %.3g%s), final gather %s (%.3g nodes per vertex)\n",
                 sol.solver_reason.c_str(), sol.nodes, sol.links, sol.link_tolerance,
@@ -268,7 +268,7 @@ void run_radiosity(RadiosityOptions& o) {
                 static_cast<unsigned long long>(sol.shots), sol.residual, o.solver.tolerance);
   // A timed solve's ladder, level by level, when it had more than one.
   if (sol.ladder.size() > 1 || (sol.ladder.size() == 1 && sol.linking_stopped))
-    for (const radiosity::LadderLevel& l : sol.ladder)
+    for (const radiosity::solver::LadderLevel& l : sol.ladder)
       std::printf("  ladder:  tolerance %.3g: %zu links (%zu of %zu open pairs split) in %.3g s; %d iterations%s to "
                   "residual %.3g in %.3g s\n",
                   l.link_tolerance, l.links, l.splits, l.open_pairs, l.link_seconds, l.iterations + l.finishing_iterations,
@@ -278,7 +278,7 @@ void run_radiosity(RadiosityOptions& o) {
               static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
               static_cast<unsigned long long>(sol.shadow_rays),
               sol.convex_enclosure ? " (convex enclosure: visibility rays skipped)" : "");
-  if (sol.solver == radiosity::SolverKind::hierarchical)
+  if (sol.solver == radiosity::solver::SolverKind::hierarchical)
     std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, links %.3g, iterations %.3g, final gather %.3g)\n",
                 sol.seconds, sol.mesh_seconds, sol.direct_seconds, sol.link_seconds, sol.iterate_seconds,
                 sol.gather_seconds);
@@ -306,7 +306,7 @@ void run_radiosity(RadiosityOptions& o) {
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
                 100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
   if (element_surface_check) {
-    const radiosity::SurfaceCheckResult& e = *element_surface_check;
+    const radiosity::bake::SurfaceCheckResult& e = *element_surface_check;
     if (e.points + e.unlit + e.uncovered == 0)
       std::printf("  check:   nothing compared at points inside the input's faces: none could be drawn and "
                   "seen (spheres, mirrors and glass are not drawn from; points with something lying on them are "
@@ -337,7 +337,7 @@ void run_radiosity(RadiosityOptions& o) {
                 atlas->size, atlas->size, atlas->stats.faces, atlas->stats.buried_faces, atlas->stats.texels,
                 100.0 * double(atlas->stats.texels) / (double(atlas->size) * atlas->size),
                 atlas->stats.layout_seconds, atlas->stats.bake_seconds, atlas->stats.uv_source.c_str());
-  const auto print_gather = [&](const radiosity::BakeGatherCount& g) {
+  const auto print_gather = [&](const radiosity::bake::BakeGatherCount& g) {
     if (o.bake_gather == 0) return;
     std::printf("  gather:  %d shadow and gather rays at each of %llu points", o.bake_gather,
                 static_cast<unsigned long long>(g.gathered));
@@ -348,7 +348,7 @@ void run_radiosity(RadiosityOptions& o) {
   if (onto) print_gather(onto->gather);
   if (atlas && atlas->stats.uv_set < 0)
     std::printf(", %zu charts at %.4g texels per unit", atlas->stats.charts, atlas->stats.texels_per_metre);
-  if (atlas) std::printf("\n            wrote %s\n", radiosity::lightmap_image_path(o.output).c_str());
+  if (atlas) std::printf("\n            wrote %s\n", radiosity::bake::lightmap_image_path(o.output).c_str());
   if (atlas) print_gather(atlas->stats.gather);
   if (surface_check && surface_check->points == 0 && surface_check->unlit == 0)
     std::printf(kNothingChecked, "sampled point");
@@ -365,12 +365,12 @@ void run_radiosity(RadiosityOptions& o) {
 
 }  // namespace
 
-void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
+void add_solver_options(CLI::App& cmd, radiosity::solver::SolverSettings& s) {
   auto* edge = cmd.add_option("--max-edge", s.mesh.max_edge, "Radiosity: target element edge length (scene units)")
                    ->check(CLI::PositiveNumber)
                    ->check(finite_number());
   cmd.add_option("--elements", s.mesh.elements, "Radiosity: approximate element count (default " +
-                                                    std::to_string(radiosity::kDefaultElements) + ")")
+                                                    std::to_string(radiosity::mesh::kDefaultElements) + ")")
       ->check(CLI::Range(1, 50000000))
       ->excludes(edge);
   cmd.add_option("--tolerance", s.tolerance, "Radiosity: stop when unshot power < T x emitted power (default 1e-3)")
@@ -386,12 +386,12 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
   cmd.add_option_function<std::string>(
          "--solver",
          [&s](const std::string& name) {
-           s.solver = name == "progressive"    ? radiosity::SolverKind::progressive
-                      : name == "hierarchical" ? radiosity::SolverKind::hierarchical
-                                               : radiosity::SolverKind::automatic;
+           s.solver = name == "progressive"    ? radiosity::solver::SolverKind::progressive
+                      : name == "hierarchical" ? radiosity::solver::SolverKind::hierarchical
+                                               : radiosity::solver::SolverKind::automatic;
          },
          "Radiosity: progressive, hierarchical, or auto (hierarchical from " +
-             std::to_string(radiosity::kHierarchicalElements) + " elements; default)")
+             std::to_string(radiosity::solver::kHierarchicalElements) + " elements; default)")
       ->check(CLI::IsMember({"auto", "progressive", "hierarchical"}));
   cmd.add_option("--link-tolerance", s.hierarchical.link_tolerance,
                  "Hierarchical radiosity: accept a link when the power it may carry wrongly is below this fraction "
@@ -401,9 +401,9 @@ void add_solver_options(CLI::App& cmd, radiosity::SolverSettings& s) {
   cmd.add_option_function<std::string>(
          "--final-gather",
          [&s](const std::string& name) {
-           s.hierarchical.final_gather = name == "on"    ? radiosity::FinalGather::always
-                                         : name == "off" ? radiosity::FinalGather::never
-                                                         : radiosity::FinalGather::automatic;
+           s.hierarchical.final_gather = name == "on"    ? radiosity::solver::FinalGather::always
+                                         : name == "off" ? radiosity::solver::FinalGather::never
+                                                         : radiosity::solver::FinalGather::automatic;
          },
          "Hierarchical radiosity: gather at every vertex from the hierarchy at the end: on, off, or auto (default: "
          "when a probe at every 61st vertex or more predicts at most 4x the links' shadow rays, and under --time when "

@@ -14,8 +14,8 @@
 #include "cli/commands.h"
 #include "api/methods.h"
 #include "api/statistics.h"
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/image_io.h"
 #include "raytrace_core/parallel.h"
@@ -51,8 +51,8 @@ struct RenderOptions {
   int max_depth = 0;
   bool json = false;
   bool quiet = false;
-  radiosity::SolverSettings solver;
-  radiosity::ViewMode radiosity_view = radiosity::ViewMode::two_pass;
+  radiosity::solver::SolverSettings solver;
+  radiosity::bake::ViewMode radiosity_view = radiosity::bake::ViewMode::two_pass;
   api::PhotonOptions photon;  ///< photon mapping (photon, sppm)
 };
 
@@ -120,7 +120,7 @@ void run_render(const RenderOptions& o) {
   const MethodResult result = api::run_method(scene, camera, o.method, settings, mo);
   const rc::Film& film = result.film;
   const rc::RenderStats& stats = result.stats;
-  const std::optional<radiosity::Solution>& solution = result.solution;
+  const std::optional<radiosity::solver::Solution>& solution = result.solution;
   const std::optional<photonmap::PhotonMapperStats>& photon = result.photon;
   const std::optional<photonmap::SppmStats>& sppm_stats = result.sppm;
   for (const std::string& n : result.notes)
@@ -195,7 +195,7 @@ std::function<void()> add_render_command(CLI::App& app) {
   cmd->add_option_function<std::string>(
          "--radiosity-view",
          [o](const std::string& name) {
-           o->radiosity_view = name == "mesh" ? radiosity::ViewMode::mesh : radiosity::ViewMode::two_pass;
+           o->radiosity_view = name == "mesh" ? radiosity::bake::ViewMode::mesh : radiosity::bake::ViewMode::two_pass;
          },
          "Radiosity: two-pass (the input's surfaces, direct light per pixel, reflected light from the solution; "
          "default) or mesh (the elements' radiance, as exported)")

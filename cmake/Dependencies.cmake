@@ -28,7 +28,7 @@ add_library(OpenImageIO::OpenImageIO ALIAS PkgConfig::OIIO)
 # OpenMesh: CGAL ships a FindOpenMesh.cmake that fails on Debian; ask for the package's own config.
 find_package(OpenMesh CONFIG REQUIRED)
 find_package(CGAL CONFIG REQUIRED)
-# Eigen: sparse conjugate gradients for the least-squares vertex fit (radiosity/vertex_fit.cpp).
+# Eigen: sparse conjugate gradients for the least-squares vertex fit (radiosity/bake/vertex_fit.cpp).
 find_package(Eigen3 3.3 CONFIG REQUIRED NO_MODULE)
 
 # FLANN's kd-tree is header-only. Its CMake target would link a static library into every binary,

@@ -8,8 +8,8 @@
 #include <map>
 #include <string>
 
-#include "radiosity/export.h"
-#include "radiosity/solver.h"
+#include "radiosity/bake/export.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {
@@ -19,10 +19,10 @@ int main(int argc, char** argv) {
   const std::string output = argc > 2 ? argv[2] : "cornell_baked.ply";
   try {
     const rc::Scene scene = rc::load_scene(scene_name);
-    rad::SolverSettings settings;
+    rad::solver::SolverSettings settings;
     settings.mesh.elements = argc > 3 ? std::atoi(argv[3]) : 2000;
     settings.progress = false;
-    const rad::Solution solution = rad::solve(scene, settings);
+    const rad::solver::Solution solution = rad::solver::solve(scene, settings);
 
     // Per-vertex and per-element values are plain arrays on the solution.
     std::map<uint32_t, size_t> brightest;  // material → vertex
@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
       std::printf("%-12s brightest vertex radiance (%.4g, %.4g, %.4g) W/sr/m^2\n",
                   scene.materials[material].name.c_str(), l.r, l.g, l.b);
     }
-    rad::write_solution(output, scene, solution, rad::ExportSettings{});
+    rad::bake::write_solution(output, scene, solution, rad::bake::ExportSettings{});
     std::printf("%zu elements, %llu shots, residual %.2g, %.2f s -> %s\n", solution.mesh.element_count(),
                 static_cast<unsigned long long>(solution.shots), solution.residual, solution.seconds, output.c_str());
   } catch (const std::exception& e) {

@@ -1,5 +1,5 @@
 // `import gilt`: the Python front end. It calls the same entry points as the command line
-// (api/methods.h, api/compare.h, radiosity/solver.h) and hands back NumPy arrays and dicts.
+// (api/methods.h, api/compare.h, radiosity/solver/solver.h) and hands back NumPy arrays and dicts.
 //
 // Every long call runs on a worker thread with the GIL released; the calling thread wakes every
 // 50 ms to let Python look for signals, and a Ctrl-C there calls raytrace_core::request_stop(),
@@ -21,8 +21,8 @@
 #include "api/compare.h"
 #include "api/methods.h"
 #include "api/statistics.h"
-#include "radiosity/budget.h"
-#include "radiosity/solver.h"
+#include "radiosity/solver/budget.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/parallel.h"
@@ -177,7 +177,7 @@ py::tuple render(PyScene& s, const std::string& method, std::optional<int> spp, 
   }
   if (radiosity_view != "two-pass" && radiosity_view != "mesh")
     throw rc::InputError("radiosity_view " + radiosity_view + ": expected two-pass or mesh");
-  options.radiosity_view = radiosity_view == "mesh" ? radiosity::ViewMode::mesh : radiosity::ViewMode::two_pass;
+  options.radiosity_view = radiosity_view == "mesh" ? radiosity::bake::ViewMode::mesh : radiosity::bake::ViewMode::two_pass;
   const api::MethodResult result =
       run_interruptible([&] { return api::run_method(s.scene, camera, method, settings, options); });
   nlohmann::json stats = api::run_statistics(s.scene, method, settings, result);
@@ -187,7 +187,7 @@ py::tuple render(PyScene& s, const std::string& method, std::optional<int> spp, 
 
 py::dict solve_radiosity(PyScene& s, std::optional<int> elements, std::optional<double> time, double tolerance,
                          const std::string& solver, uint64_t seed, int threads) {
-  radiosity::SolverSettings settings;
+  radiosity::solver::SolverSettings settings;
   if (elements) {
     if (*elements < 1) throw rc::InputError("elements: must be at least 1");
     settings.mesh.elements = *elements;
@@ -197,15 +197,15 @@ py::dict solve_radiosity(PyScene& s, std::optional<int> elements, std::optional<
     settings.time_limit = *time;
   }
   if (!(tolerance > 0.0 && tolerance < 1.0)) throw rc::InputError("tolerance: from 0 to 1, exclusive");
-  if (solver == "auto") settings.solver = radiosity::SolverKind::automatic;
-  else if (solver == "progressive") settings.solver = radiosity::SolverKind::progressive;
-  else if (solver == "hierarchical") settings.solver = radiosity::SolverKind::hierarchical;
+  if (solver == "auto") settings.solver = radiosity::solver::SolverKind::automatic;
+  else if (solver == "progressive") settings.solver = radiosity::solver::SolverKind::progressive;
+  else if (solver == "hierarchical") settings.solver = radiosity::solver::SolverKind::hierarchical;
   else throw rc::InputError("solver " + solver + ": expected auto, progressive or hierarchical");
   if (threads < 0) throw rc::InputError("threads: 0 (all) or more");
   settings.tolerance = tolerance, settings.seed = seed, settings.threads = threads, settings.progress = false;
   // Under a time budget a mesh left to gilt is sized to fit it, as in `gilt radiosity --time`.
-  const radiosity::Solution sol = run_interruptible([&] {
-    return time ? radiosity::solve_within(s.scene, settings, *time) : radiosity::solve(s.scene, settings);
+  const radiosity::solver::Solution sol = run_interruptible([&] {
+    return time ? radiosity::solver::solve_within(s.scene, settings, *time) : radiosity::solver::solve(s.scene, settings);
   });
 
   py::array_t<uint32_t> indices({py::ssize_t(sol.mesh.element_count()), py::ssize_t(3)});

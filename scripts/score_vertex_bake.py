@@ -8,7 +8,7 @@ same OBJ. BAKE.npy comes from ../shared/tools/cycles_bake.py on that OBJ: one ro
 (OBJ vertex index, radiance r g b), corners in the OBJ's face order. At each point the bake's
 radiance is its face's corners interpolated with the point's barycentric weights, as a viewer
 shows a per-corner colour, and turned into irradiance, E = pi L / albedo. The figures use gilt's
-own definitions (radiosity/check.cpp), so the two bakes are scored by one reference:
+own definitions (radiosity/bake/check.cpp), so the two bakes are scored by one reference:
   relMSE = mean (E - E_ref)^2 / (E_ref^2 + f^2),  mean relative error = mean |E - E_ref| / (E_ref + f),
 with f = 1 % of the mean reference, over points and channels, and the median over points of
 the relative error (less ruled by the few worst points). gilt's own bake (the CSV's `baked`

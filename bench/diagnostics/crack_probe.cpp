@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/element_scene.h"
-#include "radiosity/mesh.h"
+#include "radiosity/mesh/element_scene.h"
+#include "radiosity/mesh/mesh.h"
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/closest_point.h"
 #include "raytrace_core/io/scene_io.h"
@@ -79,7 +79,7 @@ std::optional<rc::SurfacePoint> input_point(const rc::Scene& scene, uint32_t s, 
   const Vec3 p_in = (1 - near->u - near->v) * a + near->u * b + near->v * c;
   Vec3 n_in = glm::normalize(glm::cross(b - a, c - a));
   if (glm::dot(n_in, n) < 0) n_in = -n_in;
-  return rad::mesh_surface_point(p_in, n_in);
+  return rad::mesh::mesh_surface_point(p_in, n_in);
 }
 
 int main(int argc, char** argv) {
@@ -89,11 +89,11 @@ int main(int argc, char** argv) {
   }
   const rc::Scene scene = rc::load_scene(argv[1]);
   std::FILE* camcsv = std::getenv("CAMCSV") ? std::fopen(std::getenv("CAMCSV"), "w") : nullptr;
-  rad::MeshSettings ms;
-  ms.elements = argc > 2 ? std::atoi(argv[2]) : rad::kDefaultElements;
-  rad::MeshReport report;
-  const rad::RadiosityMesh mesh = rad::build_mesh(scene, ms, &report);
-  const rc::Scene geo = rad::element_scene(scene, mesh);
+  rad::mesh::MeshSettings ms;
+  ms.elements = argc > 2 ? std::atoi(argv[2]) : rad::mesh::kDefaultElements;
+  rad::mesh::MeshReport report;
+  const rad::mesh::RadiosityMesh mesh = rad::mesh::build_mesh(scene, ms, &report);
+  const rc::Scene geo = rad::mesh::element_scene(scene, mesh);
   std::printf("elements %zu, vertices %zu, edge %.4g, contact edges %zu, buried faces %zu, buried elements %zu, "
               "buried area %.4g of %.4g\n",
               mesh.element_count(), mesh.vertex_count(), report.max_edge, report.contact_edges, report.buried_faces,
@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
         const rc::Vec2 b = rc::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
         const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
         points += w;
-        const bool elem_blocked = geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh_surface_point(q, n), wi));
+        const bool elem_blocked = geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(q, n), wi));
         // The input point: nearest on the element's own input mesh, facing within 60 degrees.
         const uint32_t s = mesh.element_surface[e];
         const std::optional<rc::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
@@ -208,7 +208,7 @@ int main(int argc, char** argv) {
         if (glm::dot(at_in.ng, wi) > 0.0f) hit = scene.intersect(ray_in);
         const bool input_blocked = glm::dot(at_in.ng, wi) <= 0.0f || hit.has_value();
         // As the README's experiment did: the element's own point traced against the input.
-        const bool raw_blocked = scene.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh_surface_point(q, n), wi));
+        const bool raw_blocked = scene.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(q, n), wi));
         // Interior: under a roof (an upward ray from the input point meets the input).
         const bool interior = scene.occluded(rc::spawn_shadow_ray_to_infinity(at_in, Vec3(0, 1, 0)));
         if (interior) {
@@ -283,7 +283,7 @@ int main(int argc, char** argv) {
     if (k.category == 2) {
       const rc::TriangleMesh& tm = scene.meshes[k.blocker_mesh];
       const uint32_t* idx = &tm.indices[3 * size_t(k.blocker_prim)];
-      k.blocker_buried = rad::input_triangle_buried(scene, tm.positions[idx[0]], tm.positions[idx[1]], tm.positions[idx[2]]);
+      k.blocker_buried = rad::mesh::input_triangle_buried(scene, tm.positions[idx[0]], tm.positions[idx[1]], tm.positions[idx[2]]);
       buried += k.blocker_buried;
     }
   std::printf("  of the uncovered blockers, %zu are input triangles that test as buried\n", buried);
@@ -313,7 +313,7 @@ int main(int argc, char** argv) {
         const Vec3 w = rc::Frame::from_normal(n).to_world(wl);
         if (!(glm::dot(w, at_in.ng) > 0.0f)) continue;
         rays += 1;
-        const rc::Ray ray_e = rc::spawn_ray(rad::mesh_surface_point(q, n), w);
+        const rc::Ray ray_e = rc::spawn_ray(rad::mesh::mesh_surface_point(q, n), w);
         const rc::Ray ray_i = rc::spawn_ray(at_in, w);
         const auto he = geo.intersect(ray_e);
         const auto hi = scene.intersect(ray_i);
@@ -467,12 +467,12 @@ int main(int argc, char** argv) {
                          cc = tm.positions[tm.indices[3 * nn->prim_id + 2]];
               Vec3 ni = glm::normalize(glm::cross(bb - a, cc - a));
               if (glm::dot(ni, nv) < 0) ni = -ni;
-              vin = rad::mesh_surface_point((1 - nn->u - nn->v) * a + nn->u * bb + nn->v * cc, ni);
+              vin = rad::mesh::mesh_surface_point((1 - nn->u - nn->v) * a + nn->u * bb + nn->v * cc, ni);
             }
           }
           for (int r = 0; r < 16; ++r) {
             const Vec3 w = fv.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
-            const auto hv = geo.intersect(rc::spawn_ray(rad::mesh_surface_point(pv, nv), w));
+            const auto hv = geo.intersect(rc::spawn_ray(rad::mesh::mesh_surface_point(pv, nv), w));
             float lv = 0.0f;
             if (hv && hv->geom_id == 0 && glm::dot(mesh.element_normal[hv->prim_id], w) < 0.0f) lv = reflected(hv->prim_id);
             read_v += lv;
@@ -480,7 +480,7 @@ int main(int argc, char** argv) {
             if (hv && lv > 0) {
               // The sun at the input point under the hit: what the element's mean stands for there.
               const uint32_t e2 = hv->prim_id, s2 = mesh.element_surface[e2];
-              const Vec3 x2 = rc::spawn_ray(rad::mesh_surface_point(pv, nv), w).origin + hv->t * w;
+              const Vec3 x2 = rc::spawn_ray(rad::mesh::mesh_surface_point(pv, nv), w).origin + hv->t * w;
               const Vec3 n2 = mesh.element_normal[e2];
               float tr = 0.0f;
               const auto nn = s2 < scene.meshes.size() ? scene.nearest_triangle(s2, x2, L, n2, 0.5f) : std::nullopt;
@@ -490,7 +490,7 @@ int main(int argc, char** argv) {
                            cc = tm.positions[tm.indices[3 * nn->prim_id + 2]];
                 Vec3 ni = glm::normalize(glm::cross(bb - a, cc - a));
                 if (glm::dot(ni, n2) < 0) ni = -ni;
-                const rc::SurfacePoint sp = rad::mesh_surface_point((1 - nn->u - nn->v) * a + nn->u * bb + nn->v * cc, ni);
+                const rc::SurfacePoint sp = rad::mesh::mesh_surface_point((1 - nn->u - nn->v) * a + nn->u * bb + nn->v * cc, ni);
                 const float cs = glm::dot(ni, wi);
                 if (cs > 0 && !scene.occluded(rc::spawn_shadow_ray_to_infinity(sp, wi)))
                   tr = rc::diffuse_reflectance(scene.materials[mesh.element_material[e2]]).luminance() * sun->irradiance.luminance() * cs / 3.14159265f;
@@ -513,13 +513,13 @@ int main(int argc, char** argv) {
               const Vec3 pn = 0.9f * mesh.positions[v] + 0.05f * (3.0f * c - mesh.positions[v]);
               const rc::Frame fe = rc::Frame::from_normal(ne);
               const Vec3 we = fe.to_world(fv.to_local(w));
-              const auto h1 = geo.intersect(rc::spawn_ray(rad::mesh_surface_point(pn, ne), we));
+              const auto h1 = geo.intersect(rc::spawn_ray(rad::mesh::mesh_surface_point(pn, ne), we));
               if (h1 && h1->geom_id == 0 && glm::dot(mesh.element_normal[h1->prim_id], we) < 0.0f) {
                 read_near += reflected(h1->prim_id);
                 read_n_bin[h1->t < 0.02f * L ? 0 : h1->t < 0.1f * L ? 1 : h1->t < 0.5f * L ? 2 : 3] += reflected(h1->prim_id);
               }
               const Vec3 pve = mesh.positions[v] + 1e-3f * (towards - glm::dot(towards, ne) * ne + size * ne);
-              const auto h2 = geo.intersect(rc::spawn_ray(rad::mesh_surface_point(pve, ne), we));
+              const auto h2 = geo.intersect(rc::spawn_ray(rad::mesh::mesh_surface_point(pve, ne), we));
               if (h2 && h2->geom_id == 0 && glm::dot(mesh.element_normal[h2->prim_id], we) < 0.0f) read_ve += reflected(h2->prim_id);
             }
             if (!(lv > 0.0f) || !vin) continue;
@@ -551,7 +551,7 @@ int main(int argc, char** argv) {
           const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
           if (!(glm::dot(w, n) > 0.0f)) continue;
           nrays += 1;
-          const rc::Ray ray_e = rc::spawn_ray(rad::mesh_surface_point(q, n), w);
+          const rc::Ray ray_e = rc::spawn_ray(rad::mesh::mesh_surface_point(q, n), w);
           const rc::Ray ray_i = rc::spawn_ray(at_in, w);
           const auto he = geo.intersect(ray_e);
           const auto hi = scene.intersect(ray_i);
@@ -562,7 +562,7 @@ int main(int argc, char** argv) {
             const Vec3 ne2 = mesh.element_normal[he->prim_id];
             const float c2 = glm::dot(ne2, wi);
             const Vec3 x2 = ray_e.origin + he->t * w;
-            if (c2 > 0.0f && !geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh_surface_point(x2, ne2), wi)))
+            if (c2 > 0.0f && !geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(x2, ne2), wi)))
               read_pt += rc::diffuse_reflectance(scene.materials[mesh.element_material[he->prim_id]]).luminance() *
                          sun->irradiance.luminance() * c2 / 3.14159265f;
           }

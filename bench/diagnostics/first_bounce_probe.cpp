@@ -16,9 +16,9 @@
 #include <optional>
 #include <string>
 
-#include "radiosity/element_scene.h"
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
+#include "radiosity/mesh/element_scene.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/rng.h"
@@ -38,21 +38,21 @@ int main(int argc, char** argv) {
   scene.commit();
   const rc::Light& sun = scene.punctual_lights.at(0);
   const Vec3 wi = -glm::normalize(sun.direction);
-  rad::SolverSettings ss;
-  ss.mesh.elements = argc > 3 ? std::atoi(argv[3]) : rad::kDefaultElements;
-  ss.solver = rad::SolverKind::hierarchical;
+  rad::solver::SolverSettings ss;
+  ss.mesh.elements = argc > 3 ? std::atoi(argv[3]) : rad::mesh::kDefaultElements;
+  ss.solver = rad::solver::SolverKind::hierarchical;
   ss.hierarchical.link_tolerance = argc > 2 ? std::atof(argv[2]) : 2e-4;
   ss.hierarchical.max_iterations = 1;
   ss.progress = false;
-  ss = rad::solver_settings_for(rad::ViewMode::two_pass, ss);
+  ss = rad::bake::solver_settings_for(rad::bake::ViewMode::two_pass, ss);
   if (const char* r = std::getenv("LINK_RAYS")) ss.hierarchical.link_rays = std::atoi(r);
   // The final gather alone: no iteration, so the radiosity it gathers is the first reflection.
-  if (std::getenv("FINAL_GATHER")) ss.hierarchical.final_gather = rad::FinalGather::always, ss.hierarchical.max_iterations = 0;
-  const rad::Solution sol = rad::solve(scene, ss);
-  const rad::RadiosityMesh& mesh = sol.mesh;
+  if (std::getenv("FINAL_GATHER")) ss.hierarchical.final_gather = rad::solver::FinalGather::always, ss.hierarchical.max_iterations = 0;
+  const rad::solver::Solution sol = rad::solver::solve(scene, ss);
+  const rad::mesh::RadiosityMesh& mesh = sol.mesh;
   std::printf("solved: %zu elements, %zu links, %d iterations, final gather %d\n", mesh.element_count(), sol.links,
               sol.iterations, int(sol.final_gather));
-  const rc::Scene geo = rad::element_scene(scene, mesh);
+  const rc::Scene geo = rad::mesh::element_scene(scene, mesh);
   if (const char* path = std::getenv("ELEMCSV")) {
     std::FILE* f = std::fopen(path, "w");
     for (size_t e = 0; e < mesh.element_count(); ++e) {
@@ -102,12 +102,12 @@ int main(int argc, char** argv) {
       double ge = 0, gp = 0, tf = 0, tb = 0;
       for (int r = 0; r < rays; ++r) {
         const Vec3 wl = rc::sample_cosine_hemisphere(rng.uniform2());
-        const rc::Ray re = rc::spawn_ray(rad::mesh_surface_point(q, n), fe.to_world(wl));
+        const rc::Ray re = rc::spawn_ray(rad::mesh::mesh_surface_point(q, n), fe.to_world(wl));
         if (const auto he = geo.intersect(re); he && he->geom_id == 0 && geo.surface(re, *he).front_face) {
           ge += elem_b(he->prim_id);
           const Vec3 n2 = mesh.element_normal[he->prim_id];
           const float c2 = glm::dot(n2, wi);
-          if (c2 > 0 && !geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh_surface_point(re.origin + he->t * re.direction, n2), wi)))
+          if (c2 > 0 && !geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(re.origin + he->t * re.direction, n2), wi)))
             gp += albedo(mesh.element_material[he->prim_id]) * E * c2;
         }
         const rc::Ray ri = rc::spawn_ray(at_in, fi.to_world(wl));

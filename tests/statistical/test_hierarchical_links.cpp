@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/rng.h"
 #include "tests/support/mesh_builders.h"
@@ -19,7 +19,7 @@ namespace rad = gilt::radiosity;
 namespace {
 
 /// Area-weighted mean radiance of the solution (each element the mean of its vertices).
-double mean_radiance(const rad::Solution& sol) {
+double mean_radiance(const rad::solver::Solution& sol) {
   double sum = 0.0, area = 0.0;
   for (size_t e = 0; e < sol.mesh.element_count(); ++e) {
     double l = 0.0;
@@ -67,16 +67,16 @@ TEST(HierarchicalLinks, VisibleFractionDoesNotDependOnTheDecidingRays) {
   auto mean_over_seeds = [&](int link_rays, int seeds, std::vector<double>* each) {
     double sum = 0.0;
     for (int seed = 0; seed < seeds; ++seed) {
-      rad::SolverSettings s;
-      s.solver = rad::SolverKind::hierarchical;
+      rad::solver::SolverSettings s;
+      s.solver = rad::solver::SolverKind::hierarchical;
       s.mesh.elements = 1500;
       s.subdivision_levels = 0;
       s.progress = false;
       s.seed = uint64_t(seed);
-      s.hierarchical.final_gather = rad::FinalGather::never;
+      s.hierarchical.final_gather = rad::solver::FinalGather::never;
       s.hierarchical.link_tolerance = 2e-5;
       s.hierarchical.link_rays = link_rays;
-      const rad::Solution sol = rad::solve(scene, s);
+      const rad::solver::Solution sol = rad::solver::solve(scene, s);
       const double r = mean_radiance(sol) / expected;
       std::printf("%d rays, seed %d: %zu links, mean / (Le / (1 − rho)) %.4f\n", link_rays, seed, sol.links, r);
       if (each) each->push_back(r);

@@ -9,7 +9,7 @@
 // - Depth: lights laid out so that cost-driven splits peel one off at a time still give a tree
 //   whose leaves fit the 64-bit trails.
 // - Unbiased and better: direct irradiance under 256 lamps by next-event estimation agrees with
-//   Lambert's formula (radiosity/form_factor.h) within 4 standard errors, and its variance per
+//   Lambert's formula (radiosity/solver/form_factor.h) within 4 standard errors, and its variance per
 //   sample is several times below choosing by power's.
 
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 #include <cmath>
 #include <vector>
 
-#include "radiosity/form_factor.h"
+#include "radiosity/solver/form_factor.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/light_sampler.h"
 #include "raytrace_core/rng.h"
@@ -261,7 +261,7 @@ TEST(LightBvh, DirectLightIsUnbiasedAndLessNoisyThanByPower) {
       const TriangleMesh& mesh = scene.meshes[light.geom_id];
       const uint32_t* c = &mesh.indices[3 * size_t(light.prim_id)];
       exact += 5.0 * kPi *
-               radiosity::point_to_triangle_form_factor(DVec3(p), DVec3(0, 1, 0), DVec3(mesh.positions[c[0]]),
+               radiosity::solver::point_to_triangle_form_factor(DVec3(p), DVec3(0, 1, 0), DVec3(mesh.positions[c[0]]),
                                                         DVec3(mesh.positions[c[1]]), DVec3(mesh.positions[c[2]]));
     }
     constexpr int kSamples = 200000;

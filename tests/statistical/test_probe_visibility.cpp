@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -19,15 +19,15 @@ namespace {
 
 /// Sum over the vertices of the direct irradiance (channel mean) from the scene's emitters.
 double direct_sum(const rc::Scene& scene, int visibility_samples, uint64_t seed) {
-  rad::SolverSettings s;
-  s.solver = rad::SolverKind::progressive;
+  rad::solver::SolverSettings s;
+  s.solver = rad::solver::SolverKind::progressive;
   s.mesh.elements = 1500;
   s.subdivision_levels = 0;
   s.progress = false;
   s.tolerance = 0.5;  // the direct light is gathered before any shot; shots do not matter here
   s.seed = seed;
   s.visibility_samples = visibility_samples;
-  const rad::Solution sol = rad::solve(scene, s);
+  const rad::solver::Solution sol = rad::solver::solve(scene, s);
   double sum = 0.0;
   for (const rc::Rgb& e : sol.vertex_direct) sum += e.average();
   return sum;

@@ -1,4 +1,4 @@
-// The object-space check (radiosity/check.h) on scenes whose answer is known.
+// The object-space check (radiosity/bake/check.h) on scenes whose answer is known.
 //
 // Tolerance: the check compares the solution with a Monte Carlo estimate whose standard error σ
 // it reports (as a mean relative to the reference, "reference noise"). Where the solution is
@@ -12,8 +12,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "radiosity/check.h"
-#include "radiosity/solver.h"
+#include "radiosity/bake/check.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/io/scene_io.h"
@@ -23,18 +23,18 @@ namespace rad = gilt::radiosity;
 
 namespace {
 
-rad::Solution solve(const rc::Scene& scene) {
-  rad::SolverSettings s;
+rad::solver::Solution solve(const rc::Scene& scene) {
+  rad::solver::SolverSettings s;
   s.mesh.elements = 1000;
   s.tolerance = 1e-4;
   s.progress = false;
-  return rad::solve(scene, s);
+  return rad::solver::solve(scene, s);
 }
 
 TEST(RadiosityCheck, FurnaceErrorIsTheReferenceNoise) {
   const rc::Scene scene = rc::load_scene("furnace");
-  const rad::Solution sol = solve(scene);
-  const rad::CheckResult check = rad::check_against_path_tracer(scene, sol, rad::CheckSettings{});
+  const rad::solver::Solution sol = solve(scene);
+  const rad::bake::CheckResult check = rad::bake::check_against_path_tracer(scene, sol, rad::bake::CheckSettings{});
   std::printf("[ measured ] furnace: %zu vertices, mean relative error %.4f, noise %.4f\n", check.points,
               check.mean_relative_error, check.reference_noise);
   ASSERT_EQ(check.points, 64u);
@@ -48,8 +48,8 @@ TEST(RadiosityCheck, FurnaceErrorIsTheReferenceNoise) {
 // blocks) must agree with that to within 6 % plus the reference noise as above.
 TEST(RadiosityCheck, CornellAgreesWithTheImageSpaceError) {
   const rc::Scene scene = rc::load_scene("cornell");
-  const rad::Solution sol = solve(scene);
-  const rad::CheckResult check = rad::check_against_path_tracer(scene, sol, rad::CheckSettings{});
+  const rad::solver::Solution sol = solve(scene);
+  const rad::bake::CheckResult check = rad::bake::check_against_path_tracer(scene, sol, rad::bake::CheckSettings{});
   std::printf("[ measured ] cornell: %zu vertices, mean relative error %.4f, relative mean absolute error %.4f, "
               "noise %.4f\n",
               check.points, check.mean_relative_error, check.relative_mean_absolute_error, check.reference_noise);
@@ -59,23 +59,23 @@ TEST(RadiosityCheck, CornellAgreesWithTheImageSpaceError) {
 
 TEST(RadiosityCheck, SameResultForAnyThreadCountAndBadSettingsAreRefused) {
   const rc::Scene scene = rc::load_scene("cornell");
-  const rad::Solution sol = solve(scene);
-  rad::CheckSettings settings;
+  const rad::solver::Solution sol = solve(scene);
+  rad::bake::CheckSettings settings;
   settings.points = 16;
   settings.samples = 256;
-  const rad::CheckResult all = rad::check_against_path_tracer(scene, sol, settings);
-  rad::CheckResult one;
+  const rad::bake::CheckResult all = rad::bake::check_against_path_tracer(scene, sol, settings);
+  rad::bake::CheckResult one;
   {
     rc::ThreadLimit limit(1);
-    one = rad::check_against_path_tracer(scene, sol, settings);
+    one = rad::bake::check_against_path_tracer(scene, sol, settings);
   }
   EXPECT_EQ(all.mean_relative_error, one.mean_relative_error);
   EXPECT_EQ(all.reference_noise, one.reference_noise);
   settings.points = 0;
-  EXPECT_THROW(rad::check_against_path_tracer(scene, sol, settings), rc::InputError);
+  EXPECT_THROW(rad::bake::check_against_path_tracer(scene, sol, settings), rc::InputError);
   settings.points = 8;
   settings.samples = 1;
-  EXPECT_THROW(rad::check_against_path_tracer(scene, sol, settings), rc::InputError);
+  EXPECT_THROW(rad::bake::check_against_path_tracer(scene, sol, settings), rc::InputError);
 }
 
 }  // namespace

@@ -16,8 +16,8 @@
 #include <cstdio>
 
 #include "raytrace_core/io/image_error.h"
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
 #include "raytrace_core/io/scene_io.h"
@@ -46,13 +46,13 @@ std::vector<rc::Rgb> path_render(const rc::Scene& scene, int spp, uint64_t seed)
 }
 
 std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, int elements,
-                                      rad::ViewMode mode = rad::ViewMode::mesh, uint64_t seed = 1, int spp = 64) {
-  rad::SolverSettings s;
+                                      rad::bake::ViewMode mode = rad::bake::ViewMode::mesh, uint64_t seed = 1, int spp = 64) {
+  rad::solver::SolverSettings s;
   s.mesh.elements = elements;
   s.tolerance = 1e-4;
   s.progress = false;
-  const rad::Solution sol = rad::solve(scene, s);
-  const rad::RadiosityView view(scene, sol, mode);
+  const rad::solver::Solution sol = rad::solver::solve(scene, s);
+  const rad::bake::RadiosityView view(scene, sol, mode);
   // Same pixel filter and sample positions as the reference (same seed): only the radiance differs.
   return rc::render_image(scene, scene.effective_camera(), settings(spp, seed),
                           [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); })
@@ -84,12 +84,12 @@ TEST(RadiosityVsPath, TwoPassViewTakesTheDirectLightExactly) {
   rc::Scene scene = rc::load_scene("cornell");
   const std::vector<rc::Rgb> reference = path_render(scene, 2048, 1);
   const double reference_noise = 0.5 * rc::mean_relative_error(path_render(scene, 2048, 2), reference);
-  const std::vector<rc::Rgb> coarse_image = radiosity_render(scene, 400, rad::ViewMode::two_pass, 1, 1024);
+  const std::vector<rc::Rgb> coarse_image = radiosity_render(scene, 400, rad::bake::ViewMode::two_pass, 1, 1024);
   const double own_noise =
-      0.5 * rc::mean_relative_error(radiosity_render(scene, 400, rad::ViewMode::two_pass, 2, 1024), coarse_image);
+      0.5 * rc::mean_relative_error(radiosity_render(scene, 400, rad::bake::ViewMode::two_pass, 2, 1024), coarse_image);
   const double mesh = rc::mean_relative_error(radiosity_render(scene, 400), reference);
   const double coarse = rc::mean_relative_error(coarse_image, reference);
-  const double fine = rc::mean_relative_error(radiosity_render(scene, 1600, rad::ViewMode::two_pass, 1, 1024), reference);
+  const double fine = rc::mean_relative_error(radiosity_render(scene, 1600, rad::bake::ViewMode::two_pass, 1, 1024), reference);
   std::printf("mean relative error: mesh view %.4f; two-pass 400 elements %.4f, 1600 elements %.4f; "
               "noise: two-pass %.4f, reference %.4f\n", mesh, coarse, fine, own_noise, reference_noise);
   EXPECT_LT(coarse + own_noise, mesh) << "the two-pass view is no closer to the path tracer than the mesh view";

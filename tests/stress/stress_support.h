@@ -16,8 +16,8 @@
 
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
 #include "raytrace_core/path_tracer.h"
 #include "raytrace_core/render.h"
 #include "raytrace_core/scene.h"
@@ -67,7 +67,7 @@ struct MethodResult {
   size_t non_finite_pixels = 0;      ///< pixels of the final image that are NaN or infinite
   size_t non_finite_vertices = 0;    ///< radiosity: vertex radiosity or irradiance NaN or infinite
   bool non_finite_residual = false;  ///< radiosity: the residual is NaN or infinite
-  std::optional<rad::Solution> solution;
+  std::optional<rad::solver::Solution> solution;
 
   /// Every count above, summed: zero when nothing non-finite appeared anywhere.
   uint64_t non_finite_total() const {
@@ -122,15 +122,15 @@ inline MethodResult render_method(const rc::Scene& scene, Method method, const B
       break;
     }
     case Method::radiosity: {
-      rad::SolverSettings solver;
+      rad::solver::SolverSettings solver;
       solver.mesh.elements = budget.radiosity_elements;
       solver.seed = seed;
       solver.progress = false;
-      r.solution.emplace(rad::solve(scene, solver));
+      r.solution.emplace(rad::solver::solve(scene, solver));
       r.non_finite_vertices =
           count_non_finite(r.solution->vertex_radiosity) + count_non_finite(r.solution->vertex_irradiance);
       r.non_finite_residual = !std::isfinite(r.solution->residual);
-      const rad::RadiosityView view(scene, *r.solution);
+      const rad::bake::RadiosityView view(scene, *r.solution);
       film = rc::render_image(
           scene, camera, s,
           [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); }, &stats);

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/mesh.h"
-#include "radiosity/solver.h"
+#include "radiosity/mesh/mesh.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/rng.h"
@@ -30,6 +30,8 @@
 #include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {
+using namespace mesh;
+using namespace solver;
 namespace {
 
 using rc::Material;

@@ -1,6 +1,6 @@
 # A library must not change the process around it: no binary or module of gilt defines the
 # global operator new or delete (it once replaced them to order CGAL's allocations; see
-# radiosity/imprint.h for what does that job now). Run as
+# radiosity/mesh/imprint.h for what does that job now). Run as
 #   cmake -DNM=nm "-DFILES=a;b" -P no_replaced_allocator.cmake
 foreach(file ${FILES})
   execute_process(COMMAND ${NM} -C --defined-only ${file} OUTPUT_VARIABLE symbols RESULT_VARIABLE status)

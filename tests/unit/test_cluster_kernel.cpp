@@ -1,4 +1,4 @@
-// The kernel between two clusters averaged over their extent (radiosity/cluster_kernel.h),
+// The kernel between two clusters averaged over their extent (radiosity/solver/cluster_kernel.h),
 // against Howell's closed form for coaxial disks and against quadrature for squares in general
 // position, and the covariance of a triangle against its moments.
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <utility>
 
-#include "radiosity/cluster_kernel.h"
+#include "radiosity/solver/cluster_kernel.h"
 #include "raytrace_core/rng.h"
 
 namespace rc = gilt::raytrace_core;
@@ -16,12 +16,12 @@ namespace rad = gilt::radiosity;
 namespace {
 
 using glm::dvec3;
-using rad::Vec3;
+using gilt::raytrace_core::Vec3;
 
 // The right triangle (0,0), (1,0), (0,1): E[x] = 1/3, E[x²] = 1/6, E[xy] = 1/12, so
 // Var x = 1/18 and Cov(x, y) = −1/36.
 TEST(ClusterKernel, TriangleCovarianceIsItsSecondMoment) {
-  const glm::dmat3 c = rad::triangle_covariance(dvec3(0, 0, 0), dvec3(1, 0, 0), dvec3(0, 1, 0));
+  const glm::dmat3 c = rad::solver::triangle_covariance(dvec3(0, 0, 0), dvec3(1, 0, 0), dvec3(0, 1, 0));
   EXPECT_NEAR(c[0][0], 1.0 / 18.0, 1e-12);
   EXPECT_NEAR(c[1][1], 1.0 / 18.0, 1e-12);
   EXPECT_NEAR(c[0][1], -1.0 / 36.0, 1e-12);
@@ -42,7 +42,7 @@ TEST(ClusterKernel, CoaxialDisksMatchHowell) {
     // Uniform disk of radius r: variance r² / 4 along each axis of its plane.
     glm::mat3 C(0.0f);
     C[0][0] = C[1][1] = float((A * A + B * B) / 4.0);
-    const double scale = rad::cluster_kernel_scale(Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, -1), C);
+    const double scale = rad::solver::cluster_kernel_scale(Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, -1), C);
     EXPECT_NEAR(scale, exact, A * A * B * B) << "A " << A << " B " << B;
     EXPECT_LT(std::abs(scale - exact), 0.1 * std::abs(1.0 - exact)) << "A " << A << " B " << B;
   }
@@ -95,7 +95,7 @@ TEST(ClusterKernel, SquaresInGeneralPositionAgreeWithQuadrature) {
     const glm::dmat3 C = a * a / 12.0 * (glm::outerProduct(tr, tr) + glm::outerProduct(br, br)) +
                          b * b / 12.0 * (glm::outerProduct(ts, ts) + glm::outerProduct(bs, bs));
     const double averaged =
-        centre * rad::cluster_kernel_scale(Vec3(d), Vec3(n_r), Vec3(n_s), glm::mat3(C));
+        centre * rad::solver::cluster_kernel_scale(Vec3(d), Vec3(n_r), Vec3(n_s), glm::mat3(C));
     centre_error += std::abs(centre - mean) / mean;
     average_error += std::abs(averaged - mean) / mean;
     EXPECT_LT(std::abs(averaged - mean) / mean, std::pow(a + b, 4.0) / 4.0) << "a " << a << " b " << b;
@@ -109,9 +109,9 @@ TEST(ClusterKernel, SquaresInGeneralPositionAgreeWithQuadrature) {
 // Where an end does not face the other at the centres the expansion says nothing: factor 1.
 TEST(ClusterKernel, NoFactorWhereTheEndsDoNotFace) {
   glm::mat3 C(0.01f);
-  EXPECT_EQ(rad::cluster_kernel_scale(Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(0, 0, -1), C), 1.0f);
-  EXPECT_EQ(rad::cluster_kernel_scale(Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1), C), 1.0f);
-  EXPECT_EQ(rad::cluster_kernel_scale(Vec3(0.0f), Vec3(0, 0, 1), Vec3(0, 0, -1), C), 1.0f);
+  EXPECT_EQ(rad::solver::cluster_kernel_scale(Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(0, 0, -1), C), 1.0f);
+  EXPECT_EQ(rad::solver::cluster_kernel_scale(Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1), C), 1.0f);
+  EXPECT_EQ(rad::solver::cluster_kernel_scale(Vec3(0.0f), Vec3(0, 0, 1), Vec3(0, 0, -1), C), 1.0f);
 }
 
 }  // namespace

@@ -3,7 +3,7 @@
 // extension, missing folder, no temporaries left, existing files kept); the exported elements
 // checked at random points of the input (check_element_colours) against a scan of every element.
 
-#include "radiosity/export.h"
+#include "radiosity/bake/export.h"
 
 #include <unistd.h>
 
@@ -26,13 +26,16 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/check.h"
+#include "radiosity/bake/check.h"
 #include "raytrace_core/closest_point.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
 namespace gilt::radiosity {
+using namespace mesh;
+using namespace solver;
+using namespace bake;
 namespace {
 
 namespace fs = std::filesystem;
@@ -702,6 +705,9 @@ TEST_F(ExportTest, MaterialsLoadBackIntoGiltAsTheSameKind) {
 }  // namespace gilt::radiosity
 
 namespace gilt::radiosity {
+using namespace mesh;
+using namespace solver;
+using namespace bake;
 namespace {
 
 TEST(ExportSnap, CoincidentElementsFacingTheSameWayAreMerged) {

@@ -25,16 +25,16 @@
 #include <utility>
 #include <vector>
 
-#include "radiosity/form_factor.h"
+#include "radiosity/solver/form_factor.h"
 #include "raytrace_core/rng.h"
 
 namespace {
 
-using gilt::radiosity::DVec3;
-using gilt::radiosity::point_to_polygon_form_factor;
-using gilt::radiosity::point_to_triangle_form_factor;
-using gilt::radiosity::SourceTriangle;
-using gilt::radiosity::Vec3;
+using gilt::raytrace_core::DVec3;
+using gilt::radiosity::solver::point_to_polygon_form_factor;
+using gilt::radiosity::solver::point_to_triangle_form_factor;
+using gilt::radiosity::solver::SourceTriangle;
+using gilt::raytrace_core::Vec3;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -764,8 +764,8 @@ TEST(FormFactorContract, NonConvexPolygonStraddlingTangentPlane) {
 // measured 0.26 %), and
 // checks that SourceTriangle switches to the exact formula where the rule does not apply.
 TEST(FormFactorFarField, WithinStatedBoundAtTheSwitchDistance) {
-  using gilt::radiosity::SourceTriangle;
-  using gilt::radiosity::Vec3;
+  using gilt::radiosity::solver::SourceTriangle;
+  using gilt::raytrace_core::Vec3;
   constexpr double kStatedBound = 3e-3;
   double worst = 0.0;
   int compared = 0;
@@ -779,7 +779,7 @@ TEST(FormFactorFarField, WithinStatedBoundAtTheSwitchDistance) {
     const Vec3 centroid = (a + b2 + c) / 3.0f;
     const float radius = std::max({glm::length(a - centroid), glm::length(b2 - centroid), glm::length(c - centroid)});
     const Vec3 dir = glm::normalize(Vec3(u(), u(), std::abs(u()) + 0.02f));
-    const Vec3 p = centroid + dir * (gilt::radiosity::kFarFieldRatio * radius * 1.0001f);
+    const Vec3 p = centroid + dir * (gilt::radiosity::solver::kFarFieldRatio * radius * 1.0001f);
     const Vec3 n = glm::normalize(Vec3(u(), u(), u()));
     if (!(glm::dot(n, a - p) > 0.0f && glm::dot(n, b2 - p) > 0.0f && glm::dot(n, c - p) > 0.0f)) continue;
     const double exact = point_to_triangle_form_factor(DVec3(p), DVec3(n), DVec3(a), DVec3(b2), DVec3(c));
@@ -789,7 +789,7 @@ TEST(FormFactorFarField, WithinStatedBoundAtTheSwitchDistance) {
     worst = std::max(worst, relative_error(source.form_factor(p, n), exact));
     ++compared;
     // Nearer than the switch distance the exact formula is used, bit for bit.
-    const Vec3 near = centroid + dir * (0.5f * gilt::radiosity::kFarFieldRatio * radius);
+    const Vec3 near = centroid + dir * (0.5f * gilt::radiosity::solver::kFarFieldRatio * radius);
     EXPECT_EQ(source.form_factor(near, n),
               point_to_triangle_form_factor(DVec3(near), DVec3(n), DVec3(a), DVec3(b2), DVec3(c)));
   }
@@ -800,9 +800,9 @@ TEST(FormFactorFarField, WithinStatedBoundAtTheSwitchDistance) {
 // The batched evaluation the solver uses gives SourceTriangle::form_factor's values exactly
 // (same operations in the same order), near and far, in front and behind.
 TEST(FormFactorFarField, BatchEqualsOneByOne) {
-  using gilt::radiosity::SourceBatch;
-  using gilt::radiosity::SourceTriangle;
-  using gilt::radiosity::Vec3;
+  using gilt::radiosity::solver::SourceBatch;
+  using gilt::radiosity::solver::SourceTriangle;
+  using gilt::raytrace_core::Vec3;
   gilt::raytrace_core::Rng rng = gilt::raytrace_core::Rng::for_item(12, 0, 0);
   auto u = [&] { return 2.0f * rng.uniform() - 1.0f; };
   std::vector<SourceTriangle> triangles;

@@ -1,4 +1,4 @@
-// gilt's own imprinting (radiosity/imprint.h): a surface cut along the lines where tool triangles
+// gilt's own imprinting (radiosity/mesh/imprint.h): a surface cut along the lines where tool triangles
 // cross or touch it stays a conforming surface of the same area and facing, carries the contact
 // outline as cuts, and comes out the same whatever else the process did.
 
@@ -11,12 +11,12 @@
 #include <memory>
 #include <vector>
 
-#include "radiosity/imprint.h"
+#include "radiosity/mesh/imprint.h"
 
 namespace rad = gilt::radiosity;
-using rad::detail::DVec3;
-using rad::detail::ImprintCounts;
-using rad::detail::TriangleSoup;
+using rad::mesh::detail::DVec3;
+using rad::mesh::detail::ImprintCounts;
+using rad::mesh::detail::TriangleSoup;
 using Triangle = std::array<DVec3, 3>;
 
 namespace {
@@ -87,7 +87,7 @@ TEST(Imprint, ABlockStandingOnTheFloorLeavesItsOutline) {
   // A block 0.3 × 0.2 standing on the floor, its sides crossing cell edges and diagonals.
   const std::vector<Triangle> block = box({0.33, 0.41, 0.0}, {0.63, 0.61, 0.5});
   ImprintCounts counts;
-  const TriangleSoup cut = rad::detail::imprint(floor, block, &counts);
+  const TriangleSoup cut = rad::mesh::detail::imprint(floor, block, &counts);
   EXPECT_GT(counts.faces_cut, 0u);
   EXPECT_EQ(counts.segments_lost, 0u);
   expect_conforming(cut);
@@ -115,7 +115,7 @@ TEST(Imprint, ALegPiercingTheFloorAndAWallAlongItsEdgeAreImprinted) {
   const double y = 2.0 / 3.0;
   tools.push_back({DVec3(0.2, y, 0.0), DVec3(0.9, y, 0.0), DVec3(0.9, y, 1.0)});
   tools.push_back({DVec3(0.2, y, 0.0), DVec3(0.9, y, 1.0), DVec3(0.2, y, 1.0)});
-  const TriangleSoup cut = rad::detail::imprint(floor, tools);
+  const TriangleSoup cut = rad::mesh::detail::imprint(floor, tools);
   expect_conforming(cut);
   EXPECT_NEAR(area(cut), 1.0, 1e-12);
   EXPECT_NEAR(cut_length(cut), 2 * (0.1 + 0.15) + 0.7, 1e-12);
@@ -127,7 +127,7 @@ TEST(Imprint, ToolsThatIntersectThemselvesAndCrossEachOther) {
   std::vector<Triangle> tools = box({0.2, 0.2, 0.0}, {0.6, 0.6, 0.3});
   const std::vector<Triangle> second = box({0.4, 0.4, 0.0}, {0.8, 0.7, 0.3});
   tools.insert(tools.end(), second.begin(), second.end());
-  const TriangleSoup cut = rad::detail::imprint(floor, tools);
+  const TriangleSoup cut = rad::mesh::detail::imprint(floor, tools);
   expect_conforming(cut);
   EXPECT_NEAR(area(cut), 1.0, 1e-12);
   // Both outlines whole, each cut where the other crosses it.
@@ -140,7 +140,7 @@ TEST(Imprint, CoplanarAndFarToolsLeaveTheSurfaceAsItIs) {
   const std::vector<Triangle> above = box({0.2, 0.2, 0.1}, {0.4, 0.4, 0.3});  // floating
   tools.insert(tools.end(), above.begin(), above.end());
   ImprintCounts counts;
-  const TriangleSoup cut = rad::detail::imprint(floor, tools, &counts);
+  const TriangleSoup cut = rad::mesh::detail::imprint(floor, tools, &counts);
   EXPECT_EQ(counts.faces_cut, 0u);
   EXPECT_EQ(cut.triangles, floor.triangles);
   EXPECT_TRUE(cut.cuts.empty());
@@ -154,12 +154,12 @@ TEST(Imprint, TheSameInputGivesTheSameBytes) {
     const std::vector<Triangle> leg = box({x, y - 0.04, -0.01 * k}, {x + 0.031, y, 0.4});
     tools.insert(tools.end(), leg.begin(), leg.end());
   }
-  const TriangleSoup first = rad::detail::imprint(floor, tools);
+  const TriangleSoup first = rad::mesh::detail::imprint(floor, tools);
   expect_conforming(first);
   for (int run = 0; run < 3; ++run) {
     std::vector<std::unique_ptr<char[]>> clutter;  // a different heap each time
     for (int k = 0; k < 50 * (run + 1); ++k) clutter.emplace_back(new char[size_t(40 + 977 * k)]);
-    const TriangleSoup again = rad::detail::imprint(floor, tools);
+    const TriangleSoup again = rad::mesh::detail::imprint(floor, tools);
     EXPECT_EQ(again.points, first.points);
     EXPECT_EQ(again.triangles, first.triangles);
     EXPECT_EQ(again.cuts, first.cuts);

@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/check.h"
-#include "radiosity/lightmap.h"
-#include "radiosity/onto_input.h"
-#include "radiosity/solver.h"
+#include "radiosity/bake/check.h"
+#include "radiosity/bake/lightmap.h"
+#include "radiosity/bake/onto_input.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/image_io.h"
 #include "raytrace_core/io/scene_io.h"
@@ -103,21 +103,21 @@ bool strictly_inside(const Vec2* t, const Vec2& p, double eps) {
 
 struct Solved {
   rc::Scene scene;
-  rad::Solution solution;
+  rad::solver::Solution solution;
 };
 
 Solved solve(const fs::path& scene_file, int elements) {
   Solved s{rc::load_scene(scene_file.string()), {}};
-  rad::SolverSettings settings;
+  rad::solver::SolverSettings settings;
   settings.mesh.elements = elements;
-  s.solution = rad::solve(s.scene, settings);
+  s.solution = rad::solver::solve(s.scene, settings);
   return s;
 }
 
 TEST(Lightmap, FacesAreLaidOutApartAtOneDensity) {
   const fs::path dir = fresh_dir("layout");
   const Solved s = solve(write_model(dir), 400);
-  const rad::Lightmap lm = rad::bake_lightmap(s.scene, s.solution, rad::Quantity::irradiance, 128);
+  const rad::bake::Lightmap lm = rad::bake::bake_lightmap(s.scene, s.solution, rad::bake::Quantity::irradiance, 128);
   ASSERT_EQ(lm.corner_uv.size(), s.scene.meshes.size());
   // The floor's two faces are coplanar neighbours: one chart; each panel instance is one more.
   EXPECT_EQ(lm.stats.charts, 3u);
@@ -165,7 +165,7 @@ TEST(Lightmap, TexelsHoldTheSunAndSkyAndThePanelsShadows) {
   // this scene is well under 2 %; the sun is exact (a shadow ray per point).
   const fs::path dir = fresh_dir("values");
   const Solved s = solve(write_model(dir), 1600);
-  const rad::Lightmap lm = rad::bake_lightmap(s.scene, s.solution, rad::Quantity::irradiance, 256);
+  const rad::bake::Lightmap lm = rad::bake::bake_lightmap(s.scene, s.solution, rad::bake::Quantity::irradiance, 256);
   const double sky = 0.3 * M_PI, open = 2.0 + sky;
   size_t floor = SIZE_MAX;
   for (size_t m = 0; m < s.scene.meshes.size(); ++m)
@@ -206,10 +206,10 @@ TEST(Lightmap, TexelsHoldTheSunAndSkyAndThePanelsShadows) {
     }
   }
   // The check agrees: its points on the open floor and panels match within the estimates' noise.
-  rad::CheckSettings check;
+  rad::bake::CheckSettings check;
   check.points = 64;
   check.samples = 256;
-  const rad::SurfaceCheckResult r = rad::check_lightmap(s.scene, lm, check);
+  const rad::bake::SurfaceCheckResult r = rad::bake::check_lightmap(s.scene, lm, check);
   EXPECT_GT(r.points, 32u);
   EXPECT_LT(r.mean_relative_error, 0.1);
   fs::remove_all(dir);
@@ -225,7 +225,7 @@ TEST(Lightmap, FinalGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   const double sky = 0.3 * M_PI, open = 2.0 + sky;
   const int rays = 4096;
   const double tolerance = 1e-4 * open;
-  const rad::SolutionAtInput gathered(s.scene, s.solution, rad::Quantity::irradiance, rad::BakeGather{rays, 3});
+  const rad::bake::SolutionAtInput gathered(s.scene, s.solution, rad::bake::Quantity::irradiance, rad::bake::BakeGather{rays, 3});
   const rc::Material& grey = s.scene.materials[s.scene.meshes[0].material];
   int tops = 0;
   for (const rc::TriangleMesh& panel : s.scene.meshes) {
@@ -248,10 +248,10 @@ TEST(Lightmap, FinalGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   EXPECT_EQ(gathered.gather_count().late, 0u);
   // Past its deadline the bake reads the solution, point for point as without a gather, and
   // counts those points.
-  rad::BakeGather late{rays, 3};
+  rad::bake::BakeGather late{rays, 3};
   late.deadline = std::chrono::steady_clock::now();
-  const rad::SolutionAtInput reading(s.scene, s.solution, rad::Quantity::irradiance);
-  const rad::SolutionAtInput past(s.scene, s.solution, rad::Quantity::irradiance, late);
+  const rad::bake::SolutionAtInput reading(s.scene, s.solution, rad::bake::Quantity::irradiance);
+  const rad::bake::SolutionAtInput past(s.scene, s.solution, rad::bake::Quantity::irradiance, late);
   const Vec3 floor_point(0.3f, 0.0f, 1.2f), up(0.0f, 1.0f, 0.0f);
   ASSERT_TRUE(reading(grey, floor_point, up).has_value());
   EXPECT_EQ(past(grey, floor_point, up)->g, reading(grey, floor_point, up)->g);
@@ -268,9 +268,9 @@ TEST(Lightmap, VertexGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   const double open = 2.0 + 0.3 * M_PI;
   const int rays = 4096;
   const double tolerance = 1e-4 * open;
-  rad::BakeGatherCount count;
-  const rad::Solution gathered = rad::gather_at_vertices(s.scene, s.solution, rad::BakeGather{rays, 3}, &count);
-  const rad::RadiosityMesh& mesh = s.solution.mesh;
+  rad::bake::BakeGatherCount count;
+  const rad::solver::Solution gathered = rad::bake::gather_at_vertices(s.scene, s.solution, rad::bake::BakeGather{rays, 3}, &count);
+  const rad::mesh::RadiosityMesh& mesh = s.solution.mesh;
   ASSERT_EQ(gathered.vertex_irradiance.size(), mesh.vertex_count());
   size_t tops = 0;
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
@@ -289,13 +289,13 @@ TEST(Lightmap, VertexGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   // Each vertex draws its own stream: the same for any thread count.
   {
     const rc::ThreadLimit one(1);
-    const rad::Solution again = rad::gather_at_vertices(s.scene, s.solution, rad::BakeGather{rays, 3});
+    const rad::solver::Solution again = rad::bake::gather_at_vertices(s.scene, s.solution, rad::bake::BakeGather{rays, 3});
     for (size_t v = 0; v < mesh.vertex_count(); ++v) EXPECT_EQ(again.vertex_irradiance[v].g, gathered.vertex_irradiance[v].g);
   }
   // Past its deadline every vertex keeps the solve's value, and is counted.
-  rad::BakeGather late{rays, 3};
+  rad::bake::BakeGather late{rays, 3};
   late.deadline = std::chrono::steady_clock::now();
-  const rad::Solution kept = rad::gather_at_vertices(s.scene, s.solution, late, &count);
+  const rad::solver::Solution kept = rad::bake::gather_at_vertices(s.scene, s.solution, late, &count);
   EXPECT_EQ(count.late, mesh.vertex_count());
   EXPECT_EQ(count.gathered, 0u);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) EXPECT_EQ(kept.vertex_irradiance[v].g, s.solution.vertex_irradiance[v].g);
@@ -532,7 +532,7 @@ TEST(Lightmap, TheInputsOwnUvSetIsUsedWhenItCanHoldTheLightmap) {
   // TEXCOORD_0, as a tiling or mirrored texture's).
   for (const Case c : {Case{true, false, 1}, Case{false, true, 0}, Case{false, false, -1}}) {
     const Solved s = solve(write_uv_model(dir, c.uv1, c.uv0_apart), 400);
-    const rad::Lightmap lm = rad::bake_lightmap(s.scene, s.solution, rad::Quantity::irradiance, 128);
+    const rad::bake::Lightmap lm = rad::bake::bake_lightmap(s.scene, s.solution, rad::bake::Quantity::irradiance, 128);
     EXPECT_EQ(lm.stats.uv_set, c.expected_set) << lm.stats.uv_source;
     if (c.expected_set < 0) {
       EXPECT_NE(lm.stats.uv_source.find("overlap"), std::string::npos) << lm.stats.uv_source;
@@ -686,21 +686,21 @@ TEST(Lightmap, AnAtlasTooSmallForItsChartsIsRefusedNotLeftEmpty) {
     "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}]})");
   const rc::Scene scene = rc::load_scene((dir / "scene.json").string());
   try {
-    rad::check_lightmap_layout(scene, 16);
+    rad::bake::check_lightmap_layout(scene, 16);
     ADD_FAILURE() << "a 16-texel atlas cannot hold six charts";
   } catch (const rc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("32 holds them"), std::string::npos) << e.what();
   }
-  EXPECT_NO_THROW(rad::check_lightmap_layout(scene, 32));
+  EXPECT_NO_THROW(rad::bake::check_lightmap_layout(scene, 32));
   const CliResult r = run_command(kGilt + " radiosity " + quoted(dir / "scene.json") + " --lightmap 16 -q -o " +
                                       quoted(dir / "x.glb"),
                                   dir);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("give a larger size (32 holds them)"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "x.glb"));
-  rad::SolverSettings settings;
+  rad::solver::SolverSettings settings;
   settings.mesh.elements = 50;
-  const rad::Lightmap lm = rad::bake_lightmap(scene, rad::solve(scene, settings), rad::Quantity::irradiance, 32);
+  const rad::bake::Lightmap lm = rad::bake::bake_lightmap(scene, rad::solver::solve(scene, settings), rad::bake::Quantity::irradiance, 32);
   EXPECT_EQ(lm.stats.charts, 6u);
   // Each face holds texels: at least its one texel of density, of the 32² atlas.
   EXPECT_GE(lm.stats.texels, 6u);

@@ -16,13 +16,14 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/mesh.h"
+#include "radiosity/mesh/mesh.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
 namespace gilt::radiosity {
+using namespace mesh;
 namespace {
 
 using rc::DVec3;

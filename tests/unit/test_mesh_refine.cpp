@@ -8,7 +8,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -18,7 +18,7 @@ namespace {
 
 /// Vertices lying strictly inside an edge of an element they do not belong to: T-junctions.
 /// Brute force over every vertex and edge, with a tolerance of 1e-5 of the edge's length.
-size_t count_t_junctions(const rad::RadiosityMesh& mesh) {
+size_t count_t_junctions(const rad::mesh::RadiosityMesh& mesh) {
   size_t found = 0;
   for (size_t e = 0; e < mesh.element_count(); ++e)
     for (int i = 0; i < 3; ++i) {
@@ -36,21 +36,21 @@ size_t count_t_junctions(const rad::RadiosityMesh& mesh) {
   return found;
 }
 
-double total_area(const rad::RadiosityMesh& mesh) {
+double total_area(const rad::mesh::RadiosityMesh& mesh) {
   return std::accumulate(mesh.element_area.begin(), mesh.element_area.end(), 0.0);
 }
 
-rad::RadiosityMesh cornell_mesh(int elements) {
+rad::mesh::RadiosityMesh cornell_mesh(int elements) {
   rc::Scene scene = rc::load_scene("cornell");
-  rad::MeshSettings settings;
+  rad::mesh::MeshSettings settings;
   settings.elements = elements;
-  return rad::build_mesh(scene, settings);
+  return rad::mesh::build_mesh(scene, settings);
 }
 
 }  // namespace
 
 TEST(MeshRefine, BisectionStaysConformingAndKeepsArea) {
-  rad::RadiosityMesh mesh = cornell_mesh(300);
+  rad::mesh::RadiosityMesh mesh = cornell_mesh(300);
   ASSERT_EQ(count_t_junctions(mesh), 0u) << "the input mesh already has T-junctions";
   const double area = total_area(mesh);
   const size_t elements = mesh.element_count();
@@ -58,7 +58,7 @@ TEST(MeshRefine, BisectionStaysConformingAndKeepsArea) {
   for (int round = 0; round < 3; ++round) {
     std::vector<uint32_t> marked;
     for (uint32_t e = 0; e < mesh.element_count(); e += 3) marked.push_back(e);
-    EXPECT_GT(rad::split_longest_edges(mesh, marked, 0.0f), 0u);
+    EXPECT_GT(rad::mesh::split_longest_edges(mesh, marked, 0.0f), 0u);
   }
   EXPECT_GT(mesh.element_count(), elements + elements / 2);
   EXPECT_EQ(count_t_junctions(mesh), 0u);
@@ -75,25 +75,25 @@ TEST(MeshRefine, BisectionStaysConformingAndKeepsArea) {
 }
 
 TEST(MeshRefine, MinimumEdgeStopsSplitting) {
-  rad::RadiosityMesh mesh = cornell_mesh(300);
+  rad::mesh::RadiosityMesh mesh = cornell_mesh(300);
   std::vector<uint32_t> all(mesh.element_count());
   std::iota(all.begin(), all.end(), 0u);
-  EXPECT_EQ(rad::split_longest_edges(mesh, all, 1e6f), 0u);
+  EXPECT_EQ(rad::mesh::split_longest_edges(mesh, all, 1e6f), 0u);
   EXPECT_EQ(mesh.element_count(), all.size());
 }
 
 TEST(MeshRefine, SolverRefinesShadowBoundariesAndStaysConforming) {
   const rc::Scene scene = rc::load_scene("cornell");
-  rad::SolverSettings settings;
+  rad::solver::SolverSettings settings;
   settings.mesh.elements = 400;
   settings.tolerance = 1e-2;
   settings.progress = false;
-  const rad::Solution flat = [&] {
-    rad::SolverSettings s = settings;
+  const rad::solver::Solution flat = [&] {
+    rad::solver::SolverSettings s = settings;
     s.subdivision_levels = 0;
-    return rad::solve(scene, s);
+    return rad::solver::solve(scene, s);
   }();
-  const rad::Solution refined = rad::solve(scene, settings);
+  const rad::solver::Solution refined = rad::solver::solve(scene, settings);
   EXPECT_EQ(flat.refined_elements, 0u);
   EXPECT_GT(refined.refined_elements, 0u);
   EXPECT_GT(refined.mesh.element_count(), flat.mesh.element_count());

@@ -22,15 +22,17 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/element_scene.h"
-#include "radiosity/mesh.h"
-#include "radiosity/mesh_detail.h"
-#include "radiosity/solver.h"
+#include "radiosity/mesh/element_scene.h"
+#include "radiosity/mesh/mesh.h"
+#include "radiosity/mesh/mesh_detail.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {
+using namespace mesh;
+using namespace solver;
 namespace {
 
 using rc::DVec3;

@@ -1,4 +1,4 @@
-// The visible fractions read after a stopping probe (radiosity/probe_fraction.h) are unbiased:
+// The visible fractions read after a stopping probe (radiosity/solver/probe_fraction.h) are unbiased:
 // over every outcome of the probe and the rays after it, weighted by its probability for given
 // true fractions, they average to the true fraction. Exact enumeration, no sampling, so the
 // tolerance is rounding.
@@ -8,7 +8,7 @@
 #include <array>
 #include <cmath>
 
-#include "radiosity/probe_fraction.h"
+#include "radiosity/solver/probe_fraction.h"
 
 namespace rad = gilt::radiosity;
 
@@ -34,7 +34,7 @@ TEST(ProbeFraction, ExtendedIsUnbiased) {
       for (int k = 1; k < rays; ++k) {
         const double p = (choose(rays, k) - choose(rays - probe, k - probe) - choose(rays - probe, k)) *
                          std::pow(v, k) * std::pow(1.0 - v, rays - k);
-        const double f = rad::extended_fraction(k, rays, probe);
+        const double f = rad::solver::extended_fraction(k, rays, probe);
         ASSERT_GE(f, 1.0 / probe - 1e-12);
         ASSERT_LE(f, (probe - 1.0) / probe + 1e-12);
         expected += p * f;
@@ -85,7 +85,7 @@ TEST(ProbeFraction, QuarteredIsUnbiased) {
             p *= binomial(n - 1, more, v[j]);
           }
           if (!(p > 0.0)) continue;
-          const double f = rad::quartered_fraction(hits, n);
+          const double f = rad::solver::quartered_fraction(hits, n);
           ASSERT_GE(f, 0.0);
           ASSERT_LE(f, 1.0);
           expected += p * f;

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -13,8 +13,8 @@ namespace rad = gilt::radiosity;
 
 namespace {
 
-rad::SolverSettings coarse(double tolerance, int elements) {
-  rad::SolverSettings s;
+rad::solver::SolverSettings coarse(double tolerance, int elements) {
+  rad::solver::SolverSettings s;
   s.tolerance = tolerance;
   s.mesh.elements = elements;
   s.progress = false;
@@ -32,7 +32,7 @@ TEST(Radiosity, FurnaceGivesLeOverOneMinusRho) {
     const float le = 0.5f;
     rc::Scene scene = rc::furnace_scene(le, rho);
     scene.commit();
-    const rad::Solution sol = rad::solve(scene, coarse(1e-5, 300));
+    const rad::solver::Solution sol = rad::solver::solve(scene, coarse(1e-5, 300));
     ASSERT_GT(sol.mesh.vertex_count(), 0u);
     EXPECT_TRUE(sol.convex_enclosure);
     EXPECT_EQ(sol.shadow_rays, 0u) << "a convex enclosure needs no visibility rays";
@@ -57,7 +57,7 @@ TEST(Radiosity, AmbientTermCompletesAPartialFurnace) {
   const float le = 0.5f, rho = 0.8f;
   rc::Scene scene = rc::furnace_scene(le, rho);
   scene.commit();
-  const rad::Solution sol = rad::solve(scene, coarse(5e-2, 300));
+  const rad::solver::Solution sol = rad::solver::solve(scene, coarse(5e-2, 300));
   ASSERT_GT(sol.residual, 1e-2);
   const double expected = le / (1.0 - rho);
   double partial_error = 0.0, display_error = 0.0, area = 0.0;
@@ -81,7 +81,7 @@ TEST(Radiosity, AmbientTermCompletesAPartialFurnace) {
 TEST(Radiosity, StableAtAlbedo099) {
   rc::Scene scene = rc::furnace_scene(1.0f, 0.99f);
   scene.commit();
-  const rad::Solution sol = rad::solve(scene, coarse(1e-3, 120));
+  const rad::solver::Solution sol = rad::solver::solve(scene, coarse(1e-3, 120));
   EXPECT_LT(sol.residual, 1e-3);
   for (size_t v = 0; v < sol.mesh.vertex_count(); ++v) {
     const rc::Rgb l = sol.vertex_radiance(v);
@@ -111,7 +111,7 @@ double closed_cornell_imbalance(int elements) {
   front.material = scene.meshes[0].material;  // the floor's white
   scene.meshes.push_back(front);
   scene.commit();
-  const rad::Solution sol = rad::solve(scene, coarse(1e-5, elements));
+  const rad::solver::Solution sol = rad::solver::solve(scene, coarse(1e-5, elements));
   EXPECT_FALSE(sol.convex_enclosure) << "the blocks occlude";
   EXPECT_GT(sol.shadow_rays, 0u);
   double emitted = 0.0, absorbed = 0.0;

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "radiosity/budget.h"
-#include "radiosity/mesh.h"
+#include "radiosity/solver/budget.h"
+#include "radiosity/mesh/mesh.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -12,8 +12,8 @@ namespace rad = gilt::radiosity;
 
 namespace {
 
-rad::SolverSettings quiet() {
-  rad::SolverSettings s;
+rad::solver::SolverSettings quiet() {
+  rad::solver::SolverSettings s;
   s.progress = false;
   s.subdivision_levels = 0;  // the element counts asked for are the counts meshed
   return s;
@@ -23,24 +23,24 @@ rad::SolverSettings quiet() {
 
 // The cost model: n² from the pilot's point, capped, nothing without time or a pilot.
 TEST(RadiosityBudget, FittedCountGrowsAsTheSquareRootOfTheTime) {
-  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.4, 4000.0), 2000.0);
-  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 0.025, 4000.0), 500.0);
-  EXPECT_DOUBLE_EQ(rad::fitted_elements(1000, 0.1, 1e6, 4000.0), 4000.0);
-  EXPECT_EQ(rad::fitted_elements(1000, 0.1, 0.0, 4000.0), 0.0);
-  EXPECT_EQ(rad::fitted_elements(1000, 0.1, -1.0, 4000.0), 0.0);
-  EXPECT_EQ(rad::fitted_elements(1000, 0.0, 1.0, 4000.0), 0.0);
-  EXPECT_EQ(rad::fitted_elements(0, 0.1, 1.0, 4000.0), 0.0);
+  EXPECT_DOUBLE_EQ(rad::solver::fitted_elements(1000, 0.1, 0.4, 4000.0), 2000.0);
+  EXPECT_DOUBLE_EQ(rad::solver::fitted_elements(1000, 0.1, 0.025, 4000.0), 500.0);
+  EXPECT_DOUBLE_EQ(rad::solver::fitted_elements(1000, 0.1, 1e6, 4000.0), 4000.0);
+  EXPECT_EQ(rad::solver::fitted_elements(1000, 0.1, 0.0, 4000.0), 0.0);
+  EXPECT_EQ(rad::solver::fitted_elements(1000, 0.1, -1.0, 4000.0), 0.0);
+  EXPECT_EQ(rad::solver::fitted_elements(1000, 0.0, 1.0, 4000.0), 0.0);
+  EXPECT_EQ(rad::solver::fitted_elements(0, 0.1, 1.0, 4000.0), 0.0);
 }
 
 // A long budget gets the default mesh, not a finer one.
 TEST(RadiosityBudget, ALongBudgetGetsTheDefaultMesh) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::BudgetFit fit;
-  const rad::Solution fitted = rad::solve_within(scene, quiet(), 1e5, &fit);
-  const rad::Solution plain = rad::solve(scene, quiet());
+  rad::solver::BudgetFit fit;
+  const rad::solver::Solution fitted = rad::solver::solve_within(scene, quiet(), 1e5, &fit);
+  const rad::solver::Solution plain = rad::solver::solve(scene, quiet());
   ASSERT_GT(fit.requested_elements, 0);
-  EXPECT_NEAR(double(fit.requested_elements), rad::kDefaultElements, 1.0);
+  EXPECT_NEAR(double(fit.requested_elements), rad::mesh::kDefaultElements, 1.0);
   EXPECT_EQ(fitted.mesh.element_count(), plain.mesh.element_count());
 }
 
@@ -48,10 +48,10 @@ TEST(RadiosityBudget, ALongBudgetGetsTheDefaultMesh) {
 TEST(RadiosityBudget, AMeshSizeTheUserSetIsKept) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::SolverSettings s = quiet();
+  rad::solver::SolverSettings s = quiet();
   s.mesh.elements = 600;
-  rad::BudgetFit fit;
-  const rad::Solution sol = rad::solve_within(scene, s, 30.0, &fit);
+  rad::solver::BudgetFit fit;
+  const rad::solver::Solution sol = rad::solver::solve_within(scene, s, 30.0, &fit);
   EXPECT_FALSE(fit.fitted);
   EXPECT_EQ(fit.pilot_elements, 0u);
   EXPECT_TRUE(fit.note.empty());
@@ -63,10 +63,10 @@ TEST(RadiosityBudget, AMeshSizeTheUserSetIsKept) {
 TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::BudgetFit fit;
-  const rad::Solution sol = rad::solve_within(scene, quiet(), 2.0, &fit);
+  rad::solver::BudgetFit fit;
+  const rad::solver::Solution sol = rad::solver::solve_within(scene, quiet(), 2.0, &fit);
   EXPECT_TRUE(fit.fitted);
-  EXPECT_NEAR(double(fit.pilot_elements), rad::kPilotElements, 0.2 * rad::kPilotElements);
+  EXPECT_NEAR(double(fit.pilot_elements), rad::solver::kPilotElements, 0.2 * rad::solver::kPilotElements);
   EXPECT_FALSE(fit.note.empty());
   if (fit.requested_elements == 0) {
     EXPECT_EQ(sol.mesh.element_count(), fit.pilot_elements);
@@ -75,9 +75,9 @@ TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
     // The final solve meshes at the request: its mesh is the one build_mesh makes for it. (How
     // near a request the mesher lands depends on the count, as whole edges divide the walls: not
     // this test's concern, and the request itself depends on this machine's speed.)
-    rad::SolverSettings asked = quiet();
+    rad::solver::SolverSettings asked = quiet();
     asked.mesh.elements = fit.requested_elements;
-    EXPECT_EQ(sol.mesh.element_count(), rad::build_mesh(scene, asked.mesh).element_count());
+    EXPECT_EQ(sol.mesh.element_count(), rad::mesh::build_mesh(scene, asked.mesh).element_count());
   }
 }
 
@@ -85,8 +85,8 @@ TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
 TEST(RadiosityBudget, NoPilotWithoutABudgetOrOnALargeInput) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::BudgetFit fit;
-  rad::solve_within(scene, quiet(), 0.0, &fit);
+  rad::solver::BudgetFit fit;
+  rad::solver::solve_within(scene, quiet(), 0.0, &fit);
   EXPECT_EQ(fit.pilot_elements, 0u);
 
   rc::Scene fine;
@@ -107,8 +107,8 @@ TEST(RadiosityBudget, NoPilotWithoutABudgetOrOnALargeInput) {
   lamp.material = 1;
   fine.meshes.push_back(lamp);
   fine.commit();
-  ASSERT_GE(fine.triangle_count(), size_t(rad::kPilotElements / 2));
-  rad::solve_within(fine, quiet(), 30.0, &fit);
+  ASSERT_GE(fine.triangle_count(), size_t(rad::solver::kPilotElements / 2));
+  rad::solver::solve_within(fine, quiet(), 30.0, &fit);
   EXPECT_EQ(fit.pilot_elements, 0u);
   EXPECT_FALSE(fit.fitted);
 }

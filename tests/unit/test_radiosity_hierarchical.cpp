@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "radiosity/solver.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/io/scene_io.h"
@@ -15,8 +15,8 @@ namespace rad = gilt::radiosity;
 
 namespace {
 
-rad::SolverSettings settings(rad::SolverKind kind, int elements, int subdivision_levels = 2) {
-  rad::SolverSettings s;
+rad::solver::SolverSettings settings(rad::solver::SolverKind kind, int elements, int subdivision_levels = 2) {
+  rad::solver::SolverSettings s;
   s.solver = kind;
   s.mesh.elements = elements;
   s.subdivision_levels = subdivision_levels;
@@ -26,7 +26,7 @@ rad::SolverSettings settings(rad::SolverKind kind, int elements, int subdivision
 
 /// Area-weighted mean of the vertex radiance over the elements (each element the mean of its
 /// vertices), channel mean.
-double mean_radiance(const rad::Solution& sol) {
+double mean_radiance(const rad::solver::Solution& sol) {
   double sum = 0.0, area = 0.0;
   for (size_t e = 0; e < sol.mesh.element_count(); ++e) {
     const auto& el = sol.mesh.elements[e];
@@ -75,12 +75,12 @@ rc::Scene lit_room(const rc::TriangleMesh& boxes) {
 }  // namespace
 
 /// Worst relative error of any vertex's radiance against Le / (1 − ρ) in the furnace.
-double furnace_error(float rho, const rad::SolverSettings& s) {
+double furnace_error(float rho, const rad::solver::SolverSettings& s) {
   const float le = 0.5f;
   rc::Scene scene = rc::furnace_scene(le, rho);
   scene.commit();
-  const rad::Solution sol = rad::solve(scene, s);
-  EXPECT_EQ(sol.solver, rad::SolverKind::hierarchical);
+  const rad::solver::Solution sol = rad::solver::solve(scene, s);
+  EXPECT_EQ(sol.solver, rad::solver::SolverKind::hierarchical);
   EXPECT_GT(sol.links, 0u);
   EXPECT_TRUE(sol.final_gather);
   EXPECT_EQ(sol.shadow_rays, 0u) << "a convex enclosure needs no visibility rays";
@@ -102,7 +102,7 @@ double furnace_error(float rho, const rad::SolverSettings& s) {
 // under 0.3 % there (the progressive solver's furnace bound is 0.2 %).
 TEST(HierarchicalRadiosity, FurnaceGivesLeOverOneMinusRho) {
   for (float rho : {0.5f, 0.9f}) {
-    rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 600);
+    rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 600);
     s.tolerance = 1e-5;
     const double loose = furnace_error(rho, s);
     s.hierarchical.gather_tolerance = 5e-4;
@@ -127,14 +127,14 @@ TEST(HierarchicalRadiosity, CoarseLinksDoNotBrightenTheFurnace) {
   const float le = 0.5f, rho = 0.8f;
   rc::Scene scene = rc::furnace_scene(le, rho);
   scene.commit();
-  rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 3000, 0);
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 3000, 0);
   s.tolerance = 1e-5;
-  s.hierarchical.final_gather = rad::FinalGather::never;
+  s.hierarchical.final_gather = rad::solver::FinalGather::never;
   const double expected = le / (1.0 - rho);
   s.hierarchical.link_tolerance = 2e-4;
-  const double coarse = mean_radiance(rad::solve(scene, s)) / expected;
+  const double coarse = mean_radiance(rad::solver::solve(scene, s)) / expected;
   s.hierarchical.link_tolerance = 2e-6;
-  const double fine = mean_radiance(rad::solve(scene, s)) / expected;
+  const double fine = mean_radiance(rad::solver::solve(scene, s)) / expected;
   RecordProperty("coarse_mean_over_answer", std::to_string(coarse));
   RecordProperty("fine_mean_over_answer", std::to_string(fine));
   EXPECT_NEAR(coarse, 1.0, 0.01);
@@ -152,13 +152,13 @@ TEST(HierarchicalRadiosity, CoarseLinksDoNotBrightenTheFurnace) {
 TEST(HierarchicalRadiosity, StoppedIterationKeepsItsTolerance) {
   rc::Scene scene = rc::furnace_scene(0.5f, 0.8f);
   scene.commit();
-  rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 600, 0);
-  s.hierarchical.final_gather = rad::FinalGather::never;
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 600, 0);
+  s.hierarchical.final_gather = rad::solver::FinalGather::never;
   s.hierarchical.link_tolerance = 2e-7;
   s.tolerance = 1e-2;
-  const rad::Solution stopped = rad::solve(scene, s);
+  const rad::solver::Solution stopped = rad::solver::solve(scene, s);
   s.tolerance = 1e-6;
-  const rad::Solution converged = rad::solve(scene, s);
+  const rad::solver::Solution converged = rad::solver::solve(scene, s);
   EXPECT_LE(converged.iterations, 30) << "plain Jacobi steps need about 66";
   EXPECT_LT(stopped.iterations + 10, converged.iterations);
   const double ratio = mean_radiance(stopped) / mean_radiance(converged);
@@ -167,7 +167,7 @@ TEST(HierarchicalRadiosity, StoppedIterationKeepsItsTolerance) {
 }
 
 /// Mean over vertices of |b − a| / a, where a is lit.
-double mean_relative_difference(const rad::Solution& a, const rad::Solution& b) {
+double mean_relative_difference(const rad::solver::Solution& a, const rad::solver::Solution& b) {
   double rel = 0.0;
   size_t n = 0;
   for (size_t v = 0; v < a.mesh.vertex_count(); ++v) {
@@ -189,12 +189,12 @@ double mean_relative_difference(const rad::Solution& a, const rad::Solution& b) 
 TEST(HierarchicalRadiosity, AgreesWithProgressiveOnCornell) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::SolverSettings s = settings(rad::SolverKind::progressive, 1500, 0);
-  const rad::Solution p0 = rad::solve(scene, s);
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::progressive, 1500, 0);
+  const rad::solver::Solution p0 = rad::solver::solve(scene, s);
   s.seed = 1;
-  const rad::Solution p1 = rad::solve(scene, s);
-  s.solver = rad::SolverKind::hierarchical;
-  const rad::Solution h = rad::solve(scene, s);
+  const rad::solver::Solution p1 = rad::solver::solve(scene, s);
+  s.solver = rad::solver::SolverKind::hierarchical;
+  const rad::solver::Solution h = rad::solver::solve(scene, s);
   ASSERT_EQ(p0.mesh.vertex_count(), h.mesh.vertex_count()) << "the same mesh";
   ASSERT_EQ(p0.mesh.vertex_count(), p1.mesh.vertex_count());
   const double noise = mean_relative_difference(p0, p1), difference = mean_relative_difference(p0, h);
@@ -210,11 +210,11 @@ TEST(HierarchicalRadiosity, AgreesWithProgressiveOnCornell) {
 TEST(HierarchicalRadiosity, IdenticalForAnyThreadCount) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 800);
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 800);
   s.threads = 1;
-  const rad::Solution one = rad::solve(scene, s);
+  const rad::solver::Solution one = rad::solver::solve(scene, s);
   s.threads = 2;
-  const rad::Solution two = rad::solve(scene, s);
+  const rad::solver::Solution two = rad::solver::solve(scene, s);
   ASSERT_EQ(one.vertex_irradiance.size(), two.vertex_irradiance.size());
   EXPECT_EQ(one.links, two.links);
   for (size_t v = 0; v < one.vertex_irradiance.size(); ++v)
@@ -228,8 +228,8 @@ TEST(HierarchicalRadiosity, IdenticalForAnyThreadCount) {
 TEST(HierarchicalRadiosity, LinksGrowSlowerThanTheElements) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  const rad::Solution small = rad::solve(scene, settings(rad::SolverKind::hierarchical, 1000, 0));
-  const rad::Solution large = rad::solve(scene, settings(rad::SolverKind::hierarchical, 8000, 0));
+  const rad::solver::Solution small = rad::solver::solve(scene, settings(rad::solver::SolverKind::hierarchical, 1000, 0));
+  const rad::solver::Solution large = rad::solver::solve(scene, settings(rad::solver::SolverKind::hierarchical, 8000, 0));
   const double elements = double(large.mesh.element_count()) / double(small.mesh.element_count());
   const double links = double(large.links) / double(small.links);
   RecordProperty("element_ratio", std::to_string(elements));
@@ -242,13 +242,13 @@ TEST(HierarchicalRadiosity, LinksGrowSlowerThanTheElements) {
 
 // `automatic` picks by the element count, and says why.
 TEST(HierarchicalRadiosity, AutomaticChoosesByElementCount) {
-  rad::SolverSettings s;
+  rad::solver::SolverSettings s;
   std::string why;
-  EXPECT_EQ(rad::choose_solver(s, 1000, &why), rad::SolverKind::progressive);
+  EXPECT_EQ(rad::solver::choose_solver(s, 1000, &why), rad::solver::SolverKind::progressive);
   EXPECT_FALSE(why.empty());
-  EXPECT_EQ(rad::choose_solver(s, rad::kHierarchicalElements, &why), rad::SolverKind::hierarchical);
-  s.solver = rad::SolverKind::progressive;
-  EXPECT_EQ(rad::choose_solver(s, 10 * rad::kHierarchicalElements), rad::SolverKind::progressive);
+  EXPECT_EQ(rad::solver::choose_solver(s, rad::solver::kHierarchicalElements, &why), rad::solver::SolverKind::hierarchical);
+  s.solver = rad::solver::SolverKind::progressive;
+  EXPECT_EQ(rad::solver::choose_solver(s, 10 * rad::solver::kHierarchicalElements), rad::solver::SolverKind::progressive);
 }
 
 // A closed room crowded with a grid of boxes, lit by a lamp: many of the faces that turn towards
@@ -273,11 +273,11 @@ TEST(HierarchicalRadiosity, PartlyHiddenFacesAgreeWithProgressive) {
   }
   const rc::Scene scene = lit_room(boxes);
 
-  rad::SolverSettings hs = settings(rad::SolverKind::hierarchical, 4000, 0);
-  hs.hierarchical.final_gather = rad::FinalGather::never;
+  rad::solver::SolverSettings hs = settings(rad::solver::SolverKind::hierarchical, 4000, 0);
+  hs.hierarchical.final_gather = rad::solver::FinalGather::never;
   hs.hierarchical.link_tolerance = 2e-4;
-  const rad::Solution h = rad::solve(scene, hs);
-  const rad::Solution p = rad::solve(scene, settings(rad::SolverKind::progressive, 4000, 0));
+  const rad::solver::Solution h = rad::solver::solve(scene, hs);
+  const rad::solver::Solution p = rad::solver::solve(scene, settings(rad::solver::SolverKind::progressive, 4000, 0));
   std::printf("hierarchical: %zu links, %d iterations, residual %g\n", h.links, h.iterations, h.residual);
   ASSERT_EQ(h.mesh.vertex_count(), p.mesh.vertex_count());
   double sum_h = 0.0, sum_p = 0.0;
@@ -305,7 +305,7 @@ TEST(HierarchicalRadiosity, OverlappingBoxesOverTheFloorConverge) {
     box(boxes, c - rc::Vec3(half.x, -0.001f, half.z), c + half * rc::Vec3(1.0f, 2.0f, 1.0f), false);
   }
   const rc::Scene scene = lit_room(boxes);
-  const rad::Solution sol = rad::solve(scene, settings(rad::SolverKind::hierarchical, 4000, 0));
+  const rad::solver::Solution sol = rad::solver::solve(scene, settings(rad::solver::SolverKind::hierarchical, 4000, 0));
   std::printf("%d iterations, residual %g\n", sol.iterations, sol.residual);
   EXPECT_LT(sol.residual, 1e-3);
   const double bound = 0.7 / (1.0 - 0.7) * rc::kPi * 20.0;
@@ -322,12 +322,12 @@ TEST(HierarchicalRadiosity, OverlappingBoxesOverTheFloorConverge) {
 TEST(HierarchicalRadiosity, FinalGatherModes) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 1000, 0);
-  const rad::Solution automatic = rad::solve(scene, s);
-  s.hierarchical.final_gather = rad::FinalGather::always;
-  const rad::Solution always = rad::solve(scene, s);
-  s.hierarchical.final_gather = rad::FinalGather::never;
-  const rad::Solution never = rad::solve(scene, s);
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 1000, 0);
+  const rad::solver::Solution automatic = rad::solver::solve(scene, s);
+  s.hierarchical.final_gather = rad::solver::FinalGather::always;
+  const rad::solver::Solution always = rad::solver::solve(scene, s);
+  s.hierarchical.final_gather = rad::solver::FinalGather::never;
+  const rad::solver::Solution never = rad::solver::solve(scene, s);
   EXPECT_TRUE(automatic.final_gather) << automatic.final_gather_note;
   EXPECT_EQ(automatic.final_gather_note, "at every vertex");
   EXPECT_TRUE(always.final_gather);
@@ -352,12 +352,12 @@ TEST(HierarchicalRadiosity, FinalGatherModes) {
 TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
   rc::Scene scene = rc::builtin_scene("cornell");
   scene.commit();
-  rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 1500, 0);
-  const rad::Solution untimed = rad::solve(scene, s);
-  EXPECT_DOUBLE_EQ(untimed.link_tolerance, rad::kDefaultLinkTolerance);
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 1500, 0);
+  const rad::solver::Solution untimed = rad::solver::solve(scene, s);
+  EXPECT_DOUBLE_EQ(untimed.link_tolerance, rad::solver::kDefaultLinkTolerance);
   s.time_limit = 600.0;
-  const rad::Solution ample = rad::solve(scene, s);
-  EXPECT_DOUBLE_EQ(ample.link_tolerance, rad::kDefaultLinkTolerance);
+  const rad::solver::Solution ample = rad::solver::solve(scene, s);
+  EXPECT_DOUBLE_EQ(ample.link_tolerance, rad::solver::kDefaultLinkTolerance);
   EXPECT_FALSE(ample.linking_stopped);
   // Each level of the ladder refines the pairs the last one accepted: the split decisions above
   // them are those of linking from the root, and a pair's visibility rays are keyed by the pair,
@@ -370,8 +370,8 @@ TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
   ASSERT_EQ(untimed.ladder.size(), 1u);
   ASSERT_EQ(ample.ladder.size(), 4u);
   for (size_t l = 0; l < ample.ladder.size(); ++l) {
-    const rad::LadderLevel& level = ample.ladder[l];
-    EXPECT_NEAR(level.link_tolerance, rad::kDefaultLinkTolerance * std::pow(10.0, 3.0 - double(l)),
+    const rad::solver::LadderLevel& level = ample.ladder[l];
+    EXPECT_NEAR(level.link_tolerance, rad::solver::kDefaultLinkTolerance * std::pow(10.0, 3.0 - double(l)),
                 1e-6 * level.link_tolerance);
     EXPECT_LT(level.residual, (l + 1 < ample.ladder.size() ? 10.0 : 1.0) * s.hierarchical.tolerance);
     EXPECT_EQ(level.finishing_iterations, 0);
@@ -382,7 +382,7 @@ TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
   EXPECT_EQ(ample.ladder.back().links, ample.links);
   EXPECT_EQ(untimed.ladder[0].links, untimed.links);
   s.time_limit = 1e-6;
-  const rad::Solution none = rad::solve(scene, s);
+  const rad::solver::Solution none = rad::solver::solve(scene, s);
   EXPECT_FALSE(none.final_gather);
   for (const rc::Rgb& e : none.vertex_irradiance)
     for (int k = 0; k < 3; ++k) ASSERT_TRUE(std::isfinite(e[k]) && e[k] >= 0.0f);
@@ -414,10 +414,10 @@ TEST(HierarchicalRadiosity, NoLightLeaksThroughAThickRoof) {
   scene.punctual_lights.push_back(sky);
   scene.commit();
   constexpr double tolerance = 2e-3;
-  rad::SolverSettings s = settings(rad::SolverKind::hierarchical, 8000, 0);
+  rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 8000, 0);
   s.hierarchical.link_tolerance = tolerance;
-  s.hierarchical.final_gather = rad::FinalGather::never;
-  const rad::Solution sol = rad::solve(scene, s);
+  s.hierarchical.final_gather = rad::solver::FinalGather::never;
+  const rad::solver::Solution sol = rad::solver::solve(scene, s);
   double inside = 0.0, total = 0.0;
   for (size_t e = 0; e < sol.mesh.element_count(); ++e) {
     const auto& el = sol.mesh.elements[e];
@@ -462,11 +462,11 @@ TEST(HierarchicalRadiosity, ABallsFacesTakeTheLightOfTheirOwnSide) {
     }
   const rc::Scene scene = lit_room(ball);
 
-  rad::SolverSettings hs = settings(rad::SolverKind::hierarchical, 4000, 0);
-  hs.hierarchical.final_gather = rad::FinalGather::never;
+  rad::solver::SolverSettings hs = settings(rad::solver::SolverKind::hierarchical, 4000, 0);
+  hs.hierarchical.final_gather = rad::solver::FinalGather::never;
   hs.hierarchical.link_tolerance = 2e-4;
-  const rad::Solution h = rad::solve(scene, hs);
-  const rad::Solution p = rad::solve(scene, settings(rad::SolverKind::progressive, 4000, 0));
+  const rad::solver::Solution h = rad::solver::solve(scene, hs);
+  const rad::solver::Solution p = rad::solver::solve(scene, settings(rad::solver::SolverKind::progressive, 4000, 0));
   ASSERT_EQ(h.mesh.element_count(), p.mesh.element_count());
   // Reflected irradiance (the direct light left out) over each half of the ball, area-weighted.
   double up_h = 0.0, up_p = 0.0, down_h = 0.0, down_p = 0.0;

@@ -7,9 +7,9 @@
 #include <tuple>
 #include <utility>
 
-#include "radiosity/solver.h"
-#include "radiosity/view.h"
-#include "radiosity/element_scene.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/bake/view.h"
+#include "radiosity/mesh/element_scene.h"
 #include "raytrace_core/path_tracer.h"
 
 namespace rc = gilt::raytrace_core;
@@ -30,7 +30,7 @@ rc::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 /// Gives `scene` (its meshes added, all of material 0) a white diffuse material (0.8) and a sun
 /// of unit irradiance travelling along `sun_direction`, commits it, and solves it with elements
 /// of at most `max_edge`.
-rad::Solution solve_sunlit(rc::Scene& scene, Vec3 sun_direction, float max_edge) {
+rad::solver::Solution solve_sunlit(rc::Scene& scene, Vec3 sun_direction, float max_edge) {
   scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
   rc::Light sun;
   sun.kind = rc::LightKind::directional;
@@ -38,10 +38,10 @@ rad::Solution solve_sunlit(rc::Scene& scene, Vec3 sun_direction, float max_edge)
   sun.irradiance = Rgb(1.0f);
   scene.punctual_lights.push_back(sun);
   scene.commit();
-  rad::SolverSettings settings;
+  rad::solver::SolverSettings settings;
   settings.mesh.max_edge = max_edge;
   settings.progress = false;
-  return rad::solve(scene, settings);
+  return rad::solver::solve(scene, settings);
 }
 
 }  // namespace
@@ -59,8 +59,8 @@ TEST(RadiosityView, DoesNotReadTheSolutionThroughASurface) {
   scene.meshes.push_back(quad({-0.5f, -0.3f, -0.5f}, {0.5f, -0.3f, -0.5f}, {0.5f, -0.3f, 0.5f},
                               {-0.5f, -0.3f, 0.5f}));                                   // plate, down
   // Elements of 0.5: the view looks up to 1.0 away, so the floor is within reach of the plate.
-  const rad::Solution sol = solve_sunlit(scene, Vec3(-1.0f, -1.0f, 0.2f), 0.5f);
-  const rad::RadiosityView view(scene, sol, rad::ViewMode::two_pass, false);
+  const rad::solver::Solution sol = solve_sunlit(scene, Vec3(-1.0f, -1.0f, 0.2f), 0.5f);
+  const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f);
   const rc::SurfacePoint on_floor{Vec3(0.2f, 0.0f, 0.1f), Vec3(1e-6f), up};
@@ -86,10 +86,10 @@ TEST(RadiosityView, ElementSceneKeepsEveryElementsIndex) {
   scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));
   scene.commit();
-  rad::RadiosityMesh mesh;
+  rad::mesh::RadiosityMesh mesh;
   mesh.positions = {{-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {0, 0, 0}, {0.5f, 0, 0}, {1, 0, 0}};
   mesh.elements = {{4, 5, 6}, {0, 1, 2}, {0, 2, 3}};  // the first is a segment, not a triangle
-  const rc::Scene geometry = rad::element_scene(scene, mesh);
+  const rc::Scene geometry = rad::mesh::element_scene(scene, mesh);
   ASSERT_EQ(geometry.meshes[0].triangle_count(), 3u);
   const Vec3 up(0.0f, 1.0f, 0.0f);
   const struct {
@@ -129,7 +129,7 @@ struct GatherAgainstTrace {
   /// Four standard errors of the difference, both estimated from the samples.
   double tolerance() const { return 4.0 * std::hypot(gather_error, trace_error); }
 };
-GatherAgainstTrace gather_against_trace(const rc::Scene& scene, const rad::RadiosityView& view, Vec3 p, Vec3 n) {
+GatherAgainstTrace gather_against_trace(const rc::Scene& scene, const rad::bake::RadiosityView& view, Vec3 p, Vec3 n) {
   static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
   rc::PathSettings probe;
   probe.first_surface = &white;
@@ -137,7 +137,7 @@ GatherAgainstTrace gather_against_trace(const rc::Scene& scene, const rad::Radio
   GatherAgainstTrace g;
   std::tie(g.gathered, g.gather_error) = mean_and_error(kSamples, [&](int i) {
     rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(1, 0, uint64_t(i))), 0};
-    return double(view.gathered_sample(rad::mesh_surface_point(p, n), ctx).g);
+    return double(view.gathered_sample(rad::mesh::mesh_surface_point(p, n), ctx).g);
   });
   std::tie(g.traced, g.trace_error) = mean_and_error(kSamples, [&](int i) {
     rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(2, 0, uint64_t(i))), 0};
@@ -177,11 +177,11 @@ TEST(RadiosityView, AGatherUnderALowSlabAgreesWithThePathTracer) {
   sky.radiance = Rgb(0.3f);
   scene.punctual_lights = {sun, sky};
   scene.commit();
-  rad::SolverSettings settings;
+  rad::solver::SolverSettings settings;
   settings.mesh.max_edge = 0.25f;
   settings.progress = false;
-  const rad::Solution sol = rad::solve(scene, settings);
-  const rad::RadiosityView view(scene, sol, rad::ViewMode::mesh, false);
+  const rad::solver::Solution sol = rad::solver::solve(scene, settings);
+  const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::mesh, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f);
   struct Case {
@@ -227,18 +227,18 @@ TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
     Vec3 p, n;
   };
   const Case cases[] = {{Vec3(1.0f, 1.25f, 0.3f), Vec3(-1, 0, 0)}, {Vec3(0.0f, 2.5f, 0.3f), Vec3(0, -1, 0)}};
-  for (const rad::SolverKind solver : {rad::SolverKind::progressive, rad::SolverKind::hierarchical}) {
-    rad::SolverSettings settings;
+  for (const rad::solver::SolverKind solver : {rad::solver::SolverKind::progressive, rad::solver::SolverKind::hierarchical}) {
+    rad::solver::SolverSettings settings;
     settings.mesh.max_edge = 0.5f;
     settings.subdivision_levels = 0;  // as the two-pass view solves; refinement only narrows the leak
     settings.solver = solver;
     settings.progress = false;
-    const rad::Solution sol = rad::solve(scene, settings);
-    const rad::RadiosityView view(scene, sol, rad::ViewMode::mesh, false);
+    const rad::solver::Solution sol = rad::solver::solve(scene, settings);
+    const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::mesh, false);
     for (const Case& c : cases) {
       const GatherAgainstTrace g = gather_against_trace(scene, view, c.p, c.n);
       EXPECT_NEAR(g.gathered, g.traced, g.tolerance())
-          << rad::to_string(solver) << " at (" << c.p.x << ", " << c.p.y << "): the path tracer's error " << g.trace_error;
+          << rad::solver::to_string(solver) << " at (" << c.p.x << ", " << c.p.y << "): the path tracer's error " << g.trace_error;
     }
   }
 }
@@ -259,8 +259,8 @@ TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
   chip.positions = {{-0.05f, 0.53f, -0.05f}, {-0.05f, 0.53f, 0.05f}, {0.05f, 0.53f, 0.0f}};
   chip.indices = {0, 1, 2};
   scene.meshes.push_back(chip);
-  const rad::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);
-  const rad::RadiosityView view(scene, sol, rad::ViewMode::two_pass, false);
+  const rad::solver::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);
+  const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f), down(0.0f, -1.0f, 0.0f);
   const Vec3 on_canopy(0.0f, 0.5f, 0.0f);
@@ -284,8 +284,8 @@ TEST(RadiosityView, AnElementBesideThePointIsNotItsChord) {
   rc::Scene scene;
   scene.meshes.push_back(quad({0.5f, 0.02f, -0.25f}, {0.5f, 0.02f, 0.25f}, {1.0f, 0.02f, 0.25f},
                               {1.0f, 0.02f, -0.25f}));  // ledge, up
-  const rad::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);  // the bound for chords: 0.07
-  const rad::RadiosityView view(scene, sol, rad::ViewMode::two_pass, false);
+  const rad::solver::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);  // the bound for chords: 0.07
+  const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f);
   const auto at = view.locate(Vec3(0.0f), up);

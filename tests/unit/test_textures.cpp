@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "radiosity/element_albedo.h"
-#include "radiosity/mesh.h"
+#include "radiosity/mesh/element_albedo.h"
+#include "radiosity/mesh/mesh.h"
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/light.h"
@@ -418,8 +418,8 @@ TEST_F(Textures, ElementsReflectTheTexturesMeanOverThem) {
   const rc::Scene scene = textured_quad(
       rc::TextureImage{ppm("rb.ppm", 64, 1, texels), true, rc::TextureWrap::clamp, rc::TextureWrap::clamp},
       rc::Rgb(0.9f));
-  const radiosity::RadiosityMesh mesh = radiosity::build_mesh(scene, radiosity::MeshSettings{.max_edge = 0.1f});
-  const std::vector<rc::Rgb> rho = radiosity::element_reflectance(scene, mesh);
+  const radiosity::mesh::RadiosityMesh mesh = radiosity::mesh::build_mesh(scene, radiosity::mesh::MeshSettings{.max_edge = 0.1f});
+  const std::vector<rc::Rgb> rho = radiosity::mesh::element_reflectance(scene, mesh);
   ASSERT_EQ(rho.size(), mesh.element_count());
   rc::Rgb sum(0.0f);
   double area = 0.0;

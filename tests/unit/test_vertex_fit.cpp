@@ -1,8 +1,8 @@
-// Vertex colours fitted to a field over a mesh's faces (radiosity/vertex_fit.h): a linear field
+// Vertex colours fitted to a field over a mesh's faces (radiosity/bake/vertex_fit.h): a linear field
 // is reproduced by both fits, least squares is nearer a sharp field than point samples, unknown
 // points are left out, and the result is never negative.
 
-#include "radiosity/vertex_fit.h"
+#include "radiosity/bake/vertex_fit.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include <vector>
 
 namespace gilt::radiosity {
+using namespace bake;
 namespace {
 
 /// A unit square in the xy-plane cut into n × n cells of two triangles, facing +z.
