@@ -175,29 +175,13 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
   if (!keep) args->valid[0] = 0;
 }
 
-}  // namespace
 
-struct AlphaTest;
+// --- Scene::commit's passes, in the order it runs them. ---
 
-struct Scene::Impl {
-  RTCScene scene = nullptr;
-  std::vector<std::unique_ptr<AlphaTest>> alpha_tests;  // Embree's user data for cut-out meshes
-  std::vector<Sphere> spheres;  // Embree's user data: a stable copy that survives moves of Scene
-  ~Impl() {
-    if (scene) rtcReleaseScene(scene);
-  }
-};
-
-Scene::Scene() : impl_(std::make_unique<Impl>()) {}
-Scene::~Scene() = default;
-Scene::Scene(Scene&&) noexcept = default;
-Scene& Scene::operator=(Scene&&) noexcept = default;
-
-void Scene::commit() {
-  if (committed_) throw std::logic_error("Scene::commit called twice");
-  const std::string where = name.empty() ? std::string("scene") : name;
-
-  // Validate the description before anything is built.
+/// Pass 1. Reads every material and the number of textures; writes nothing. Throws InputError
+/// naming the first material whose parameters are not finite, out of range or refer to a
+/// texture that does not exist.
+void validate_materials(const std::vector<Material>& materials, size_t texture_count, const std::string& where) {
   for (size_t mi = 0; mi < materials.size(); ++mi) {
     const Material& m = materials[mi];
     const std::string id = where + ": material '" + m.name + "'";
@@ -216,83 +200,122 @@ void Scene::commit() {
       throw InputError(id + ": transmission tint must lie in [0, 1]");
     if (!std::isfinite(m.normal_scale)) throw InputError(id + ": normal map scale must be finite");
     for (const TextureRef* t : m.texture_refs()) {
-      if (t->image >= int32_t(textures.size()) || t->image < -1)
+      if (t->image >= int32_t(texture_count) || t->image < -1)
         throw InputError(id + ": refers to texture " + std::to_string(t->image) + " but there are " +
-                         std::to_string(textures.size()));
+                         std::to_string(texture_count));
       for (float x : t->map)
         if (!std::isfinite(x)) throw InputError(id + ": texture transform must be finite");
     }
     if (!(m.alpha >= 0.0f && m.alpha <= 1.0f) || !(m.alpha_cutoff >= 0.0f && m.alpha_cutoff <= 1.0f))
       throw InputError(id + ": alpha and alpha cutoff must lie in [0, 1]");
   }
-  if (!textures.empty()) texture_set_ = std::make_unique<TextureSet>(textures);
-  auto check_material = [&](uint32_t material, const std::string& what) {
-    if (material >= materials.size())
-      throw InputError(where + ": " + what + " refers to material " + std::to_string(material) + " but there are " +
-                       std::to_string(materials.size()));
-  };
+}
 
+/// Throws InputError unless `material` is the index of one of `material_count` materials.
+void check_material_index(uint32_t material, size_t material_count, const std::string& where,
+                          const std::string& what) {
+  if (material >= material_count)
+    throw InputError(where + ": " + what + " refers to material " + std::to_string(material) + " but there are " +
+                     std::to_string(material_count));
+}
+
+/// Pass 2a, for one mesh (`what` names it). Reads the mesh's arrays and the materials; writes
+/// the mesh's uvs (non-finite ones become 0) and normals (unusable ones become 0, i.e. fall back
+/// to ng), and to `warnings` when a textured material's mesh has no uvs. Throws InputError on a
+/// bad material index, index count, array size or a non-finite vertex.
+void check_mesh_arrays(TriangleMesh& mesh, const std::vector<Material>& materials, const std::string& where,
+                       const std::string& what, std::vector<std::string>& warnings) {
+  check_material_index(mesh.material, materials.size(), where, what);
+  if (mesh.indices.size() % 3 != 0) throw InputError(where + ": " + what + ": index count is not a multiple of 3");
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    throw InputError(where + ": " + what + ": has " + std::to_string(mesh.normals.size()) + " normals for " +
+                     std::to_string(mesh.positions.size()) + " positions");
+  if (mesh.uvs.empty() && mesh.material < materials.size() && materials[mesh.material].is_textured() &&
+      !mesh.indices.empty())
+    warnings.push_back(where + ": " + what + ": has no texture coordinates, so its material's texture reads one texel");
+  for (Vec2& uv : mesh.uvs)
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = Vec2(0.0f);
+  if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
+    throw InputError(where + ": " + what + ": has " + std::to_string(mesh.uvs.size()) + " texture coordinates for " +
+                     std::to_string(mesh.positions.size()) + " positions");
+  for (size_t vi = 0; vi < mesh.positions.size(); ++vi)
+    if (!finite3(mesh.positions[vi]))
+      throw InputError(where + ": " + what + ": vertex " + std::to_string(vi) + " has a NaN or infinite coordinate");
+  for (Vec3& n : mesh.normals)
+    if (!finite3(n) || glm::dot(n, n) == 0.0f) n = Vec3(0.0f);  // unusable normal: fall back to ng
+}
+
+/// Pass 2b, for one mesh (`what` names it). Reads its positions and indices; writes its indices
+/// without the triangles of no (or no finite) area, unless it keeps them (keep_degenerate).
+/// Returns how many it dropped. Throws InputError on an index past the vertices.
+size_t drop_degenerate_triangles(TriangleMesh& mesh, const std::string& where, const std::string& what) {
+  size_t dropped = 0;
+  std::vector<uint32_t> kept;
+  kept.reserve(mesh.indices.size());
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
+    if (i0 >= mesh.positions.size() || i1 >= mesh.positions.size() || i2 >= mesh.positions.size())
+      throw InputError(where + ": " + what + ": triangle " + std::to_string(t) + " refers to a vertex past the " +
+                       std::to_string(mesh.positions.size()) + " it has");
+    const Vec3 c = glm::cross(mesh.positions[i1] - mesh.positions[i0], mesh.positions[i2] - mesh.positions[i0]);
+    const float len2 = glm::dot(c, c);
+    if ((!(len2 > 0.0f) || !std::isfinite(len2)) && !mesh.keep_degenerate) {
+      ++dropped;
+      continue;
+    }
+    kept.insert(kept.end(), {i0, i1, i2});
+  }
+  mesh.indices = std::move(kept);
+  return dropped;
+}
+
+/// Pass 2c, for one mesh of material m. Reads the mesh and m's normal map; writes its tangents:
+/// none without a normal map (or uvs); else the file's (glTF's TANGENT) when it gives a usable
+/// one for every vertex, else made here.
+void prepare_tangents(TriangleMesh& mesh, const Material& m) {
+  if (!m.normal_texture.valid() || mesh.uvs.empty()) {
+    mesh.tangents.clear();
+  } else {
+    const bool usable = mesh.tangents.size() == mesh.positions.size() &&
+                        std::all_of(mesh.tangents.begin(), mesh.tangents.end(), [](const glm::vec4& t) {
+                          return std::isfinite(t.x + t.y + t.z + t.w) && glm::dot(Vec3(t), Vec3(t)) > 0.0f;
+                        });
+    if (!usable) mesh.tangents = generate_tangents(mesh, m.normal_texture);
+  }
+}
+
+/// Pass 2: passes 2a–2c over every mesh, in order. Reads and writes the meshes; reads the
+/// materials; writes to `warnings` (one line for all dropped triangles, after the meshes' own).
+void repair_meshes(std::vector<TriangleMesh>& meshes, const std::vector<Material>& materials,
+                   const std::string& where, std::vector<std::string>& warnings) {
   size_t dropped = 0;
   for (size_t gi = 0; gi < meshes.size(); ++gi) {
     TriangleMesh& mesh = meshes[gi];
     const std::string what = "mesh '" + (mesh.name.empty() ? std::to_string(gi) : mesh.name) + "'";
-    check_material(mesh.material, what);
-    if (mesh.indices.size() % 3 != 0) throw InputError(where + ": " + what + ": index count is not a multiple of 3");
-    if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
-      throw InputError(where + ": " + what + ": has " + std::to_string(mesh.normals.size()) + " normals for " +
-                       std::to_string(mesh.positions.size()) + " positions");
-    if (mesh.uvs.empty() && mesh.material < materials.size() && materials[mesh.material].is_textured() &&
-        !mesh.indices.empty())
-      warnings.push_back(where + ": " + what + ": has no texture coordinates, so its material's texture reads one texel");
-    for (Vec2& uv : mesh.uvs)
-      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = Vec2(0.0f);
-    if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
-      throw InputError(where + ": " + what + ": has " + std::to_string(mesh.uvs.size()) + " texture coordinates for " +
-                       std::to_string(mesh.positions.size()) + " positions");
-    for (size_t vi = 0; vi < mesh.positions.size(); ++vi)
-      if (!finite3(mesh.positions[vi]))
-        throw InputError(where + ": " + what + ": vertex " + std::to_string(vi) + " has a NaN or infinite coordinate");
-    for (Vec3& n : mesh.normals)
-      if (!finite3(n) || glm::dot(n, n) == 0.0f) n = Vec3(0.0f);  // unusable normal: fall back to ng
-    std::vector<uint32_t> kept;
-    kept.reserve(mesh.indices.size());
-    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-      const uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
-      if (i0 >= mesh.positions.size() || i1 >= mesh.positions.size() || i2 >= mesh.positions.size())
-        throw InputError(where + ": " + what + ": triangle " + std::to_string(t) + " refers to a vertex past the " +
-                         std::to_string(mesh.positions.size()) + " it has");
-      const Vec3 c = glm::cross(mesh.positions[i1] - mesh.positions[i0], mesh.positions[i2] - mesh.positions[i0]);
-      const float len2 = glm::dot(c, c);
-      if ((!(len2 > 0.0f) || !std::isfinite(len2)) && !mesh.keep_degenerate) {
-        ++dropped;
-        continue;
-      }
-      kept.insert(kept.end(), {i0, i1, i2});
-    }
-    mesh.indices = std::move(kept);
-    // Normal maps need a tangent frame at every vertex: the file's (glTF's TANGENT), when it
-    // gives a usable one for each, else made here.
-    const Material& m = materials[mesh.material];
-    if (!m.normal_texture.valid() || mesh.uvs.empty()) {
-      mesh.tangents.clear();
-    } else {
-      const bool usable = mesh.tangents.size() == mesh.positions.size() &&
-                          std::all_of(mesh.tangents.begin(), mesh.tangents.end(), [](const glm::vec4& t) {
-                            return std::isfinite(t.x + t.y + t.z + t.w) && glm::dot(Vec3(t), Vec3(t)) > 0.0f;
-                          });
-      if (!usable) mesh.tangents = generate_tangents(mesh, m.normal_texture);
-    }
+    check_mesh_arrays(mesh, materials, where, what, warnings);
+    dropped += drop_degenerate_triangles(mesh, where, what);
+    prepare_tangents(mesh, materials[mesh.material]);
   }
   if (dropped > 0) warnings.push_back(where + ": " + std::to_string(dropped) + " degenerate triangle(s) dropped");
+}
 
+/// Pass 3. Reads the spheres and the number of materials; writes nothing. Throws InputError on
+/// a bad material index, a non-finite centre or a radius that is not positive.
+void validate_spheres(const std::vector<Sphere>& spheres, size_t material_count, const std::string& where) {
   for (size_t si = 0; si < spheres.size(); ++si) {
     const Sphere& s = spheres[si];
-    check_material(s.material, "sphere " + std::to_string(si));
+    check_material_index(s.material, material_count, where, "sphere " + std::to_string(si));
     if (!finite3(s.center) || !std::isfinite(s.radius) || !(s.radius > 0.0f))
       throw InputError(where + ": sphere " + std::to_string(si) + ": centre must be finite and radius positive");
   }
-  for (size_t li = 0; li < punctual_lights.size(); ++li) {
-    const Light& l = punctual_lights[li];
+}
+
+/// Pass 4. Reads the punctual lights, checks them all (throws InputError on an area light, a
+/// non-finite parameter or a spot or directional light without a direction), then writes their
+/// directions normalised.
+void validate_punctual_lights(std::vector<Light>& lights, const std::string& where) {
+  for (size_t li = 0; li < lights.size(); ++li) {
+    const Light& l = lights[li];
     const std::string id = where + ": light " + std::to_string(li);
     if (l.kind == LightKind::area_triangle || l.kind == LightKind::area_sphere)
       throw InputError(id + ": area lights come from emissive materials, not the light list");
@@ -302,93 +325,162 @@ void Scene::commit() {
     if ((l.kind == LightKind::spot || l.kind == LightKind::directional) && !(glm::dot(l.direction, l.direction) > 0.0f))
       throw InputError(id + ": direction must not be zero");
   }
-  for (Light& l : punctual_lights)
+  for (Light& l : lights)
     if (glm::dot(l.direction, l.direction) > 0.0f) l.direction = glm::normalize(l.direction);
-  if (camera) camera->validate();
+}
 
-  // Build Embree's scene.
-  RTCDevice device = embree_device();
-  impl_->scene = rtcNewScene(device);
-  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-  for (size_t gi = 0; gi < meshes.size(); ++gi) {
-    const TriangleMesh& mesh = meshes[gi];
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), mesh.positions.size()));
-    for (size_t i = 0; i < mesh.positions.size(); ++i) {
-      vb[3 * i] = mesh.positions[i].x;
-      vb[3 * i + 1] = mesh.positions[i].y;
-      vb[3 * i + 2] = mesh.positions[i].z;
-    }
-    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(uint32_t), mesh.triangle_count()));
-    std::copy(mesh.indices.begin(), mesh.indices.end(), ib);
-    if (const Material& m = materials[mesh.material]; m.has_coverage()) {
-      auto test = std::make_unique<AlphaTest>();
-      test->mesh = &mesh;  // the vector's elements stay put when the Scene is moved
-      test->textures = texture_set_.get();
-      test->material = &m;
-      test->alpha_in_rgb = m.alpha_in_colour && m.alpha_texture.valid() && texture_set_ &&
-                           texture_set_->channels(m.alpha_texture.image) % 2 == 1;
-      rtcSetGeometryUserData(geom, test.get());
-      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
-      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
-      impl_->alpha_tests.push_back(std::move(test));
-    }
-    rtcCommitGeometry(geom);
-    rtcAttachGeometryByID(impl_->scene, geom, static_cast<unsigned>(gi));
-    rtcReleaseGeometry(geom);
+/// Pass 5a, for mesh `geom_id` of material m. Reads the mesh; writes a triangle geometry of it
+/// into `scene` under that id and, when m has coverage, an AlphaTest into `alpha_tests` (which
+/// keeps the addresses of mesh, m and textures: they must outlive the scene).
+void attach_mesh_geometry(RTCDevice device, RTCScene scene, const TriangleMesh& mesh, unsigned geom_id,
+                          const Material& m, const TextureSet* textures,
+                          std::vector<std::unique_ptr<AlphaTest>>& alpha_tests) {
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                         3 * sizeof(float), mesh.positions.size()));
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    vb[3 * i] = mesh.positions[i].x;
+    vb[3 * i + 1] = mesh.positions[i].y;
+    vb[3 * i + 2] = mesh.positions[i].z;
   }
-  if (!spheres.empty()) {
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-    rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(spheres.size()));
-    impl_->spheres = spheres;
-    rtcSetGeometryUserData(geom, &impl_->spheres);
-    rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
-    rtcSetGeometryIntersectFunction(geom, sphere_intersect);
-    rtcSetGeometryOccludedFunction(geom, sphere_occluded);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometryByID(impl_->scene, geom, sphere_geom_id());
-    rtcReleaseGeometry(geom);
+  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                            3 * sizeof(uint32_t), mesh.triangle_count()));
+  std::copy(mesh.indices.begin(), mesh.indices.end(), ib);
+  if (m.has_coverage()) {
+    auto test = std::make_unique<AlphaTest>();
+    test->mesh = &mesh;  // the vector's elements stay put when the Scene is moved
+    test->textures = textures;
+    test->material = &m;
+    test->alpha_in_rgb = m.alpha_in_colour && m.alpha_texture.valid() && textures &&
+                         textures->channels(m.alpha_texture.image) % 2 == 1;
+    rtcSetGeometryUserData(geom, test.get());
+    rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+    rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+    alpha_tests.push_back(std::move(test));
   }
-  rtcCommitScene(impl_->scene);
-  check_embree(device, "building the scene");
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene, geom, geom_id);
+  rtcReleaseGeometry(geom);
+}
 
-  bounds_ = Bounds3{};
+/// Pass 5b. Reads the spheres; writes their stable copy `kept` (Embree's user data) and one user
+/// geometry of them all into `scene` under `geom_id`.
+void attach_sphere_geometry(RTCDevice device, RTCScene scene, const std::vector<Sphere>& spheres,
+                            std::vector<Sphere>& kept, unsigned geom_id) {
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(spheres.size()));
+  kept = spheres;
+  rtcSetGeometryUserData(geom, &kept);
+  rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, sphere_intersect);
+  rtcSetGeometryOccludedFunction(geom, sphere_occluded);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene, geom, geom_id);
+  rtcReleaseGeometry(geom);
+}
+
+/// Pass 6. Reads the meshes' indexed vertices and the spheres; returns the box around them.
+Bounds3 geometry_bounds(const std::vector<TriangleMesh>& meshes, const std::vector<Sphere>& spheres) {
+  Bounds3 bounds{};
   for (const TriangleMesh& mesh : meshes)
-    for (uint32_t i : mesh.indices) bounds_.extend(mesh.positions[i]);
+    for (uint32_t i : mesh.indices) bounds.extend(mesh.positions[i]);
   for (const Sphere& s : spheres) {
-    bounds_.extend(s.center - Vec3(s.radius));
-    bounds_.extend(s.center + Vec3(s.radius));
+    bounds.extend(s.center - Vec3(s.radius));
+    bounds.extend(s.center + Vec3(s.radius));
   }
+  return bounds;
+}
 
-  // Lights: every emissive triangle and sphere, then the punctual lights; chosen by power.
-  lights_.clear();
-  first_light_of_mesh_.assign(meshes.size(), -1);
-  light_of_sphere_.assign(spheres.size(), -1);
+/// The light tables Scene::commit fills (its private members).
+struct LightTables {
+  std::vector<Light>& lights;
+  std::vector<int32_t>& first_light_of_mesh;
+  std::vector<int32_t>& light_of_sphere;
+  std::vector<uint32_t>& environment_lights;
+};
+
+/// Pass 7. Reads the meshes, spheres, their materials and the punctual lights; writes `out`:
+/// one light per emissive triangle (mesh by mesh), then per emissive sphere, then the punctual
+/// lights, with the index of each emissive mesh's first light, of each sphere's light and of
+/// the environment lights.
+void collect_lights(const std::vector<TriangleMesh>& meshes, const std::vector<Sphere>& spheres,
+                    const std::vector<Material>& materials, const std::vector<Light>& punctual_lights,
+                    uint32_t sphere_geom_id, const LightTables& out) {
+  out.lights.clear();
+  out.first_light_of_mesh.assign(meshes.size(), -1);
+  out.light_of_sphere.assign(spheres.size(), -1);
   for (size_t gi = 0; gi < meshes.size(); ++gi) {
     if (!materials[meshes[gi].material].is_emissive() || meshes[gi].triangle_count() == 0) continue;
-    first_light_of_mesh_[gi] = static_cast<int32_t>(lights_.size());
+    out.first_light_of_mesh[gi] = static_cast<int32_t>(out.lights.size());
     for (size_t t = 0; t < meshes[gi].triangle_count(); ++t) {
       Light l;
       l.kind = LightKind::area_triangle;
       l.geom_id = static_cast<uint32_t>(gi);
       l.prim_id = static_cast<uint32_t>(t);
-      lights_.push_back(l);
+      out.lights.push_back(l);
     }
   }
   for (size_t si = 0; si < spheres.size(); ++si) {
     if (!materials[spheres[si].material].is_emissive()) continue;
-    light_of_sphere_[si] = static_cast<int32_t>(lights_.size());
+    out.light_of_sphere[si] = static_cast<int32_t>(out.lights.size());
     Light l;
     l.kind = LightKind::area_sphere;
-    l.geom_id = sphere_geom_id();
+    l.geom_id = sphere_geom_id;
     l.prim_id = static_cast<uint32_t>(si);
-    lights_.push_back(l);
+    out.lights.push_back(l);
   }
-  lights_.insert(lights_.end(), punctual_lights.begin(), punctual_lights.end());
-  for (size_t i = lights_.size() - punctual_lights.size(); i < lights_.size(); ++i)
-    if (lights_[i].kind == LightKind::environment) environment_lights_.push_back(uint32_t(i));
+  out.lights.insert(out.lights.end(), punctual_lights.begin(), punctual_lights.end());
+  for (size_t i = out.lights.size() - punctual_lights.size(); i < out.lights.size(); ++i)
+    if (out.lights[i].kind == LightKind::environment) out.environment_lights.push_back(uint32_t(i));
+}
+}  // namespace
+
+struct AlphaTest;
+
+struct Scene::Impl {
+  RTCScene scene = nullptr;
+  std::vector<std::unique_ptr<AlphaTest>> alpha_tests;  // Embree's user data for cut-out meshes
+  std::vector<Sphere> spheres;  // Embree's user data: a stable copy that survives moves of Scene
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+  }
+};
+
+Scene::Scene() : impl_(std::make_unique<Impl>()) {}
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+// A driver over named passes (above): validate the description, repair the meshes, build
+// Embree's scene, then the bounds and the lights. Each pass throws before the next one runs.
+void Scene::commit() {
+  if (committed_) throw std::logic_error("Scene::commit called twice");
+  const std::string where = name.empty() ? std::string("scene") : name;
+
+  // Validate the description (and repair what can be) before anything is built.
+  validate_materials(materials, textures.size(), where);
+  if (!textures.empty()) texture_set_ = std::make_unique<TextureSet>(textures);
+  repair_meshes(meshes, materials, where, warnings);
+  validate_spheres(spheres, materials.size(), where);
+  validate_punctual_lights(punctual_lights, where);
+  if (camera) camera->validate();
+
+  // Build Embree's scene: mesh gi is geometry gi, the spheres one geometry after them.
+  RTCDevice device = embree_device();
+  impl_->scene = rtcNewScene(device);
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  for (size_t gi = 0; gi < meshes.size(); ++gi)
+    attach_mesh_geometry(device, impl_->scene, meshes[gi], static_cast<unsigned>(gi), materials[meshes[gi].material],
+                         texture_set_.get(), impl_->alpha_tests);
+  if (!spheres.empty()) attach_sphere_geometry(device, impl_->scene, spheres, impl_->spheres, sphere_geom_id());
+  rtcCommitScene(impl_->scene);
+  check_embree(device, "building the scene");
+
+  bounds_ = geometry_bounds(meshes, spheres);
+
+  // Lights: every emissive triangle and sphere, then the punctual lights; chosen by power.
+  collect_lights(meshes, spheres, materials, punctual_lights, sphere_geom_id(),
+                 {lights_, first_light_of_mesh_, light_of_sphere_, environment_lights_});
   committed_ = true;  // light_power needs bounds and geometry queries
   std::vector<float> power(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) power[i] = light_power(*this, lights_[i]).average();

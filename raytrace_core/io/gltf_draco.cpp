@@ -107,8 +107,8 @@ const tinygltf::Accessor& accessor(const tinygltf::Model& model, int index, cons
   return a;
 }
 
-/// Decodes and checks everything first, then changes the model: a problem leaves it as it was.
-void decode(tinygltf::Primitive& primitive, tinygltf::Model& model, const tinygltf::Value& extension) {
+/// Pass 1. Reads the primitive's mode and the extension object's shape; writes nothing.
+void check_extension(const tinygltf::Primitive& primitive, const tinygltf::Value& extension) {
   if (primitive.mode != TINYGLTF_MODE_TRIANGLES)
     problem("primitive mode " + std::to_string(primitive.mode) +
             " is not supported with Draco compression (only TRIANGLES, 4)");
@@ -117,10 +117,11 @@ void decode(tinygltf::Primitive& primitive, tinygltf::Model& model, const tinygl
   const tinygltf::Value& attributes_value = extension.Get("attributes");
   if (!view_value.IsInt()) problem("bufferView: expected an integer");
   if (!attributes_value.IsObject()) problem("attributes: expected an object");
+}
 
-  // The compressed bytes.
-  const int view_index = view_value.Get<int>();
-  const std::string view_name = "buffer view " + std::to_string(view_index);
+/// Pass 2. Reads the compressed bytes of buffer view `view_index` (`view_name`); returns the
+/// mesh Draco decodes from them, its triangles checked to refer to its vertices.
+std::unique_ptr<draco::Mesh> decode_mesh(const tinygltf::Model& model, int view_index, const std::string& view_name) {
   if (view_index < 0 || size_t(view_index) >= model.bufferViews.size())
     problem(view_name + " does not exist");
   const tinygltf::BufferView& view = model.bufferViews[size_t(view_index)];
@@ -136,83 +137,96 @@ void decode(tinygltf::Primitive& primitive, tinygltf::Model& model, const tinygl
   draco::Decoder decoder;
   auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
   if (!decoded.ok()) problem(view_name + " cannot be decoded: " + decoded.status().error_msg_string());
-  const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
+  std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
   if (!mesh) problem(view_name + " holds no mesh");
   const size_t points = mesh->num_points();
-  const size_t faces = mesh->num_faces();
   for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f)
     for (int k = 0; k < 3; ++k)
       if (mesh->face(f)[k].value() >= points)
         problem(view_name + ": a decoded triangle refers past the " + std::to_string(points) + " vertices");
+  return mesh;
+}
 
-  std::vector<Decoded> out;
-  // Indices: 3 per decoded triangle, in the accessor's component type.
-  if (primitive.indices >= 0) {
-    const std::string name = "indices";
-    const tinygltf::Accessor& a = accessor(model, primitive.indices, name);
-    if (a.type != TINYGLTF_TYPE_SCALAR)
-      problem(name + ": " + accessor_name(primitive.indices) + " is not SCALAR");
-    if (a.count != 3 * faces)
-      problem(name + ": " + accessor_name(primitive.indices) + " has count " + std::to_string(a.count) +
-              ", but the Draco data decodes to " + std::to_string(faces) + " triangles (" +
-              std::to_string(3 * faces) + " indices)");
-    const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
-    if (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-        a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-        a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-      problem(name + ": must be unsigned byte, short or int, not component type " +
-              std::to_string(a.componentType));
-    if (points > 0 && size < 4 && points - 1 > (size_t(1) << (8 * size)) - 1)
-      problem(name + ": the " + std::to_string(points) + " decoded vertices cannot be indexed with " +
-              std::to_string(size) + "-byte indices");
-    std::vector<unsigned char> bytes(3 * faces * size_t(size));
-    unsigned char* at = bytes.data();
-    for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f)
-      for (int k = 0; k < 3; ++k, at += size) {
-        const uint32_t v = mesh->face(f)[k].value();
-        if (size == 1) {
-          *at = uint8_t(v);
-        } else if (size == 2) {
-          const uint16_t v16 = uint16_t(v);
-          std::memcpy(at, &v16, 2);
-        } else {
-          std::memcpy(at, &v, 4);
-        }
+/// Pass 3a, for a primitive with indices. Reads its index accessor and the mesh's triangles;
+/// returns 3 indices per triangle in the accessor's component type, once checked to fit it.
+Decoded decode_indices(const tinygltf::Primitive& primitive, const tinygltf::Model& model, const draco::Mesh& mesh) {
+  const size_t points = mesh.num_points();
+  const size_t faces = mesh.num_faces();
+  const std::string name = "indices";
+  const tinygltf::Accessor& a = accessor(model, primitive.indices, name);
+  if (a.type != TINYGLTF_TYPE_SCALAR)
+    problem(name + ": " + accessor_name(primitive.indices) + " is not SCALAR");
+  if (a.count != 3 * faces)
+    problem(name + ": " + accessor_name(primitive.indices) + " has count " + std::to_string(a.count) +
+            ", but the Draco data decodes to " + std::to_string(faces) + " triangles (" +
+            std::to_string(3 * faces) + " indices)");
+  const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+  if (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+      a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+      a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+    problem(name + ": must be unsigned byte, short or int, not component type " + std::to_string(a.componentType));
+  if (points > 0 && size < 4 && points - 1 > (size_t(1) << (8 * size)) - 1)
+    problem(name + ": the " + std::to_string(points) + " decoded vertices cannot be indexed with " +
+            std::to_string(size) + "-byte indices");
+  std::vector<unsigned char> bytes(3 * faces * size_t(size));
+  unsigned char* at = bytes.data();
+  for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k, at += size) {
+      const uint32_t v = mesh.face(f)[k].value();
+      if (size == 1) {
+        *at = uint8_t(v);
+      } else if (size == 2) {
+        const uint16_t v16 = uint16_t(v);
+        std::memcpy(at, &v16, 2);
+      } else {
+        std::memcpy(at, &v, 4);
       }
-    out.push_back({primitive.indices, std::move(bytes), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER});
-  } else {
-    // Without indices the vertices are read three by three: the decoded triangles must be so.
-    for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f)
-      for (int k = 0; k < 3; ++k)
-        if (mesh->face(f)[k].value() != 3 * f.value() + uint32_t(k))
-          problem("the primitive has no indices, but its Draco data is an indexed mesh");
-    if (points != 3 * faces) problem("the primitive has no indices, but its Draco data has unused vertices");
-  }
+    }
+  return {primitive.indices, std::move(bytes), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER};
+}
 
-  // Attributes: one value per decoded vertex, in the accessor's component type.
-  for (const std::string& name : attributes_value.Keys()) {
-    const tinygltf::Value& id_value = attributes_value.Get(name);
-    if (!id_value.IsInt() || id_value.Get<int>() < 0)
-      problem("attributes." + name + ": expected a Draco attribute id (a non-negative integer)");
-    const int id = id_value.Get<int>();
-    const auto found = primitive.attributes.find(name);
-    if (found == primitive.attributes.end()) problem(name + ": not among the primitive's attributes");
-    const tinygltf::Accessor& a = accessor(model, found->second, name);
-    const draco::PointAttribute* attribute = mesh->GetAttributeByUniqueId(uint32_t(id));
-    if (!attribute) problem(name + ": the Draco data has no attribute with id " + std::to_string(id));
-    const int components = attribute->num_components();
-    if (components < 1 || components > 4 || components != tinygltf::GetNumComponentsInType(uint32_t(a.type)))
-      problem(name + ": the Draco attribute has " + std::to_string(components) + " components, " +
-              accessor_name(found->second) + " " +
-              std::to_string(tinygltf::GetNumComponentsInType(uint32_t(a.type))));
-    if (!values_in_storage(*attribute)) problem(name + ": the decoded attribute is inconsistent");
-    if (a.count != points)
-      problem(name + ": " + accessor_name(found->second) + " has count " + std::to_string(a.count) +
-              ", but the Draco data decodes to " + std::to_string(points) + " vertices");
-    out.push_back({found->second, convert(a, *mesh, *attribute, name), TINYGLTF_TARGET_ARRAY_BUFFER});
-  }
+/// Pass 3b, for a primitive without indices, whose vertices are read three by three. Reads the
+/// mesh's triangles; writes nothing. Problem unless they are so.
+void check_unindexed(const draco::Mesh& mesh) {
+  const size_t points = mesh.num_points();
+  const size_t faces = mesh.num_faces();
+  for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.face(f)[k].value() != 3 * f.value() + uint32_t(k))
+        problem("the primitive has no indices, but its Draco data is an indexed mesh");
+  if (points != 3 * faces) problem("the primitive has no indices, but its Draco data has unused vertices");
+}
 
-  // All checked: each decoded array becomes a buffer and a buffer view of its own.
+/// Pass 4, for the primitive's attribute `name`, Draco attribute `id_value`. Reads its accessor
+/// and the mesh's attribute; returns one value per decoded vertex in the accessor's component
+/// type, once checked to match the accessor.
+Decoded decode_attribute(const std::string& name, const tinygltf::Value& id_value,
+                         const tinygltf::Primitive& primitive, const tinygltf::Model& model,
+                         const draco::Mesh& mesh) {
+  const size_t points = mesh.num_points();
+  if (!id_value.IsInt() || id_value.Get<int>() < 0)
+    problem("attributes." + name + ": expected a Draco attribute id (a non-negative integer)");
+  const int id = id_value.Get<int>();
+  const auto found = primitive.attributes.find(name);
+  if (found == primitive.attributes.end()) problem(name + ": not among the primitive's attributes");
+  const tinygltf::Accessor& a = accessor(model, found->second, name);
+  const draco::PointAttribute* attribute = mesh.GetAttributeByUniqueId(uint32_t(id));
+  if (!attribute) problem(name + ": the Draco data has no attribute with id " + std::to_string(id));
+  const int components = attribute->num_components();
+  if (components < 1 || components > 4 || components != tinygltf::GetNumComponentsInType(uint32_t(a.type)))
+    problem(name + ": the Draco attribute has " + std::to_string(components) + " components, " +
+            accessor_name(found->second) + " " +
+            std::to_string(tinygltf::GetNumComponentsInType(uint32_t(a.type))));
+  if (!values_in_storage(*attribute)) problem(name + ": the decoded attribute is inconsistent");
+  if (a.count != points)
+    problem(name + ": " + accessor_name(found->second) + " has count " + std::to_string(a.count) +
+            ", but the Draco data decodes to " + std::to_string(points) + " vertices");
+  return {found->second, convert(a, mesh, *attribute, name), TINYGLTF_TARGET_ARRAY_BUFFER};
+}
+
+/// Pass 5, once all is checked. Reads the decoded arrays (moving their bytes out); writes each
+/// as a buffer and a buffer view of its own to `model`, and points its accessor at it.
+void replace_accessor_data(tinygltf::Model& model, std::vector<Decoded>& out) {
   for (Decoded& d : out) {
     tinygltf::Buffer decoded_buffer;
     decoded_buffer.data = std::move(d.bytes);
@@ -229,6 +243,30 @@ void decode(tinygltf::Primitive& primitive, tinygltf::Model& model, const tinygl
     a.bufferView = int(model.bufferViews.size() - 1);
     a.byteOffset = 0;
   }
+}
+
+/// Decodes and checks everything first, then changes the model: a problem leaves it as it was.
+/// A driver over the named passes above.
+void decode(tinygltf::Primitive& primitive, tinygltf::Model& model, const tinygltf::Value& extension) {
+  check_extension(primitive, extension);
+  const int view_index = extension.Get("bufferView").Get<int>();
+  const std::string view_name = "buffer view " + std::to_string(view_index);
+  const std::unique_ptr<draco::Mesh> mesh = decode_mesh(model, view_index, view_name);
+
+  std::vector<Decoded> out;
+  // Indices: 3 per decoded triangle, in the accessor's component type.
+  if (primitive.indices >= 0) {
+    out.push_back(decode_indices(primitive, model, *mesh));
+  } else {
+    check_unindexed(*mesh);
+  }
+  // Attributes: one value per decoded vertex, in the accessor's component type.
+  const tinygltf::Value& attributes_value = extension.Get("attributes");
+  for (const std::string& name : attributes_value.Keys())
+    out.push_back(decode_attribute(name, attributes_value.Get(name), primitive, model, *mesh));
+
+  // All checked: each decoded array becomes a buffer and a buffer view of its own.
+  replace_accessor_data(model, out);
 }
 
 }  // namespace

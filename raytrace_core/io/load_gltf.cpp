@@ -197,109 +197,169 @@ class GltfLoader {
   GltfLoader(const tinygltf::Model& model, std::string file, Scene& scene)
       : model_(model), file_(std::move(file)), scene_(scene), on_path_(model.nodes.size(), false) {}
 
+  /// A driver over named passes (below): check the required extensions, convert the materials
+  /// (naming what is ignored), then walk the default scene's node trees into meshes, cameras
+  /// and lights.
   void load() {
-    // Extensions a file cannot be read without (e.g. quantized attributes). Draco-compressed
-    // primitives were decoded into ordinary accessors while the file was read (gltf_draco.h).
-    for (const std::string& required : model_.extensionsRequired)
-      if (!gltf_extension_supported(required))
-        fail("requires extension " + required + ", which gilt does not support");
+    check_required_extensions();
     first_material_ = static_cast<uint32_t>(scene_.materials.size());
     file_index_ = int32_t(scene_.model_files.size());
     scene_.model_files.push_back(file_);
     image_files_.assign(model_.images.size(), ImageFile{});
-    std::vector<std::string> ignored;  // kinds of texture the file has and gilt does not read
-    std::vector<std::string> ignored_extensions;  // material extensions gilt does not model
-    const auto note_ignored = [&](bool present, const std::string& kind) {
-      if (present && std::find(ignored.begin(), ignored.end(), kind) == ignored.end())
-        ignored.push_back(kind);
-    };
-    for (size_t i = 0; i < model_.materials.size(); ++i) {
-      const tinygltf::Material& gm = model_.materials[i];
-      Material m = convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name);
-      // One UV set per material: the first texture's. A texture on another set is left out.
-      int uv_set = -1;
-      const std::string where = "materials[" + std::to_string(i) + "]";
-      const auto read = [&](const tinygltf::TextureInfo& info, const std::string& key, bool srgb) {
-        int set = 0;
-        TextureRef ref = texture_ref(info, where + "." + key, set, srgb);
-        if (!ref.valid()) return ref;
-        if (uv_set >= 0 && set != uv_set) {
-          scene_.warnings.push_back(file_ + ": " + where + "." + key + " reads texture coordinate set " +
-                                    std::to_string(set) + " but the material's other textures read set " +
-                                    std::to_string(uv_set) + "; it is ignored");
-          return TextureRef{};
-        }
-        uv_set = set;
-        return ref;
-      };
-      // A mirror's or glass's base colour tints what it reflects or transmits, which a texture on
-      // Material::albedo cannot express: left out, as the OBJ loader leaves out their map_Kd.
-      const bool has_base_texture = gm.pbrMetallicRoughness.baseColorTexture.index >= 0;
-      note_ignored(has_base_texture && m.is_traced_through(), "base colour of mirror and glass materials");
-      if (has_base_texture && !m.is_traced_through())
-        m.albedo_texture = read(gm.pbrMetallicRoughness.baseColorTexture, "pbrMetallicRoughness.baseColorTexture", true);
-      const bool has_mr_texture = gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
-      // Rough glass reads the texture's roughness (green); its metalness has no meaning there.
-      const bool reads_mr = m.kind == MaterialKind::metallic_roughness || m.is_rough_dielectric();
-      if (has_mr_texture && reads_mr)
-        m.metallic_roughness_texture = read(gm.pbrMetallicRoughness.metallicRoughnessTexture,
-                                            "pbrMetallicRoughness.metallicRoughnessTexture", false);
-      note_ignored(has_mr_texture && !reads_mr, "metallic-roughness of mirror and smooth glass materials");
-      if (gm.emissiveTexture.index >= 0 && m.is_emissive())
-        m.emission_texture = read(gm.emissiveTexture, "emissiveTexture", true);
-      if (gm.normalTexture.index >= 0) {
-        tinygltf::TextureInfo info;
-        info.index = gm.normalTexture.index;
-        info.texCoord = gm.normalTexture.texCoord;
-        info.extensions = gm.normalTexture.extensions;
-        m.normal_texture = read(info, "normalTexture", false);
-        m.normal_scale = float(gm.normalTexture.scale);
-        if (!std::isfinite(m.normal_scale)) fail(where + ".normalTexture.scale: must be a finite number");
-      }
-      uv_set_of_material_.push_back(std::max(uv_set, 0));
-      // alphaMode: coverage is baseColorFactor's alpha times the base colour texture's.
-      if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
-        m.alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::mask : AlphaMode::blend;
-        const auto& factor = gm.pbrMetallicRoughness.baseColorFactor;
-        m.alpha = factor.size() == 4 ? std::clamp(float(factor[3]), 0.0f, 1.0f) : 1.0f;
-        if (!(gm.alphaCutoff >= 0.0 && gm.alphaCutoff <= 1.0))
-          fail(where + ".alphaCutoff: must lie in [0, 1]");
-        m.alpha_cutoff = float(gm.alphaCutoff);
-        m.alpha_texture = m.albedo_texture;
-      } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
-        fail(where + ".alphaMode: unknown mode " + gm.alphaMode);
-      }
-      // Material extensions gilt does not model are named, so that a look that differs from
-      // other renderers' is explained. KHR_materials_unlit's surfaces are lit like the rest.
-      for (const auto& [name, value] : gm.extensions) {
-        const bool read = name == "KHR_materials_transmission" || name == "KHR_materials_ior" ||
-                          name == "KHR_materials_volume" || name == "KHR_materials_emissive_strength" ||
-                          (name == "KHR_materials_specular" && m.kind == MaterialKind::diffuse);
-        if (!read && std::find(ignored_extensions.begin(), ignored_extensions.end(), name) == ignored_extensions.end())
-          ignored_extensions.push_back(name);
-      }
-      scene_.materials.push_back(std::move(m));
-      note_ignored(gm.occlusionTexture.index >= 0, "occlusion");
-      // Extensions' textures, e.g. KHR_materials_transmission's transmissionTexture.
-      for (const auto& [name, value] : gm.extensions)
-        if (value.IsObject())
-          for (const std::string& key : value.Keys())
-            note_ignored(
-                key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.Get(key).IsObject(),
-                name + " " + key);
+    Ignored ignored;
+    for (size_t i = 0; i < model_.materials.size(); ++i) add_material(i, ignored);
+    report_ignored(ignored);
+    for (int root : scene_roots()) visit(root, glm::mat4(1.0f));
+    if (scene_.meshes.empty()) scene_.warnings.push_back(file_ + ": no triangles");
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(file_ + ": " + what); }
+
+  /// A glTF image as a file OpenImageIO can open: `path` empty when there is none (warned once).
+  struct ImageFile {
+    bool resolved = false;
+    std::string path;
+  };
+
+  // --- load's passes, in the order it runs them. ---
+
+  /// What the file has and gilt does not read, each named once in load's warnings.
+  struct Ignored {
+    std::vector<std::string> textures;    ///< kinds of texture the file has and gilt does not read
+    std::vector<std::string> extensions;  ///< material extensions gilt does not model
+  };
+
+  /// Adds `kind` to `kinds` when `present`, unless it is there already.
+  static void note_ignored(std::vector<std::string>& kinds, bool present, const std::string& kind) {
+    if (present && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) kinds.push_back(kind);
+  }
+
+  /// Pass 1. Reads extensionsRequired; writes nothing. Fails on an extension a file cannot be
+  /// read without (e.g. quantized attributes). Draco-compressed primitives were decoded into
+  /// ordinary accessors while the file was read (gltf_draco.h).
+  void check_required_extensions() const {
+    for (const std::string& required : model_.extensionsRequired)
+      if (!gltf_extension_supported(required))
+        fail("requires extension " + required + ", which gilt does not support");
+  }
+
+  /// One texture of a material (`where` names it, `key` the texture) through texture_ref, or an
+  /// invalid reference when it reads another UV set than the material's earlier textures, with
+  /// a warning. Reads and writes `uv_set`: the material's set so far (−1: none yet).
+  TextureRef material_texture(const tinygltf::TextureInfo& info, const std::string& where, const std::string& key,
+                              bool srgb, int& uv_set) {
+    int set = 0;
+    TextureRef ref = texture_ref(info, where + "." + key, set, srgb);
+    if (!ref.valid()) return ref;
+    if (uv_set >= 0 && set != uv_set) {
+      scene_.warnings.push_back(file_ + ": " + where + "." + key + " reads texture coordinate set " +
+                                std::to_string(set) + " but the material's other textures read set " +
+                                std::to_string(uv_set) + "; it is ignored");
+      return TextureRef{};
     }
-    if (!ignored.empty()) {
+    uv_set = set;
+    return ref;
+  }
+
+  /// Pass 2a, for material gm (`where` names it). Reads its base colour, metallic-roughness,
+  /// emissive and normal textures; writes m's textures (and normal scale), the kinds it leaves
+  /// out to `ignored`; returns the material's UV set: its first texture's (0 when it has none).
+  int read_material_textures(const tinygltf::Material& gm, const std::string& where, Material& m,
+                             std::vector<std::string>& ignored) {
+    int uv_set = -1;  // one UV set per material: the first texture's; a texture on another is left out
+    // A mirror's or glass's base colour tints what it reflects or transmits, which a texture on
+    // Material::albedo cannot express: left out, as the OBJ loader leaves out their map_Kd.
+    const bool has_base_texture = gm.pbrMetallicRoughness.baseColorTexture.index >= 0;
+    note_ignored(ignored, has_base_texture && m.is_traced_through(), "base colour of mirror and glass materials");
+    if (has_base_texture && !m.is_traced_through())
+      m.albedo_texture = material_texture(gm.pbrMetallicRoughness.baseColorTexture, where,
+                                          "pbrMetallicRoughness.baseColorTexture", true, uv_set);
+    const bool has_mr_texture = gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
+    // Rough glass reads the texture's roughness (green); its metalness has no meaning there.
+    const bool reads_mr = m.kind == MaterialKind::metallic_roughness || m.is_rough_dielectric();
+    if (has_mr_texture && reads_mr)
+      m.metallic_roughness_texture = material_texture(gm.pbrMetallicRoughness.metallicRoughnessTexture, where,
+                                                      "pbrMetallicRoughness.metallicRoughnessTexture", false, uv_set);
+    note_ignored(ignored, has_mr_texture && !reads_mr, "metallic-roughness of mirror and smooth glass materials");
+    if (gm.emissiveTexture.index >= 0 && m.is_emissive())
+      m.emission_texture = material_texture(gm.emissiveTexture, where, "emissiveTexture", true, uv_set);
+    if (gm.normalTexture.index >= 0) {
+      tinygltf::TextureInfo info;
+      info.index = gm.normalTexture.index;
+      info.texCoord = gm.normalTexture.texCoord;
+      info.extensions = gm.normalTexture.extensions;
+      m.normal_texture = material_texture(info, where, "normalTexture", false, uv_set);
+      m.normal_scale = float(gm.normalTexture.scale);
+      if (!std::isfinite(m.normal_scale)) fail(where + ".normalTexture.scale: must be a finite number");
+    }
+    return std::max(uv_set, 0);
+  }
+
+  /// Pass 2b, for material gm (`where` names it). Reads its alphaMode, alphaCutoff and base
+  /// colour alpha; writes m's coverage: baseColorFactor's alpha times the base colour texture's.
+  /// Fails on an unknown mode or a cutoff outside [0, 1].
+  void read_alpha_mode(const tinygltf::Material& gm, const std::string& where, Material& m) const {
+    if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
+      m.alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::mask : AlphaMode::blend;
+      const auto& factor = gm.pbrMetallicRoughness.baseColorFactor;
+      m.alpha = factor.size() == 4 ? std::clamp(float(factor[3]), 0.0f, 1.0f) : 1.0f;
+      if (!(gm.alphaCutoff >= 0.0 && gm.alphaCutoff <= 1.0)) fail(where + ".alphaCutoff: must lie in [0, 1]");
+      m.alpha_cutoff = float(gm.alphaCutoff);
+      m.alpha_texture = m.albedo_texture;
+    } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
+      fail(where + ".alphaMode: unknown mode " + gm.alphaMode);
+    }
+  }
+
+  /// Pass 2, for material i: convert_material, then passes 2a and 2b. Reads model_.materials[i];
+  /// writes the material to scene_.materials, its UV set to uv_set_of_material_, and what it has
+  /// that gilt does not read to `ignored`.
+  void add_material(size_t i, Ignored& ignored) {
+    const tinygltf::Material& gm = model_.materials[i];
+    Material m = convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name);
+    const std::string where = "materials[" + std::to_string(i) + "]";
+    uv_set_of_material_.push_back(read_material_textures(gm, where, m, ignored.textures));
+    read_alpha_mode(gm, where, m);
+    // Material extensions gilt does not model are named, so that a look that differs from
+    // other renderers' is explained. KHR_materials_unlit's surfaces are lit like the rest.
+    for (const auto& [name, value] : gm.extensions) {
+      const bool read = name == "KHR_materials_transmission" || name == "KHR_materials_ior" ||
+                        name == "KHR_materials_volume" || name == "KHR_materials_emissive_strength" ||
+                        (name == "KHR_materials_specular" && m.kind == MaterialKind::diffuse);
+      note_ignored(ignored.extensions, !read, name);
+    }
+    scene_.materials.push_back(std::move(m));
+    note_ignored(ignored.textures, gm.occlusionTexture.index >= 0, "occlusion");
+    // Extensions' textures, e.g. KHR_materials_transmission's transmissionTexture.
+    for (const auto& [name, value] : gm.extensions)
+      if (value.IsObject())
+        for (const std::string& key : value.Keys())
+          note_ignored(ignored.textures,
+                       key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.Get(key).IsObject(),
+                       name + " " + key);
+  }
+
+  /// Pass 3. Reads `ignored`; writes one warning to scene_.warnings for the textures and one for
+  /// the material extensions, when there are any.
+  void report_ignored(const Ignored& ignored) {
+    if (!ignored.textures.empty()) {
       std::string list;
-      for (const std::string& kind : ignored) list += (list.empty() ? "" : ", ") + kind;
+      for (const std::string& kind : ignored.textures) list += (list.empty() ? "" : ", ") + kind;
       scene_.warnings.push_back(file_ + ": these textures are ignored: " + list);
     }
-    if (!ignored_extensions.empty()) {
+    if (!ignored.extensions.empty()) {
       std::string list;
-      for (const std::string& name : ignored_extensions)
+      for (const std::string& name : ignored.extensions)
         list += (list.empty() ? "" : ", ") + name + (name == "KHR_materials_unlit" ? " (its surfaces are lit)" : "");
       scene_.warnings.push_back(file_ + ": these material extensions are ignored: " + list);
     }
+  }
 
+  /// Pass 4. Reads the scenes and nodes; returns the nodes to walk from: the default scene's
+  /// (the first when none is named), or without scenes every node that is nobody's child.
+  /// Fails when the default scene does not exist.
+  std::vector<int> scene_roots() const {
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
       const int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
@@ -313,18 +373,8 @@ class GltfLoader {
       for (size_t i = 0; i < model_.nodes.size(); ++i)
         if (!is_child[i]) roots.push_back(int(i));
     }
-    for (int root : roots) visit(root, glm::mat4(1.0f));
-    if (scene_.meshes.empty()) scene_.warnings.push_back(file_ + ": no triangles");
+    return roots;
   }
-
- private:
-  [[noreturn]] void fail(const std::string& what) const { throw InputError(file_ + ": " + what); }
-
-  /// A glTF image as a file OpenImageIO can open: `path` empty when there is none (warned once).
-  struct ImageFile {
-    bool resolved = false;
-    std::string path;
-  };
 
   /// The reference a base colour textureInfo (at JSON path `where`) makes, or an invalid one when
   /// its image cannot be had; `uv_set` is set to the TEXCOORD set it reads.

@@ -460,198 +460,290 @@ Material convert_material(const tinyobj::material_t& mtl, const std::string& fil
 /// Key of one OBJ corner: position, texture coordinate and normal indices.
 using Corner = std::tuple<int, int, int>;
 
-}  // namespace
+// --- load_obj's passes, in the order it runs them. ---
 
-void load_obj(const fs::path& path, Scene& scene) {
-  const std::string file = path.string();
-  check_obj_text(path);
-
-  std::string obj_text;
-  if (!read_without_comments(path, obj_text)) throw InputError(file + ": cannot open file");
-  std::istringstream obj_stream(obj_text);
-  MtlReader mtl_reader(path.parent_path());
+/// What load_obj's passes share: the OBJ file, and what tinyobjloader reads from it and from the
+/// MTL files it names (filled by read_obj).
+struct ObjFile {
+  explicit ObjFile(const fs::path& p) : path(p), file(p.string()), mtl_reader(p.parent_path()) {}
+  const fs::path& path;
+  const std::string file;  ///< path as given, for messages
+  MtlReader mtl_reader;
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> mtls;
+};
+
+/// Pass 1. Reads the OBJ file (checked first by check_obj_text) and its MTL files; writes obj's
+/// attrib, shapes, mtls and mtl_reader, and tinyobjloader's warnings to `warnings`. Throws
+/// InputError when the file cannot be read or a map_Kd is malformed.
+void read_obj(ObjFile& obj, std::vector<std::string>& warnings) {
+  check_obj_text(obj.path);
+
+  std::string obj_text;
+  if (!read_without_comments(obj.path, obj_text)) throw InputError(obj.file + ": cannot open file");
+  std::istringstream obj_stream(obj_text);
   std::string warning, error;
-  if (!tinyobj::LoadObj(&attrib, &shapes, &mtls, &warning, &error, &obj_stream, &mtl_reader,
+  if (!tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.mtls, &warning, &error, &obj_stream, &obj.mtl_reader,
                         /*triangulate=*/true, /*default_vcols_fallback=*/false))
-    throw InputError(file + ": " + (error.empty() ? std::string("cannot read OBJ file") : error));
-  std::istringstream warnings(warning);
-  for (std::string w; std::getline(warnings, w);)
-    if (!w.empty()) scene.warnings.push_back(file + ": " + w);
+    throw InputError(obj.file + ": " + (error.empty() ? std::string("cannot read OBJ file") : error));
+  std::istringstream lines(warning);
+  for (std::string w; std::getline(lines, w);)
+    if (!w.empty()) warnings.push_back(obj.file + ": " + w);
 
-  mtl_reader.throw_if_failed();
+  obj.mtl_reader.throw_if_failed();
+}
 
-  const auto first_material = static_cast<uint32_t>(scene.materials.size());
-  std::vector<std::string> ignored_maps;
-  for (size_t i = 0; i < mtls.size(); ++i) {
-    const tinyobj::material_t& mtl = mtls[i];
-    Material m = convert_material(mtl, file, scene.warnings);
-    unused_maps(mtl, ignored_maps);
-    const bool read = i < mtl_reader.diffuse_map_of_material.size();
-    const DiffuseMap diffuse = read ? mtl_reader.diffuse_map_of_material[i] : DiffuseMap{};
-    // The PBR extension (Pr roughness, Pm metallic): glTF's metallic-roughness model with base
-    // colour Kd. Glass and mirrors keep their kind.
-    if (diffuse.pbr_given && m.kind == MaterialKind::dielectric) {
-      m.roughness = std::clamp(float(mtl.roughness), 0.0f, 1.0f);  // Pr on glass: frosted glass
-    } else if (diffuse.pbr_given && !m.is_traced_through()) {
-      const Rgb emission = m.emission;
-      m = Material::make_metallic_roughness(mtl.name, clamp(rgb(mtl.diffuse), 0.0f, 1.0f),
-                                            std::clamp(float(mtl.metallic), 0.0f, 1.0f),
-                                            std::clamp(float(mtl.roughness), 0.0f, 1.0f));
-      m.emission = emission;
+/// Adds `kind` to `kinds` unless it is there already.
+void note_once(std::vector<std::string>& kinds, const char* kind) {
+  if (std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) kinds.push_back(kind);
+}
+
+/// Whether material i was read by the MtlReader (else tinyobjloader made it up).
+bool read_by_mtl_reader(const ObjFile& obj, size_t i) { return i < obj.mtl_reader.diffuse_map_of_material.size(); }
+
+/// The folder material i's texture names are relative to: its MTL file's, else the OBJ's.
+fs::path material_folder(const ObjFile& obj, size_t i) {
+  return read_by_mtl_reader(obj, i) ? obj.mtl_reader.folder_of_material[i] : obj.path.parent_path();
+}
+
+/// Pass 2a, for material i and its map_Kd `diffuse`. Reads whether the image file exists; writes
+/// m's albedo texture (its image added to scene.textures), or a warning to scene.warnings when
+/// it would not show or is not found, or the kind to `ignored_maps` on mirrors and glass.
+void apply_map_kd(Material& m, const ObjFile& obj, size_t i, const DiffuseMap& diffuse, Scene& scene,
+                  std::vector<std::string>& ignored_maps) {
+  const tinyobj::material_t& mtl = obj.mtls[i];
+  if (!diffuse.name.empty() && (m.kind == MaterialKind::mirror || m.kind == MaterialKind::dielectric)) {
+    note_once(ignored_maps, "map_Kd of mirror and glass materials");
+  } else if (!diffuse.name.empty() && m.albedo.is_black()) {
+    scene.warnings.push_back(obj.file + ": material '" + mtl.name + "': Kd is black, so map_Kd " + diffuse.name +
+                             " would not show; left untextured");
+  } else if (!diffuse.name.empty()) {
+    const fs::path folder = material_folder(obj, i);
+    TextureImage image;
+    image.file = find_texture_file(folder, diffuse.name);
+    if (image.file.empty()) {
+      const std::string where = folder.empty() ? std::string(".") : folder.string();
+      scene.warnings.push_back(obj.file + ": material '" + mtl.name + "': texture '" + diffuse.name +
+                               "' not found in " + where + "; left untextured");
+    } else {
+      image.srgb = !diffuse.linear;
+      image.wrap_s = image.wrap_t = diffuse.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+      m.albedo_texture = diffuse_texture_ref(texture_index(scene.textures, image), diffuse);
     }
-    if (!diffuse.name.empty() && (m.kind == MaterialKind::mirror || m.kind == MaterialKind::dielectric)) {
-      const char* kind = "map_Kd of mirror and glass materials";
-      if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end())
-        ignored_maps.push_back(kind);
-    } else if (!diffuse.name.empty() && m.albedo.is_black()) {
-      scene.warnings.push_back(file + ": material '" + mtl.name + "': Kd is black, so map_Kd " +
-                               diffuse.name + " would not show; left untextured");
-    } else if (!diffuse.name.empty()) {
-      const fs::path folder = read ? mtl_reader.folder_of_material[i] : path.parent_path();
-      TextureImage image;
-      image.file = find_texture_file(folder, diffuse.name);
-      if (image.file.empty()) {
-        const std::string where = folder.empty() ? std::string(".") : folder.string();
-        scene.warnings.push_back(file + ": material '" + mtl.name + "': texture '" + diffuse.name +
-                                 "' not found in " + where + "; left untextured");
-      } else {
-        image.srgb = !diffuse.linear;
-        image.wrap_s = image.wrap_t = diffuse.clamp ? TextureWrap::clamp : TextureWrap::repeat;
-        m.albedo_texture = diffuse_texture_ref(texture_index(scene.textures, image), diffuse);
-      }
-    }
-    // A map other than map_Kd, with tinyobjloader's reading of its options (-s, -o, -clamp):
-    // its reference, or none (with a warning) when the file is not found.
-    const auto read_map = [&](const std::string& texname, const tinyobj::texture_option_t& o, bool srgb,
-                              const char* key, const char* fallback) -> TextureRef {
-      const fs::path folder = read ? mtl_reader.folder_of_material[i] : path.parent_path();
-      TextureImage image;
-      image.file = find_texture_file(folder, texname);
-      if (image.file.empty()) {
-        const std::string where = folder.empty() ? std::string(".") : folder.string();
-        scene.warnings.push_back(file + ": material '" + mtl.name + "': " + key + " '" + texname +
-                                 "' not found in " + where + "; " + fallback);
-        return TextureRef{};
-      }
-      DiffuseMap map;
-      map.scale[0] = float(o.scale[0]), map.scale[1] = float(o.scale[1]);
-      map.offset[0] = float(o.origin_offset[0]), map.offset[1] = float(o.origin_offset[1]);
-      image.srgb = srgb;
-      image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
-      return diffuse_texture_ref(texture_index(scene.textures, image), map);
-    };
-    // map_d: a cut-out (leaves, fences), its image read as data; coverage below one half is not
-    // there.
-    if (!mtl.alpha_texname.empty() && m.is_traced_through()) {
-      const char* kind = "map_d of mirror and glass materials";
-      if (std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end()) ignored_maps.push_back(kind);
-    } else if (!mtl.alpha_texname.empty()) {
-      const TextureRef ref = read_map(mtl.alpha_texname, mtl.alpha_texopt, false, "map_d", "left opaque");
-      if (ref.valid()) {
-        m.alpha_mode = AlphaMode::mask;
-        m.alpha_cutoff = 0.5f;
-        m.alpha_in_colour = true;
-        m.alpha_texture = ref;
-      }
-    }
-    // map_Ke: the emission is Ke × the texel (sRGB, as colour maps are), as map_Kd scales Kd.
-    if (!mtl.emissive_texname.empty() && !m.is_emissive()) {
-      scene.warnings.push_back(file + ": material '" + mtl.name + "': Ke is black, so map_Ke " +
-                               mtl.emissive_texname + " would not show; ignored");
-    } else if (!mtl.emissive_texname.empty()) {
-      m.emission_texture = read_map(mtl.emissive_texname, mtl.emissive_texopt, true, "map_Ke", "emission untextured");
-    }
-    // norm: a tangent-space normal map; bump (map_Bump): a height map, its heights times -bm.
-    // Both are data, read linear.
-    if (!mtl.normal_texname.empty()) {
-      m.normal_texture = read_map(mtl.normal_texname, mtl.normal_texopt, false, "norm", "normals left smooth");
-      const char* kind = "bump maps beside a normal map (norm)";
-      if (!mtl.bump_texname.empty() && std::find(ignored_maps.begin(), ignored_maps.end(), kind) == ignored_maps.end())
-        ignored_maps.push_back(kind);
-    } else if (!mtl.bump_texname.empty()) {
-      m.normal_texture = read_map(mtl.bump_texname, mtl.bump_texopt, false, "bump", "normals left smooth");
-      m.normal_is_height = true;
-      m.normal_scale = float(mtl.bump_texopt.bump_multiplier);
-    }
-    scene.materials.push_back(std::move(m));
   }
-  if (!ignored_maps.empty())
-    scene.warnings.push_back(file + ": " + join_words(ignored_maps) + " are ignored");
+}
 
-  // Gather the triangles of each material (−1: faces without usemtl, or with an unknown name).
+/// A map of material i other than map_Kd, with tinyobjloader's reading of its options (-s, -o,
+/// -clamp): its reference (the image added to scene.textures), or none, with a warning to
+/// scene.warnings ending in `fallback`, when the file is not found.
+TextureRef read_texture_map(const ObjFile& obj, size_t i, const std::string& texname,
+                            const tinyobj::texture_option_t& o, bool srgb, const char* key, const char* fallback,
+                            Scene& scene) {
+  const fs::path folder = material_folder(obj, i);
+  TextureImage image;
+  image.file = find_texture_file(folder, texname);
+  if (image.file.empty()) {
+    const std::string where = folder.empty() ? std::string(".") : folder.string();
+    scene.warnings.push_back(obj.file + ": material '" + obj.mtls[i].name + "': " + key + " '" + texname +
+                             "' not found in " + where + "; " + fallback);
+    return TextureRef{};
+  }
+  DiffuseMap map;
+  map.scale[0] = float(o.scale[0]), map.scale[1] = float(o.scale[1]);
+  map.offset[0] = float(o.origin_offset[0]), map.offset[1] = float(o.origin_offset[1]);
+  image.srgb = srgb;
+  image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+  return diffuse_texture_ref(texture_index(scene.textures, image), map);
+}
+
+/// Pass 2b, for material i. Reads its map_d, map_Ke, norm and bump; writes m's alpha, emission
+/// and normal textures (read_texture_map), warnings to scene.warnings, and the kinds it leaves
+/// out to `ignored_maps`.
+void apply_other_maps(Material& m, const ObjFile& obj, size_t i, Scene& scene,
+                      std::vector<std::string>& ignored_maps) {
+  const tinyobj::material_t& mtl = obj.mtls[i];
+  // map_d: a cut-out (leaves, fences), its image read as data; coverage below one half is not
+  // there.
+  if (!mtl.alpha_texname.empty() && m.is_traced_through()) {
+    note_once(ignored_maps, "map_d of mirror and glass materials");
+  } else if (!mtl.alpha_texname.empty()) {
+    const TextureRef ref =
+        read_texture_map(obj, i, mtl.alpha_texname, mtl.alpha_texopt, false, "map_d", "left opaque", scene);
+    if (ref.valid()) {
+      m.alpha_mode = AlphaMode::mask;
+      m.alpha_cutoff = 0.5f;
+      m.alpha_in_colour = true;
+      m.alpha_texture = ref;
+    }
+  }
+  // map_Ke: the emission is Ke × the texel (sRGB, as colour maps are), as map_Kd scales Kd.
+  if (!mtl.emissive_texname.empty() && !m.is_emissive()) {
+    scene.warnings.push_back(obj.file + ": material '" + mtl.name + "': Ke is black, so map_Ke " +
+                             mtl.emissive_texname + " would not show; ignored");
+  } else if (!mtl.emissive_texname.empty()) {
+    m.emission_texture = read_texture_map(obj, i, mtl.emissive_texname, mtl.emissive_texopt, true, "map_Ke",
+                                          "emission untextured", scene);
+  }
+  // norm: a tangent-space normal map; bump (map_Bump): a height map, its heights times -bm.
+  // Both are data, read linear.
+  if (!mtl.normal_texname.empty()) {
+    m.normal_texture =
+        read_texture_map(obj, i, mtl.normal_texname, mtl.normal_texopt, false, "norm", "normals left smooth", scene);
+    if (!mtl.bump_texname.empty()) note_once(ignored_maps, "bump maps beside a normal map (norm)");
+  } else if (!mtl.bump_texname.empty()) {
+    m.normal_texture =
+        read_texture_map(obj, i, mtl.bump_texname, mtl.bump_texopt, false, "bump", "normals left smooth", scene);
+    m.normal_is_height = true;
+    m.normal_scale = float(mtl.bump_texopt.bump_multiplier);
+  }
+}
+
+/// Pass 2, for material i: convert_material, the PBR extension, then passes 2a and 2b. Reads
+/// its MTL entry; writes textures and warnings to `scene` and left-out kinds to `ignored_maps`.
+Material convert_obj_material(const ObjFile& obj, size_t i, Scene& scene, std::vector<std::string>& ignored_maps) {
+  const tinyobj::material_t& mtl = obj.mtls[i];
+  Material m = convert_material(mtl, obj.file, scene.warnings);
+  unused_maps(mtl, ignored_maps);
+  const bool read = read_by_mtl_reader(obj, i);
+  const DiffuseMap diffuse = read ? obj.mtl_reader.diffuse_map_of_material[i] : DiffuseMap{};
+  // The PBR extension (Pr roughness, Pm metallic): glTF's metallic-roughness model with base
+  // colour Kd. Glass and mirrors keep their kind.
+  if (diffuse.pbr_given && m.kind == MaterialKind::dielectric) {
+    m.roughness = std::clamp(float(mtl.roughness), 0.0f, 1.0f);  // Pr on glass: frosted glass
+  } else if (diffuse.pbr_given && !m.is_traced_through()) {
+    const Rgb emission = m.emission;
+    m = Material::make_metallic_roughness(mtl.name, clamp(rgb(mtl.diffuse), 0.0f, 1.0f),
+                                          std::clamp(float(mtl.metallic), 0.0f, 1.0f),
+                                          std::clamp(float(mtl.roughness), 0.0f, 1.0f));
+    m.emission = emission;
+  }
+  apply_map_kd(m, obj, i, diffuse, scene, ignored_maps);
+  apply_other_maps(m, obj, i, scene, ignored_maps);
+  return m;
+}
+
+/// Pass 3. Reads the shapes' triangles; returns their corners grouped by material (−1: faces
+/// without usemtl, or with an unknown name), in file order within each.
+std::map<int, std::vector<tinyobj::index_t>> gather_triangles(const ObjFile& obj) {
   std::map<int, std::vector<tinyobj::index_t>> corners_of;
-  for (const tinyobj::shape_t& shape : shapes) {
+  for (const tinyobj::shape_t& shape : obj.shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     size_t offset = 0;
     for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
       const size_t n = mesh.num_face_vertices[f];
       if (n == 3) {
         const int material = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
-        auto& corners = corners_of[material >= 0 && size_t(material) < mtls.size() ? material : -1];
+        auto& corners = corners_of[material >= 0 && size_t(material) < obj.mtls.size() ? material : -1];
         corners.insert(corners.end(), mesh.indices.begin() + offset, mesh.indices.begin() + offset + 3);
       }
       offset += n;
     }
   }
+  return corners_of;
+}
 
-  const std::string stem = path.stem().string();
+/// Which vertex attributes a mesh keeps.
+struct CornerAttributes {
+  bool normals = false;
+  bool uvs = false;
+};
+
+/// Pass 4a, for mesh `mesh` of material `material`. Reads its corners: shading normals and uvs
+/// only when every corner has one; but a textured material keeps the uvs its faces have, corners
+/// without one reading the texture at (0, 0) (with a warning to `warnings`).
+CornerAttributes corner_attributes(const std::vector<tinyobj::index_t>& corners, const Material& material,
+                                   const std::string& file, const TriangleMesh& mesh,
+                                   std::vector<std::string>& warnings) {
+  bool has_normals = true, all_uvs = true, some_uvs = false;
+  size_t corners_without_uv = 0;
+  for (const tinyobj::index_t& c : corners) {
+    has_normals = has_normals && c.normal_index >= 0;
+    all_uvs = all_uvs && c.texcoord_index >= 0;
+    some_uvs = some_uvs || c.texcoord_index >= 0;
+    if (c.texcoord_index < 0) ++corners_without_uv;
+  }
+  const bool has_uvs = all_uvs || (some_uvs && material.is_textured());
+  if (has_uvs && !all_uvs)
+    warnings.push_back(file + ": mesh '" + mesh.name + "': " + std::to_string(corners_without_uv) +
+                       " face corner(s) without texture coordinates read the texture at (0, 0)");
+  return {has_normals, has_uvs};
+}
+
+/// Pass 4b. Reads the corners and obj.attrib; writes mesh's vertices (one per distinct corner
+/// of the kept attributes, in order of first use), their file vertex (origin.vertex) and its
+/// indices. Throws InputError on an index past tinyobjloader's arrays.
+void weld_corners(TriangleMesh& mesh, const std::vector<tinyobj::index_t>& corners, CornerAttributes kept,
+                  const ObjFile& obj) {
+  const tinyobj::attrib_t& attrib = obj.attrib;
+  const bool has_normals = kept.normals, has_uvs = kept.uvs;
+  std::map<Corner, uint32_t> vertex_of;
+  mesh.indices.reserve(corners.size());
+  for (const tinyobj::index_t& c : corners) {
+    const Corner key{c.vertex_index, has_uvs ? c.texcoord_index : -1, has_normals ? c.normal_index : -1};
+    auto [it, inserted] = vertex_of.try_emplace(key, static_cast<uint32_t>(mesh.positions.size()));
+    if (inserted) {
+      const size_t v = size_t(c.vertex_index), t = size_t(c.texcoord_index), n = size_t(c.normal_index);
+      const bool uv = has_uvs && c.texcoord_index >= 0;
+      // check_obj_text vouches for the indices; this guards against the two parsers disagreeing.
+      if (3 * v + 2 >= attrib.vertices.size() || (has_normals && 3 * n + 2 >= attrib.normals.size()) ||
+          (uv && 2 * t + 1 >= attrib.texcoords.size()))
+        throw InputError(obj.file + ": a face refers to a vertex, normal or texture coordinate that does not exist");
+      mesh.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
+      mesh.origin.vertex.push_back(uint32_t(v));
+      if (has_normals)
+        mesh.normals.emplace_back(attrib.normals[3 * n], attrib.normals[3 * n + 1], attrib.normals[3 * n + 2]);
+      if (uv) mesh.uvs.emplace_back(attrib.texcoords[2 * t], attrib.texcoords[2 * t + 1]);
+      else if (has_uvs) mesh.uvs.emplace_back(0.0f, 0.0f);
+    }
+    mesh.indices.push_back(it->second);
+  }
+}
+
+/// Pass 4. Reads the grouped corners; writes one mesh per material to scene.meshes (a default
+/// material to scene.materials for faces without one), the file to scene.model_files, and
+/// warnings to scene.warnings.
+void build_meshes(const ObjFile& obj, const std::map<int, std::vector<tinyobj::index_t>>& corners_of,
+                  uint32_t first_material, Scene& scene) {
+  const std::string stem = obj.path.stem().string();
   const auto file_index = int32_t(scene.model_files.size());
-  scene.model_files.push_back(file);
-  if (corners_of.empty()) scene.warnings.push_back(file + ": no faces");
+  scene.model_files.push_back(obj.file);
+  if (corners_of.empty()) scene.warnings.push_back(obj.file + ": no faces");
   for (const auto& [material, corners] : corners_of) {
     TriangleMesh mesh;
     mesh.origin.file = file_index;
     if (material >= 0) {
       mesh.material = first_material + uint32_t(material);
-      mesh.name = stem + ":" + mtls[size_t(material)].name;
+      mesh.name = stem + ":" + obj.mtls[size_t(material)].name;
     } else {
       mesh.material = static_cast<uint32_t>(scene.materials.size());
       mesh.name = stem + ":default";
       scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
     }
-    // Shading normals and uvs only when every corner of the mesh has one; but a textured
-    // material keeps the uvs its faces have, corners without one reading the texture at (0, 0).
-    bool has_normals = true, all_uvs = true, some_uvs = false;
-    size_t corners_without_uv = 0;
-    for (const tinyobj::index_t& c : corners) {
-      has_normals = has_normals && c.normal_index >= 0;
-      all_uvs = all_uvs && c.texcoord_index >= 0;
-      some_uvs = some_uvs || c.texcoord_index >= 0;
-      if (c.texcoord_index < 0) ++corners_without_uv;
-    }
-    const bool has_uvs = all_uvs || (some_uvs && scene.materials[mesh.material].is_textured());
-    if (has_uvs && !all_uvs)
-      scene.warnings.push_back(file + ": mesh '" + mesh.name + "': " + std::to_string(corners_without_uv) +
-                               " face corner(s) without texture coordinates read the texture at (0, 0)");
-    std::map<Corner, uint32_t> vertex_of;
-    mesh.indices.reserve(corners.size());
-    for (const tinyobj::index_t& c : corners) {
-      const Corner key{c.vertex_index, has_uvs ? c.texcoord_index : -1, has_normals ? c.normal_index : -1};
-      auto [it, inserted] = vertex_of.try_emplace(key, static_cast<uint32_t>(mesh.positions.size()));
-      if (inserted) {
-        const size_t v = size_t(c.vertex_index), t = size_t(c.texcoord_index), n = size_t(c.normal_index);
-        const bool uv = has_uvs && c.texcoord_index >= 0;
-        // check_obj_text vouches for the indices; this guards against the two parsers disagreeing.
-        if (3 * v + 2 >= attrib.vertices.size() || (has_normals && 3 * n + 2 >= attrib.normals.size()) ||
-            (uv && 2 * t + 1 >= attrib.texcoords.size()))
-          throw InputError(file +
-                           ": a face refers to a vertex, normal or texture coordinate that does not exist");
-        mesh.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
-                                    attrib.vertices[3 * v + 2]);
-        mesh.origin.vertex.push_back(uint32_t(v));
-        if (has_normals)
-          mesh.normals.emplace_back(attrib.normals[3 * n], attrib.normals[3 * n + 1],
-                                    attrib.normals[3 * n + 2]);
-        if (uv) mesh.uvs.emplace_back(attrib.texcoords[2 * t], attrib.texcoords[2 * t + 1]);
-        else if (has_uvs) mesh.uvs.emplace_back(0.0f, 0.0f);
-      }
-      mesh.indices.push_back(it->second);
-    }
+    const CornerAttributes kept =
+        corner_attributes(corners, scene.materials[mesh.material], obj.file, mesh, scene.warnings);
+    weld_corners(mesh, corners, kept, obj);
     scene.meshes.push_back(std::move(mesh));
   }
+}
+
+}  // namespace
+
+// A driver over named passes (above): read the file, convert its materials, gather each
+// material's triangles, and make a mesh of each.
+void load_obj(const fs::path& path, Scene& scene) {
+  ObjFile obj(path);
+  read_obj(obj, scene.warnings);
+
+  const auto first_material = static_cast<uint32_t>(scene.materials.size());
+  std::vector<std::string> ignored_maps;
+  for (size_t i = 0; i < obj.mtls.size(); ++i)
+    scene.materials.push_back(convert_obj_material(obj, i, scene, ignored_maps));
+  if (!ignored_maps.empty())
+    scene.warnings.push_back(obj.file + ": " + join_words(ignored_maps) + " are ignored");
+
+  const std::map<int, std::vector<tinyobj::index_t>> corners_of = gather_triangles(obj);
+  build_meshes(obj, corners_of, first_material, scene);
 }
 
 }  // namespace gilt::raytrace_core
