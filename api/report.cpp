@@ -121,32 +121,8 @@ std::string plot_svg(const Report& r) {
   return s.str();
 }
 
-}  // namespace
-
-void error_colour(double relative_error, unsigned char rgb[3]) {
-  // Log scale: 1e-3 → 0, 1 → 1; a ramp dark blue, blue, cyan, yellow, red.
-  const double t = std::clamp((std::log10(std::max(relative_error, 1e-12)) + 3.0) / 3.0, 0.0, 1.0);
-  static const double stops[5][3] = {{10, 10, 60}, {30, 80, 220}, {40, 200, 200}, {240, 220, 40}, {220, 30, 30}};
-  const double x = t * 4.0;
-  const int i = std::min(3, int(x));
-  const double f = x - i;
-  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<unsigned char>(std::lround(stops[i][c] * (1 - f) + stops[i + 1][c] * f));
-}
-
-nlohmann::json entry_json(const ReportEntry& e) {
-  nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
-                       {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
-                       {"rmse", e.rmse}, {"relmse", e.relmse}, {"relmse_stderr", e.relmse_stderr},
-                       {"rmse_measured", e.rmse_measured}, {"relmse_measured", e.relmse_measured},
-                       {"mae", e.mae}, {"mean_relative_error", e.mre},
-                       {"mean_ratio", e.mean_ratio}, {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
-                       {"notes", e.notes}};
-  je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
-  return je;
-}
-
-void write_report(const std::filesystem::path& folder, const Report& r) {
-  // metrics.json and metrics.csv.
+/// Reads the report; writes metrics.json and metrics.csv into the folder.
+void write_metrics(const std::filesystem::path& folder, const Report& r) {
   nlohmann::json j = {{"scene", r.scene},       {"width", r.width},         {"height", r.height},
                       {"sampler", r.sampler}, {"light_sampler", r.light_sampler},     {"reference", r.reference}, {"reference_noise_mean_relative_error", r.reference_noise_mre},
                       {"reference_relmse_floor", r.reference_relmse_floor},
@@ -167,11 +143,14 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
   }
   write_file(folder / "metrics.json", j.dump(2) + "\n");
   write_file(folder / "metrics.csv", csv.str());
+}
 
-  // index.html. Small images are shown enlarged by a whole factor (pixels stay square and sharp).
+/// Reads the report's scene, size, sampler and reference; writes index.html's head, title and the
+/// note on the reference's noise to h. Small images are shown enlarged by a whole factor (pixels
+/// stay square and sharp).
+void write_html_head(std::ostringstream& h, const Report& r) {
   const int scale = std::max(1, 192 / std::max(1, std::max(r.width, r.height)));
   const int display_width = r.width * scale;
-  std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>gilt compare: "
     << escape(r.scene) << "</title>\n<style>\n"
     << "body{font-family:sans-serif;margin:20px;color:#222;background:#fafafa}\n"
@@ -202,8 +181,10 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
          "and in the files.</p>\n";
   else
     h << "<p id=\"noise-note\">The reference's noise is not known (a reference file), so the errors include it.</p>\n";
+}
 
-  // Winners.
+/// Reads the report's budgets and entries; writes the table of the best method at each budget to h.
+void write_html_winners(std::ostringstream& h, const Report& r) {
   h << "<h2>Best method at each budget</h2>\n<table id=\"winners\"><tr><th>budget</th>";
   for (double b : r.budgets) h << "<th>" << number(b) << " s</th>";
   h << "</tr><tr><td class=\"m\">lowest relMSE</td>";
@@ -215,9 +196,11 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
       << (best ? best->method : "-") << "</td>";
   }
   h << "</tr></table>\n";
+}
 
-  h << "<h2>Error against time</h2>\n" << plot_svg(r);
-
+/// Reads the report's images, methods and budgets; writes the reference and each method's images
+/// with their error images to h.
+void write_html_images(std::ostringstream& h, const Report& r) {
   h << "<h2>Images</h2>\n<p>All at exposure " << number(r.exposure) << " EV. Under each image its per-pixel "
     << "relative error |I &minus; R| / (R + 0.01), false colour on a log scale:</p>\n"
     << "<div style=\"display:flex;gap:8px;align-items:center;font-size:12px\">0.001<div class=\"legend\"></div>1</div>\n";
@@ -236,7 +219,10 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
     }
     h << "</div>\n";
   }
+}
 
+/// Reads the report's entries; writes the metrics table and the page's end to h.
+void write_html_metrics(std::ostringstream& h, const Report& r) {
   h << "<h2>Metrics</h2>\n<div class=\"scroll\"><table id=\"metrics\"><tr><th>method</th><th>budget s</th><th>actual s</th>"
        "<th>spp / iterations</th><th>photons</th><th>shots</th><th>RMSE</th><th>relMSE</th><th>MAE</th>"
        "<th>mean rel. error</th><th>mean / reference</th><th>object-space error</th><th>relMSE against the "
@@ -260,6 +246,40 @@ void write_report(const std::filesystem::path& folder, const Report& r) {
        "channels over the reference's, its bias in overall brightness. Object-space error: radiosity vertex radiance "
        "against path-traced estimates at sampled vertices. Files: <a href=\"metrics.json\">metrics.json</a>, "
        "<a href=\"metrics.csv\">metrics.csv</a>.</p>\n</body>\n</html>\n";
+}
+
+}  // namespace
+
+void error_colour(double relative_error, unsigned char rgb[3]) {
+  // Log scale: 1e-3 → 0, 1 → 1; a ramp dark blue, blue, cyan, yellow, red.
+  const double t = std::clamp((std::log10(std::max(relative_error, 1e-12)) + 3.0) / 3.0, 0.0, 1.0);
+  static const double stops[5][3] = {{10, 10, 60}, {30, 80, 220}, {40, 200, 200}, {240, 220, 40}, {220, 30, 30}};
+  const double x = t * 4.0;
+  const int i = std::min(3, int(x));
+  const double f = x - i;
+  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<unsigned char>(std::lround(stops[i][c] * (1 - f) + stops[i + 1][c] * f));
+}
+
+nlohmann::json entry_json(const ReportEntry& e) {
+  nlohmann::json je = {{"method", e.method}, {"budget_seconds", e.budget}, {"seconds", e.seconds},
+                       {"spp_or_iterations", e.spp}, {"photons", e.photons}, {"shots", e.shots},
+                       {"rmse", e.rmse}, {"relmse", e.relmse}, {"relmse_stderr", e.relmse_stderr},
+                       {"rmse_measured", e.rmse_measured}, {"relmse_measured", e.relmse_measured},
+                       {"mae", e.mae}, {"mean_relative_error", e.mre},
+                       {"mean_ratio", e.mean_ratio}, {"image_exr", e.image_exr}, {"image_png", e.image_png}, {"error_png", e.error_png},
+                       {"notes", e.notes}};
+  je["object_space_error"] = e.object_space_error ? nlohmann::json(*e.object_space_error) : nlohmann::json(nullptr);
+  return je;
+}
+
+void write_report(const std::filesystem::path& folder, const Report& r) {
+  write_metrics(folder, r);
+  std::ostringstream h;
+  write_html_head(h, r);
+  write_html_winners(h, r);
+  h << "<h2>Error against time</h2>\n" << plot_svg(r);
+  write_html_images(h, r);
+  write_html_metrics(h, r);
   write_file(folder / "index.html", h.str());
 }
 

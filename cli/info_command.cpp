@@ -145,35 +145,48 @@ std::string camera_text(const rc::Camera& c) {
   return text;
 }
 
-void run_info(const InfoOptions& o) {
-  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
-  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
-  for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
-  std::map<std::string, size_t> lights, materials;
-  for (const rc::Light& l : scene.lights()) ++lights[light_kind_name(l.kind)];
-  for (const rc::Material& m : scene.materials) ++materials[material_kind_name(m.kind)];
-  size_t emissive = 0;
-  for (const rc::Material& m : scene.materials) emissive += m.is_emissive();
+/// What info counts in a scene, for the text and the JSON alike.
+struct SceneSummary {
+  std::map<std::string, size_t> lights, materials;  ///< by kind
+  size_t emissive = 0;   ///< materials
+  size_t vertices = 0;
+  size_t bytes = 0;      ///< geometry and BVH, estimated
+  size_t textured = 0, texels = 0, texture_bytes = 0, normal_mapped = 0;
+};
+
+/// Reads the scene's lights, materials, meshes and spheres; writes the summary's counts and
+/// memory estimate.
+void count_geometry(const rc::Scene& scene, SceneSummary& s) {
+  for (const rc::Light& l : scene.lights()) ++s.lights[light_kind_name(l.kind)];
+  for (const rc::Material& m : scene.materials) ++s.materials[material_kind_name(m.kind)];
+  for (const rc::Material& m : scene.materials) s.emissive += m.is_emissive();
   // Memory: the scene's arrays plus Embree's BVH, estimated at 96 bytes per primitive (nodes
   // and primitive references; an order-of-magnitude figure, not a measurement).
-  size_t vertices = 0, bytes = 0;
   for (const rc::TriangleMesh& m : scene.meshes) {
-    vertices += m.positions.size();
-    bytes += m.positions.size() * sizeof(rc::Vec3) + m.normals.size() * sizeof(rc::Vec3) +
-             m.uvs.size() * sizeof(rc::Vec2) + m.tangents.size() * sizeof(glm::vec4) + m.indices.size() * sizeof(uint32_t);
+    s.vertices += m.positions.size();
+    s.bytes += m.positions.size() * sizeof(rc::Vec3) + m.normals.size() * sizeof(rc::Vec3) +
+               m.uvs.size() * sizeof(rc::Vec2) + m.tangents.size() * sizeof(glm::vec4) + m.indices.size() * sizeof(uint32_t);
   }
   const size_t bvh = scene.triangle_count() * 96 + scene.spheres.size() * 96;
-  bytes += bvh + scene.spheres.size() * sizeof(rc::Sphere);
-  const rc::Bounds3& b = scene.bounds();
-  std::vector<MethodPlan> plans = plan_methods(scene);
-  // Textures: the images the materials read, at the linear half-float copies' size with their
-  // MIP levels (4/3 of the finest).
-  const size_t textured = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
-                                               [](const rc::Material& m) { return m.is_textured(); }));
-  const size_t texels = scene.texture_set() ? scene.texture_set()->texel_count() : 0;
-  const size_t texture_bytes = texels * 2 * 4 / 3;
+  s.bytes += bvh + scene.spheres.size() * sizeof(rc::Sphere);
+}
+
+/// Reads the scene's materials and texture set; writes the summary's texture counts and their
+/// memory: the images the materials read, at the linear half-float copies' size with their MIP
+/// levels (4/3 of the finest).
+void count_textures(const rc::Scene& scene, SceneSummary& s) {
+  s.textured = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
+                                    [](const rc::Material& m) { return m.is_textured(); }));
+  s.texels = scene.texture_set() ? scene.texture_set()->texel_count() : 0;
+  s.texture_bytes = s.texels * 2 * 4 / 3;
+}
+
+/// Reads the scene's materials and the summary; adds to each method's plan what it does with
+/// metallic-roughness materials, rough glass, albedo textures and normal maps; writes
+/// s.normal_mapped.
+void add_material_notes(const rc::Scene& scene, SceneSummary& s, std::vector<MethodPlan>& plans) {
   // What each method does with glTF's metallic-roughness materials.
-  const bool metallic_roughness = materials.count(material_kind_name(rc::MaterialKind::metallic_roughness)) > 0;
+  const bool metallic_roughness = s.materials.count(material_kind_name(rc::MaterialKind::metallic_roughness)) > 0;
   if (metallic_roughness)
     for (MethodPlan& p : plans) {
       if (p.method == "radiosity")
@@ -196,7 +209,7 @@ void run_info(const InfoOptions& o) {
       else
         p.runs.push_back("rough glass: GGX reflection and refraction, lights sampled through it");
     }
-  if (textured > 0)
+  if (s.textured > 0)
     for (MethodPlan& p : plans) {
       if (p.method == "radiosity")
         p.runs.push_back("albedo textures: each element reflects its texture's mean over it; the view reads texels per pixel");
@@ -205,49 +218,57 @@ void run_info(const InfoOptions& o) {
       else
         p.runs.push_back("albedo textures: read at every hit (MIP-mapped, bilinear)");
     }
-  const size_t normal_mapped = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
-                                                    [](const rc::Material& m) { return m.normal_texture.valid(); }));
-  if (normal_mapped > 0)
+  s.normal_mapped = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
+                                         [](const rc::Material& m) { return m.normal_texture.valid(); }));
+  if (s.normal_mapped > 0)
     for (MethodPlan& p : plans)
       p.runs.push_back(p.method == "radiosity"
                            ? "normal and height maps: the view shades with them; elements keep their flat normals"
                            : "normal and height maps: tilt the shading normal at every hit");
+}
 
-  if (o.json) {
-    nlohmann::json j = {{"command", "info"},
-                        {"scene", o.scene},
-                        {"triangles", scene.triangle_count()},
-                        {"vertices", vertices},
-                        {"meshes", scene.meshes.size()},
-                        {"spheres", scene.spheres.size()},
-                        {"lights", lights},
-                        {"materials", materials},
-                        {"emissive_materials", emissive},
-                        {"bounds", {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}}},
-                        {"textures", {{"images", scene.textures.size()}, {"textured_materials", textured},
-                                      {"normal_mapped_materials", normal_mapped},
-                                      {"texels", texels}, {"memory_estimate_bytes", texture_bytes}}},
-                        {"memory_estimate_bytes", bytes}};
-    j["cameras"] = nlohmann::json::array();
-    for (const rc::NamedCamera& c : scene.cameras)
-      j["cameras"].push_back({{"name", c.name}, {"orthographic", c.camera.orthographic},
-                              {"vfov_degrees", c.camera.vfov_degrees}, {"height", c.camera.ortho_height},
-                              {"aspect", c.aspect}, {"view", is_view(scene, c)}});
-    j["view"] = scene.camera ? camera_text(*scene.camera) : "none: the default view of the bounds";
-    for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};
-    std::cout << j.dump() << std::endl;
-    return;
-  }
+/// --json. Reads the scene, the summary and the plans; writes one JSON object to stdout.
+void print_info_json(const InfoOptions& o, const rc::Scene& scene, const SceneSummary& s,
+                     const std::vector<MethodPlan>& plans) {
+  const rc::Bounds3& b = scene.bounds();
+  nlohmann::json j = {{"command", "info"},
+                      {"scene", o.scene},
+                      {"triangles", scene.triangle_count()},
+                      {"vertices", s.vertices},
+                      {"meshes", scene.meshes.size()},
+                      {"spheres", scene.spheres.size()},
+                      {"lights", s.lights},
+                      {"materials", s.materials},
+                      {"emissive_materials", s.emissive},
+                      {"bounds", {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}}},
+                      {"textures", {{"images", scene.textures.size()}, {"textured_materials", s.textured},
+                                    {"normal_mapped_materials", s.normal_mapped},
+                                    {"texels", s.texels}, {"memory_estimate_bytes", s.texture_bytes}}},
+                      {"memory_estimate_bytes", s.bytes}};
+  j["cameras"] = nlohmann::json::array();
+  for (const rc::NamedCamera& c : scene.cameras)
+    j["cameras"].push_back({{"name", c.name}, {"orthographic", c.camera.orthographic},
+                            {"vfov_degrees", c.camera.vfov_degrees}, {"height", c.camera.ortho_height},
+                            {"aspect", c.aspect}, {"view", is_view(scene, c)}});
+  j["view"] = scene.camera ? camera_text(*scene.camera) : "none: the default view of the bounds";
+  for (const MethodPlan& p : plans) j["methods"][p.method] = {{"runs", p.runs}, {"skipped", p.skipped}};
+  std::cout << j.dump() << std::endl;
+}
+
+/// Reads the scene, the summary and the plans; prints them as text.
+void print_info_text(const InfoOptions& o, const rc::Scene& scene, const SceneSummary& s,
+                     const std::vector<MethodPlan>& plans) {
+  const rc::Bounds3& b = scene.bounds();
   std::printf("gilt info: %s\n", o.scene.c_str());
   std::printf("  geometry:  %zu triangles (%zu vertices) in %zu mesh(es), %zu sphere(s)\n", scene.triangle_count(),
-              vertices, scene.meshes.size(), scene.spheres.size());
+              s.vertices, scene.meshes.size(), scene.spheres.size());
   std::printf("  bounds:    (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   std::printf("  lights:   ");
-  if (lights.empty()) std::printf(" none");
-  for (const auto& [kind, n] : lights) std::printf(" %zu %s;", n, kind.c_str());
+  if (s.lights.empty()) std::printf(" none");
+  for (const auto& [kind, n] : s.lights) std::printf(" %zu %s;", n, kind.c_str());
   std::printf("\n  materials:");
-  for (const auto& [kind, n] : materials) std::printf(" %zu %s;", n, kind.c_str());
-  std::printf(" %zu emissive\n", emissive);
+  for (const auto& [kind, n] : s.materials) std::printf(" %zu %s;", n, kind.c_str());
+  std::printf(" %zu emissive\n", s.emissive);
   std::printf("  cameras:  ");
   if (scene.cameras.empty()) std::printf(" none (the default view frames the bounds)");
   for (size_t i = 0; i < scene.cameras.size(); ++i)
@@ -256,14 +277,28 @@ void run_info(const InfoOptions& o) {
   std::printf("\n");
   if (!scene.textures.empty())
     std::printf("  textures:  %zu image(s) read by %zu material(s): %.1f Mtexel channels, about %.1f MB as linear half floats with MIP levels\n",
-                scene.textures.size(), textured, double(texels) / 1e6, double(texture_bytes) / 1e6);
-  if (bytes < 1000000) std::printf("  memory:    about %.1f kB (geometry and BVH, estimated)\n", double(bytes) / 1e3);
-  else std::printf("  memory:    about %.1f MB (geometry and BVH, estimated)\n", double(bytes) / 1e6);
+                scene.textures.size(), s.textured, double(s.texels) / 1e6, double(s.texture_bytes) / 1e6);
+  if (s.bytes < 1000000) std::printf("  memory:    about %.1f kB (geometry and BVH, estimated)\n", double(s.bytes) / 1e3);
+  else std::printf("  memory:    about %.1f MB (geometry and BVH, estimated)\n", double(s.bytes) / 1e6);
   for (const MethodPlan& p : plans) {
     std::printf("  %s:\n", p.method.c_str());
     for (const std::string& r : p.runs) std::printf("    runs:    %s\n", r.c_str());
-    for (const std::string& s : p.skipped) std::printf("    skipped: %s\n", s.c_str());
+    for (const std::string& sk : p.skipped) std::printf("    skipped: %s\n", sk.c_str());
   }
+}
+
+/// `gilt info`: load the scene, count what it holds, plan each method, then print.
+void run_info(const InfoOptions& o) {
+  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
+  for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
+  SceneSummary summary;
+  count_geometry(scene, summary);
+  std::vector<MethodPlan> plans = plan_methods(scene);
+  count_textures(scene, summary);
+  add_material_notes(scene, summary, plans);
+  if (o.json) print_info_json(o, scene, summary, plans);
+  else print_info_text(o, scene, summary, plans);
 }
 
 }  // namespace

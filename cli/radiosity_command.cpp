@@ -50,18 +50,47 @@ void check_mesh_output(const std::string& path) {
     throw rc::InputError("-o " + path + ": folder " + parent.string() + " does not exist");
 }
 
-void run_radiosity(RadiosityOptions& o) {
-  check_mesh_output(o.output);
+/// What one `gilt radiosity` run carries from step to step. Each step's first comment says which
+/// fields it reads and writes; the scene and the solution are the driver's, passed by reference.
+struct RadiosityRun {
   radiosity::bake::ExportSettings ex;
+  bool lightmap = false;    ///< --lightmap: bake onto the input model, in its UVs
+  bool onto_input = false;  ///< the colours go onto the input model (--onto input or --lightmap)
+  std::chrono::steady_clock::time_point start;  ///< before loading: --time covers the whole command
+  radiosity::bake::BakeGather gather;
+  radiosity::solver::BudgetFit budget_fit;
+  radiosity::bake::VertexFit fit = radiosity::bake::VertexFit::least_squares;
+  std::optional<radiosity::bake::InputColours> onto;
+  radiosity::bake::SnapStats snap;
+  std::optional<radiosity::bake::Lightmap> atlas;
+  // --onto elements --bake-gather N: the vertices' light traced from the input under them.
+  std::optional<radiosity::solver::Solution> vertex_gather;
+  radiosity::bake::BakeGatherCount vertex_gather_count;
+  double vertex_gather_seconds = 0.0;
+  std::optional<radiosity::bake::CheckResult> check;
+  std::optional<radiosity::bake::SurfaceCheckResult> surface_check;
+  std::optional<radiosity::bake::SurfaceCheckResult> element_surface_check;  ///< --onto elements, beside `check`
+
+  /// The solution written: the vertex gather's where there is one.
+  const radiosity::solver::Solution& exported(const radiosity::solver::Solution& sol) const {
+    return vertex_gather ? *vertex_gather : sol;
+  }
+};
+
+/// Reads the options; writes run.ex, run.lightmap, run.onto_input and o.onto (--lightmap implies
+/// --onto input). Throws InputError for flags that cannot go together, before anything is loaded.
+void validate_radiosity_options(RadiosityOptions& o, RadiosityRun& run) {
+  check_mesh_output(o.output);
+  radiosity::bake::ExportSettings& ex = run.ex;
   ex.quantity = radiosity::bake::parse_quantity(o.quantity);
   ex.srgb8 = o.srgb8;
   ex.exposure = o.exposure;
-  const bool lightmap = o.lightmap > 0;
+  const bool lightmap = run.lightmap = o.lightmap > 0;
   if (lightmap && o.onto_given && o.onto != "input")
     throw rc::InputError("--lightmap bakes onto the input model, in its UVs: it cannot go with --onto " + o.onto);
   if (lightmap && o.fit_given) throw rc::InputError("--fit applies to vertex colours, not to --lightmap's texels");
   if (lightmap) o.onto = "input";
-  const bool onto_input = o.onto == "input";
+  const bool onto_input = run.onto_input = o.onto == "input";
   ex.linear_float = o.linear_float;
   if (o.srgb8 && (onto_input || std::filesystem::path(o.output).extension() != ".ply"))
     throw rc::InputError("--srgb8 applies to .ply output of --onto elements only");
@@ -76,16 +105,30 @@ void run_radiosity(RadiosityOptions& o) {
     if (!std::filesystem::is_directory(parent))
       throw rc::InputError("--check-points " + o.check_points_file + ": folder " + parent.string() + " does not exist");
   }
-  const auto start = std::chrono::steady_clock::now();
-  const rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+}
+
+/// Reads o.scene, o.lighting, o.output, o.lightmap, run.lightmap and run.onto_input; writes
+/// run.start (the clock --time runs on) and returns the scene, its warnings printed and the
+/// output checked against it (a lightmap's layout before the solve, not after it).
+rc::Scene load_radiosity_scene(const RadiosityOptions& o, RadiosityRun& run) {
+  run.start = std::chrono::steady_clock::now();
+  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
-  if (lightmap) {
+  if (run.lightmap) {
     radiosity::bake::check_lightmap_output(o.output, scene);
     radiosity::bake::check_lightmap_layout(scene, o.lightmap);  // before the solve, not after it
-  } else if (onto_input)
+  } else if (run.onto_input)
     radiosity::bake::check_onto_output(o.output, scene);
+  return scene;
+}
+
+/// Reads o.quiet, o.json, o.bake_gather, o.solver and run.start; writes o.solver.progress,
+/// o.solver.time_limit (what is left of --time for the solve) and run.gather (its deadline).
+void plan_radiosity_budget(RadiosityOptions& o, RadiosityRun& run) {
   o.solver.progress = !o.quiet && !o.json;
-  radiosity::bake::BakeGather gather{o.bake_gather, o.solver.seed};
+  radiosity::bake::BakeGather& gather = run.gather;
+  gather = radiosity::bake::BakeGather{o.bake_gather, o.solver.seed};
+  const auto start = run.start;
   // --time covers the whole command: loading has used some of it. A final gather of the bake
   // takes what the solve leaves of kBakeGatherShare of it; points it cannot reach in time read
   // the solution.
@@ -95,153 +138,178 @@ void run_radiosity(RadiosityOptions& o) {
                                   std::chrono::duration<double>(o.solver.time_limit));
     o.solver.time_limit = std::max(1e-3, o.bake_gather > 0 ? (1.0 - kBakeGatherShare) * left : left);
   }
-  // Under a budget a mesh left to gilt is sized to fit it (radiosity/solver/budget.h).
-  radiosity::solver::BudgetFit budget_fit;
-  const radiosity::solver::Solution sol = o.solver.time_limit > 0.0
-                                      ? radiosity::solver::solve_within(scene, o.solver, o.solver.time_limit, &budget_fit)
-                                      : radiosity::solver::solve(scene, o.solver);
-  // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
-  if (rc::processes().rank() > 0) return;
+}
+
+/// Reads the scene and o.solver; writes run.budget_fit and returns the solution. Under a budget a
+/// mesh left to gilt is sized to fit it (radiosity/solver/budget.h).
+radiosity::solver::Solution solve_radiosity(const rc::Scene& scene, const RadiosityOptions& o, RadiosityRun& run) {
+  return o.solver.time_limit > 0.0 ? radiosity::solver::solve_within(scene, o.solver, o.solver.time_limit, &run.budget_fit)
+                                   : radiosity::solver::solve(scene, o.solver);
+}
+
+/// Reads the solution's mesh warnings, run.budget_fit and o.json; writes them to stderr.
+void print_solve_warnings(const radiosity::solver::Solution& sol, const RadiosityOptions& o, const RadiosityRun& run) {
   for (const std::string& w : sol.mesh_report.warnings) std::cerr << "gilt: warning: " << w << "\n";
-  if (!budget_fit.note.empty() && !o.json) std::cerr << "gilt: " << budget_fit.note << "\n";
-  const radiosity::bake::VertexFit fit =
-      o.fit == "point" ? radiosity::bake::VertexFit::point : radiosity::bake::VertexFit::least_squares;
-  std::optional<radiosity::bake::InputColours> onto;
-  radiosity::bake::SnapStats snap;
-  std::optional<radiosity::bake::Lightmap> atlas;
-  // --onto elements --bake-gather N: the vertices' light traced from the input under them.
-  std::optional<radiosity::solver::Solution> vertex_gather;
-  radiosity::bake::BakeGatherCount vertex_gather_count;
-  double vertex_gather_seconds = 0.0;
-  const auto exported = [&]() -> const radiosity::solver::Solution& { return vertex_gather ? *vertex_gather : sol; };
-  if (lightmap) {
-    atlas = radiosity::bake::bake_lightmap(scene, sol, ex.quantity, o.lightmap, gather);
-    radiosity::bake::write_lightmap(o.output, scene, *atlas, ex);
-  } else if (onto_input) {
-    onto = radiosity::bake::fit_input_colours(scene, sol, fit, ex.quantity, gather);
-    radiosity::bake::write_onto_input(o.output, scene, *onto, ex);
+  if (!run.budget_fit.note.empty() && !o.json) std::cerr << "gilt: " << run.budget_fit.note << "\n";
+}
+
+/// Reads the scene, the solution, the options and run.ex, run.gather; writes run.fit and the
+/// output file, with run.atlas (--lightmap), run.onto (--onto input) or run.snap and the vertex
+/// gather (--onto elements).
+void export_radiosity(const rc::Scene& scene, const radiosity::solver::Solution& sol, const RadiosityOptions& o,
+                      RadiosityRun& run) {
+  const radiosity::bake::ExportSettings& ex = run.ex;
+  run.fit = o.fit == "point" ? radiosity::bake::VertexFit::point : radiosity::bake::VertexFit::least_squares;
+  if (run.lightmap) {
+    run.atlas = radiosity::bake::bake_lightmap(scene, sol, ex.quantity, o.lightmap, run.gather);
+    radiosity::bake::write_lightmap(o.output, scene, *run.atlas, ex);
+  } else if (run.onto_input) {
+    run.onto = radiosity::bake::fit_input_colours(scene, sol, run.fit, ex.quantity, run.gather);
+    radiosity::bake::write_onto_input(o.output, scene, *run.onto, ex);
   } else {
     if (o.bake_gather > 0) {
       const auto gather_start = std::chrono::steady_clock::now();
-      vertex_gather.emplace(radiosity::bake::gather_at_vertices(scene, sol, gather, &vertex_gather_count));
-      vertex_gather_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - gather_start).count();
+      run.vertex_gather.emplace(radiosity::bake::gather_at_vertices(scene, sol, run.gather, &run.vertex_gather_count));
+      run.vertex_gather_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - gather_start).count();
     }
-    radiosity::bake::write_solution(o.output, scene, exported(), ex, &snap);
+    radiosity::bake::write_solution(o.output, scene, run.exported(sol), ex, &run.snap);
   }
-  std::optional<radiosity::bake::CheckResult> check;
-  std::optional<radiosity::bake::SurfaceCheckResult> surface_check;
-  std::optional<radiosity::bake::SurfaceCheckResult> element_surface_check;  ///< --onto elements, beside `check`
-  if (o.check_points > 0) {
-    o.check.points = o.check_points;
-    o.check.seed = o.solver.seed;
-    const rc::ThreadLimit limit(o.solver.threads);
-    // The check's own irradiance bake gathers every point, past any deadline.
-    gather.deadline = std::chrono::steady_clock::time_point::max();
-    if (lightmap) {
-      const radiosity::bake::Lightmap e = ex.quantity == radiosity::bake::Quantity::irradiance
-                                        ? *atlas
-                                        : radiosity::bake::bake_lightmap(scene, sol, radiosity::bake::Quantity::irradiance, o.lightmap, gather);
-      surface_check = radiosity::bake::check_lightmap(scene, e, o.check);
-    } else if (onto_input) {
-      // The colours as irradiance, at random points inside the input's faces.
-      const radiosity::bake::InputColours e =
-          ex.quantity == radiosity::bake::Quantity::irradiance
-              ? *onto
-              : radiosity::bake::fit_input_colours(scene, sol, fit, radiosity::bake::Quantity::irradiance, gather);
-      surface_check = radiosity::bake::check_input_colours(scene, e, o.check);
-    } else {
-      check = radiosity::bake::check_against_path_tracer(scene, exported(), o.check);
-      // And at random points inside the input's faces, read from the elements as written: the
-      // mesh write_solution exports (snapped, coincident faces dropped), in irradiance.
-      const radiosity::solver::Solution& e = exported();
-      const radiosity::mesh::RadiosityMesh written = radiosity::bake::without_coincident(
-          radiosity::bake::snapped_to_input(scene, e.mesh, 0.5f * e.mesh_report.max_edge));
-      element_surface_check = radiosity::bake::check_element_colours(scene, written, e.vertex_irradiance, o.check);
-    }
-    if (surface_check && !o.check_points_file.empty())
-      radiosity::bake::write_check_points(o.check_points_file, scene, *surface_check);
-    if (check && !o.check_points_file.empty()) radiosity::bake::write_check_points(o.check_points_file, *check);
-  }
+}
 
+/// --check N. Reads the scene, the solution, the options and what the export left in run; writes
+/// o.check (points and seed), run.gather's deadline (none: the check gathers every point),
+/// run.check, run.surface_check or run.element_surface_check, and the --check-points file.
+void check_radiosity(const rc::Scene& scene, const radiosity::solver::Solution& sol, RadiosityOptions& o,
+                     RadiosityRun& run) {
+  if (o.check_points <= 0) return;
+  const radiosity::bake::ExportSettings& ex = run.ex;
+  o.check.points = o.check_points;
+  o.check.seed = o.solver.seed;
+  const rc::ThreadLimit limit(o.solver.threads);
+  // The check's own irradiance bake gathers every point, past any deadline.
+  run.gather.deadline = std::chrono::steady_clock::time_point::max();
+  if (run.lightmap) {
+    const radiosity::bake::Lightmap e = ex.quantity == radiosity::bake::Quantity::irradiance
+                                      ? *run.atlas
+                                      : radiosity::bake::bake_lightmap(scene, sol, radiosity::bake::Quantity::irradiance, o.lightmap, run.gather);
+    run.surface_check = radiosity::bake::check_lightmap(scene, e, o.check);
+  } else if (run.onto_input) {
+    // The colours as irradiance, at random points inside the input's faces.
+    const radiosity::bake::InputColours e =
+        ex.quantity == radiosity::bake::Quantity::irradiance
+            ? *run.onto
+            : radiosity::bake::fit_input_colours(scene, sol, run.fit, radiosity::bake::Quantity::irradiance, run.gather);
+    run.surface_check = radiosity::bake::check_input_colours(scene, e, o.check);
+  } else {
+    run.check = radiosity::bake::check_against_path_tracer(scene, run.exported(sol), o.check);
+    // And at random points inside the input's faces, read from the elements as written: the
+    // mesh write_solution exports (snapped, coincident faces dropped), in irradiance.
+    const radiosity::solver::Solution& e = run.exported(sol);
+    const radiosity::mesh::RadiosityMesh written = radiosity::bake::without_coincident(
+        radiosity::bake::snapped_to_input(scene, e.mesh, 0.5f * e.mesh_report.max_edge));
+    run.element_surface_check = radiosity::bake::check_element_colours(scene, written, e.vertex_irradiance, o.check);
+  }
+  if (run.surface_check && !o.check_points_file.empty())
+    radiosity::bake::write_check_points(o.check_points_file, scene, *run.surface_check);
+  if (run.check && !o.check_points_file.empty()) radiosity::bake::write_check_points(o.check_points_file, *run.check);
+}
+
+/// Reads the solution, the options and run's bakes; adds the JSON sections of the fit, the vertex
+/// gather and the lightmap, those that ran.
+void add_bake_json(nlohmann::json& j, const radiosity::solver::Solution& sol, const RadiosityOptions& o,
+                   const RadiosityRun& run) {
+  if (run.onto)
+    j["fit"] = {{"method", o.fit},
+                {"samples", run.onto->stats.samples},
+                {"samples_without_solution", run.onto->stats.missing},
+                {"buried_faces_left_out", run.onto->buried_faces},
+                {"iterations", run.onto->stats.iterations},
+                {"gather_rays", o.bake_gather},
+                {"gathered_samples", run.onto->gather.gathered},
+                {"samples_read_after_deadline", run.onto->gather.late},
+                {"seconds", run.onto->seconds}};
+  if (run.vertex_gather)
+    j["vertex_gather"] = {{"gather_rays", o.bake_gather},
+                          {"gathered_vertices", run.vertex_gather_count.gathered},
+                          {"vertices_read_after_deadline", run.vertex_gather_count.late},
+                          {"vertices", sol.mesh.vertex_count()},
+                          {"seconds", run.vertex_gather_seconds}};
+  if (const auto& atlas = run.atlas)
+    j["lightmap"] = {{"size", atlas->size},
+                     {"image", radiosity::bake::lightmap_image_path(o.output)},
+                     {"uvs", atlas->stats.uv_source},
+                     {"uv_set", atlas->stats.uv_set},
+                     {"charts", atlas->stats.charts},
+                     {"faces", atlas->stats.faces},
+                     {"buried_faces_left_out", atlas->stats.buried_faces},
+                     {"texels", atlas->stats.texels},
+                     {"texels_per_unit", atlas->stats.texels_per_metre},
+                     {"gather_rays", o.bake_gather},
+                     {"gathered_points", atlas->stats.gather.gathered},
+                     {"points_read_after_deadline", atlas->stats.gather.late},
+                     {"layout_seconds", atlas->stats.layout_seconds},
+                     {"bake_seconds", atlas->stats.bake_seconds}};
+}
+
+/// Reads o.check and run's check results; adds the JSON sections of the checks that ran.
+void add_check_json(nlohmann::json& j, const RadiosityOptions& o, const RadiosityRun& run) {
+  if (const auto& surface_check = run.surface_check)
+    j["check"] = {{"points", surface_check->points},
+                  {"samples", o.check.samples},
+                  {"where", "random points inside the input's faces"},
+                  {"unlit_points_left_out", surface_check->unlit},
+                  {"relative_mse", surface_check->relative_mse},
+                  {"reference_share", surface_check->reference_share},
+                  {"mean_relative_error", surface_check->mean_relative_error},
+                  {"mean_ratio", surface_check->mean_ratio},
+                  {"seconds", surface_check->seconds}};
+  if (const auto& check = run.check)
+    j["check"] = {{"points", check->points},
+                  {"samples", o.check.samples},
+                  {"mean_relative_error", check->mean_relative_error},
+                  {"relative_mean_absolute_error", check->relative_mean_absolute_error},
+                  {"reference_noise", check->reference_noise},
+                  {"seconds", check->seconds}};
+  if (const auto& element_surface_check = run.element_surface_check)
+    j["surface_check"] = {
+        {"points", element_surface_check->points},
+        {"samples", o.check.samples},
+        {"where", "random points inside the input's faces, read from the exported elements"},
+        {"covered", element_surface_check->covered},
+        {"uncovered", element_surface_check->uncovered},
+        {"covered_share", element_surface_check->covered_share()},
+        {"unlit_points_left_out", element_surface_check->unlit},
+        {"relative_mse", element_surface_check->relative_mse},
+        {"reference_share", element_surface_check->reference_share},
+        {"mean_relative_error", element_surface_check->mean_relative_error},
+        {"mean_ratio", element_surface_check->mean_ratio},
+        {"seconds", element_surface_check->seconds}};
+}
+
+/// --json. Reads the solution, the options and run; writes one JSON object to stdout.
+void report_radiosity_json(const radiosity::solver::Solution& sol, const RadiosityOptions& o, const RadiosityRun& run) {
+  const radiosity::bake::SnapStats& snap = run.snap;
+  nlohmann::json j = api::solution_statistics(sol, o.solver);
+  j.update(nlohmann::json{{"command", "radiosity"},
+                          {"scene", o.scene},
+                          {"quantity", o.quantity},
+                          {"onto", o.onto},
+                          {"vertices_moved_onto_input_far", snap.moved_far},
+                          {"vertices_left_off_input", snap.not_moved},
+                          {"largest_move_onto_input", snap.largest},
+                          {"coincident_faces_merged", snap.coincident_merged},
+                          {"coincident_back_to_back_pairs", snap.back_to_back},
+                          {"output", o.output}});
+  add_bake_json(j, sol, o, run);
+  add_check_json(j, o, run);
+  std::cout << j.dump() << std::endl;
+}
+
+/// Reads the solution and o.solver; prints its mesh, solve, ladder, work and time lines.
+void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityOptions& o) {
   const double secs = std::max(sol.seconds, 1e-9);
   const int threads = o.solver.threads > 0 ? o.solver.threads : rc::hardware_threads();
-  if (o.json) {
-    nlohmann::json j = api::solution_statistics(sol, o.solver);
-    j.update(nlohmann::json{{"command", "radiosity"},
-                            {"scene", o.scene},
-                            {"quantity", o.quantity},
-                            {"onto", o.onto},
-                            {"vertices_moved_onto_input_far", snap.moved_far},
-                            {"vertices_left_off_input", snap.not_moved},
-                            {"largest_move_onto_input", snap.largest},
-                            {"coincident_faces_merged", snap.coincident_merged},
-                            {"coincident_back_to_back_pairs", snap.back_to_back},
-                            {"output", o.output}});
-    if (onto)
-      j["fit"] = {{"method", o.fit},
-                  {"samples", onto->stats.samples},
-                  {"samples_without_solution", onto->stats.missing},
-                  {"buried_faces_left_out", onto->buried_faces},
-                  {"iterations", onto->stats.iterations},
-                  {"gather_rays", o.bake_gather},
-                  {"gathered_samples", onto->gather.gathered},
-                  {"samples_read_after_deadline", onto->gather.late},
-                  {"seconds", onto->seconds}};
-    if (vertex_gather)
-      j["vertex_gather"] = {{"gather_rays", o.bake_gather},
-                            {"gathered_vertices", vertex_gather_count.gathered},
-                            {"vertices_read_after_deadline", vertex_gather_count.late},
-                            {"vertices", sol.mesh.vertex_count()},
-                            {"seconds", vertex_gather_seconds}};
-    if (atlas)
-      j["lightmap"] = {{"size", atlas->size},
-                       {"image", radiosity::bake::lightmap_image_path(o.output)},
-                       {"uvs", atlas->stats.uv_source},
-                       {"uv_set", atlas->stats.uv_set},
-                       {"charts", atlas->stats.charts},
-                       {"faces", atlas->stats.faces},
-                       {"buried_faces_left_out", atlas->stats.buried_faces},
-                       {"texels", atlas->stats.texels},
-                       {"texels_per_unit", atlas->stats.texels_per_metre},
-                       {"gather_rays", o.bake_gather},
-                       {"gathered_points", atlas->stats.gather.gathered},
-                       {"points_read_after_deadline", atlas->stats.gather.late},
-                       {"layout_seconds", atlas->stats.layout_seconds},
-                       {"bake_seconds", atlas->stats.bake_seconds}};
-    if (surface_check)
-      j["check"] = {{"points", surface_check->points},
-                    {"samples", o.check.samples},
-                    {"where", "random points inside the input's faces"},
-                    {"unlit_points_left_out", surface_check->unlit},
-                    {"relative_mse", surface_check->relative_mse},
-                    {"reference_share", surface_check->reference_share},
-                    {"mean_relative_error", surface_check->mean_relative_error},
-                    {"mean_ratio", surface_check->mean_ratio},
-                    {"seconds", surface_check->seconds}};
-    if (check)
-      j["check"] = {{"points", check->points},
-                    {"samples", o.check.samples},
-                    {"mean_relative_error", check->mean_relative_error},
-                    {"relative_mean_absolute_error", check->relative_mean_absolute_error},
-                    {"reference_noise", check->reference_noise},
-                    {"seconds", check->seconds}};
-    if (element_surface_check)
-      j["surface_check"] = {
-          {"points", element_surface_check->points},
-          {"samples", o.check.samples},
-          {"where", "random points inside the input's faces, read from the exported elements"},
-          {"covered", element_surface_check->covered},
-          {"uncovered", element_surface_check->uncovered},
-          {"covered_share", element_surface_check->covered_share()},
-          {"unlit_points_left_out", element_surface_check->unlit},
-          {"relative_mse", element_surface_check->relative_mse},
-          {"reference_share", element_surface_check->reference_share},
-          {"mean_relative_error", element_surface_check->mean_relative_error},
-          {"mean_ratio", element_surface_check->mean_ratio},
-          {"seconds", element_surface_check->seconds}};
-    std::cout << j.dump() << std::endl;
-    return;
-  }
   std::printf("gilt radiosity: %s, %d thread(s)\n", o.scene.c_str(), threads);
   std::printf("  mesh:    %zu elements (%zu as meshed), %zu vertices, target edge %.4g, %zu elements bisected at steep "
               "direct light\n",
@@ -292,12 +360,18 @@ void run_radiosity(RadiosityOptions& o) {
       std::printf("%s%s %.3g s", i ? ", " : "", stages[i].first.c_str(), stages[i].second);
     std::printf("\n");
   }
-  // The check inverts L = ρ E / π, which holds on Lambertian surfaces only: say so rather than
-  // print errors of nothing.
-  const char* kNothingChecked =
-      "  check:   nothing compared: no %s could be checked; the check reads irradiance only on diffuse "
-      "materials with albedo above zero in every channel (glossy and metallic-roughness surfaces are not "
-      "checked yet)\n";
+}
+
+// The check inverts L = ρ E / π, which holds on Lambertian surfaces only: say so rather than
+// print errors of nothing.
+constexpr const char* kNothingChecked =
+    "  check:   nothing compared: no %s could be checked; the check reads irradiance only on diffuse "
+    "materials with albedo above zero in every channel (glossy and metallic-roughness surfaces are not "
+    "checked yet)\n";
+
+/// Reads o.check and run.check, run.element_surface_check (--onto elements); prints their lines.
+void print_element_checks(const RadiosityOptions& o, const RadiosityRun& run) {
+  const auto& check = run.check;
   if (check && check->points == 0)
     std::printf(kNothingChecked, "vertex");
   else if (check)
@@ -305,8 +379,8 @@ void run_radiosity(RadiosityOptions& o) {
                 "error %.3g %%, relative mean absolute error %.3g %%, reference noise %.3g %% (%.2f s)\n",
                 check->points, o.check.samples, 100.0 * check->mean_relative_error,
                 100.0 * check->relative_mean_absolute_error, 100.0 * check->reference_noise, check->seconds);
-  if (element_surface_check) {
-    const radiosity::bake::SurfaceCheckResult& e = *element_surface_check;
+  if (run.element_surface_check) {
+    const radiosity::bake::SurfaceCheckResult& e = *run.element_surface_check;
     if (e.points + e.unlit + e.uncovered == 0)
       std::printf("  check:   nothing compared at points inside the input's faces: none could be drawn and "
                   "seen (spheres, mirrors and glass are not drawn from; points with something lying on them are "
@@ -321,11 +395,30 @@ void run_radiosity(RadiosityOptions& o) {
           100.0 * e.mean_relative_error, e.mean_ratio, 100.0 * e.covered_share(), e.covered,
           e.covered + e.uncovered, e.seconds);
   }
-  if (vertex_gather)
+}
+
+/// Reads --bake-gather and one bake's count; prints its gather line (none without a gather).
+void print_bake_gather(const radiosity::bake::BakeGatherCount& g, int bake_gather) {
+  if (bake_gather == 0) return;
+  std::printf("  gather:  %d shadow and gather rays at each of %llu points", bake_gather,
+              static_cast<unsigned long long>(g.gathered));
+  if (g.late > 0)
+    std::printf("; %llu points past --time read the solution instead", static_cast<unsigned long long>(g.late));
+  std::printf("\n");
+}
+
+/// Reads the solution, the options and run's bakes and input-face check; prints the vertex
+/// gather, onto, lightmap and check lines, and what was written.
+void print_bake_report(const radiosity::solver::Solution& sol, const RadiosityOptions& o, const RadiosityRun& run) {
+  const auto& onto = run.onto;
+  const auto& atlas = run.atlas;
+  const auto& surface_check = run.surface_check;
+  if (run.vertex_gather)
     std::printf("  gather:  %llu of %zu vertices traced from the input surface under them, %d rays each (%llu read "
                 "from the solution after the deadline), %.3g s\n",
-                static_cast<unsigned long long>(vertex_gather_count.gathered), sol.mesh.vertex_count(), o.bake_gather,
-                static_cast<unsigned long long>(vertex_gather_count.late), vertex_gather_seconds);
+                static_cast<unsigned long long>(run.vertex_gather_count.gathered), sol.mesh.vertex_count(),
+                o.bake_gather, static_cast<unsigned long long>(run.vertex_gather_count.late),
+                run.vertex_gather_seconds);
   if (onto)
     std::printf("  onto:    %s fit to the input's vertices: %llu samples (%llu without a solution; %zu buried "
                 "faces left out), %.3g s\n",
@@ -337,19 +430,11 @@ void run_radiosity(RadiosityOptions& o) {
                 atlas->size, atlas->size, atlas->stats.faces, atlas->stats.buried_faces, atlas->stats.texels,
                 100.0 * double(atlas->stats.texels) / (double(atlas->size) * atlas->size),
                 atlas->stats.layout_seconds, atlas->stats.bake_seconds, atlas->stats.uv_source.c_str());
-  const auto print_gather = [&](const radiosity::bake::BakeGatherCount& g) {
-    if (o.bake_gather == 0) return;
-    std::printf("  gather:  %d shadow and gather rays at each of %llu points", o.bake_gather,
-                static_cast<unsigned long long>(g.gathered));
-    if (g.late > 0)
-      std::printf("; %llu points past --time read the solution instead", static_cast<unsigned long long>(g.late));
-    std::printf("\n");
-  };
-  if (onto) print_gather(onto->gather);
+  if (onto) print_bake_gather(onto->gather, o.bake_gather);
   if (atlas && atlas->stats.uv_set < 0)
     std::printf(", %zu charts at %.4g texels per unit", atlas->stats.charts, atlas->stats.texels_per_metre);
   if (atlas) std::printf("\n            wrote %s\n", radiosity::bake::lightmap_image_path(o.output).c_str());
-  if (atlas) print_gather(atlas->stats.gather);
+  if (atlas) print_bake_gather(atlas->stats.gather, o.bake_gather);
   if (surface_check && surface_check->points == 0 && surface_check->unlit == 0)
     std::printf(kNothingChecked, "sampled point");
   else if (surface_check)
@@ -361,6 +446,28 @@ void run_radiosity(RadiosityOptions& o) {
         surface_check->reference_share, 100.0 * surface_check->mean_relative_error, surface_check->mean_ratio,
         surface_check->seconds);
   std::printf("  wrote %s (%s)\n", o.output.c_str(), o.quantity.c_str());
+}
+
+/// `gilt radiosity`: validate the options, load the scene, plan the budget, solve, then (rank 0)
+/// export, check and report.
+void run_radiosity(RadiosityOptions& o) {
+  RadiosityRun run;
+  validate_radiosity_options(o, run);
+  const rc::Scene scene = load_radiosity_scene(o, run);
+  plan_radiosity_budget(o, run);
+  const radiosity::solver::Solution sol = solve_radiosity(scene, o, run);
+  // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
+  if (rc::processes().rank() > 0) return;
+  print_solve_warnings(sol, o, run);
+  export_radiosity(scene, sol, o, run);
+  check_radiosity(scene, sol, o, run);
+  if (o.json) {
+    report_radiosity_json(sol, o, run);
+    return;
+  }
+  print_solve_report(sol, o);
+  print_element_checks(o, run);
+  print_bake_report(sol, o, run);
 }
 
 }  // namespace
