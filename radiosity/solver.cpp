@@ -493,44 +493,20 @@ struct Receivers {
     return std::span<const rc::SurfacePoint>(spread).subspan(kVisibilityOrigins * v, kVisibilityOrigins);
   }
 
-  /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
-  /// factor times its radiosity, times the patch's visible fraction seen from v. `kept`, when
-  /// given, holds the patch's form factors at v (one per element): read when `known`, else
-  /// computed and stored there.
-  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts, float* kept = nullptr,
-              bool known = false) const {
-    const Vec3& p = origin[v];
-    const Vec3& n = mesh.normals[v];
-    if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
-    // Per source element: its share of what v receives, as a running sum for sampling. Elements
-    // that send nothing get empty intervals, which sampling never picks.
-    const size_t m = src.elements.size();
-    std::array<float, SourceBatch::kMaxBatch> computed;
-    const float* factor = kept;
-    if (!kept || !known) {
-      counts.form_factors += m;
-      src.batch.form_factors(p, n, computed.data());
-      if (kept) std::copy_n(computed.data(), m, kept);
-      factor = computed.data();
-    }
+  /// A patch's shares of what a vertex receives, per element, as a running sum for sampling
+  /// (receive). Elements that send nothing get empty intervals, which sampling never picks.
+  struct Shares {
     std::array<float, kMaxPatchElements> cdf;
-    float r = 0.0f, g = 0.0f, b = 0.0f, total = 0.0f;
-    for (size_t k = 0; k < m; ++k) {
-      const float f = factor[k];
-      r += f * src.channels[0][k];
-      g += f * src.channels[1][k];
-      b += f * src.channels[2][k];
-      total += f * src.channels[3][k];
-      cdf[k] = total;
-    }
-    if (!(total > 0.0f)) return Rgb(0.0f);
-    const Rgb gathered(r, g, b);
-    size_t last = m - 1;  // the last element with a share, for rounding at the top of the sum
-    while (last > 0 && !(cdf[last] > cdf[last - 1])) --last;
-    auto sends = [&](size_t k) { return k == 0 ? cdf[0] > 0.0f : cdf[k] > cdf[k - 1]; };
+    size_t m = 0;       ///< the patch's element count
+    size_t last = 0;    ///< the last element with a share, for rounding at the top of the sum
+    float total = 0.0f;
+    bool sends(size_t k) const { return k == 0 ? cdf[0] > 0.0f : cdf[k] > cdf[k - 1]; }
+  };
 
-    // Occluders that the box around v and the patch misses cannot block; for the sharp shadows
-    // of emitters the remaining ones are tested against each element's tetrahedron.
+  /// Occluders that the box around p and the patch misses cannot block; for the sharp shadows
+  /// of emitters the remaining ones are tested against each element's tetrahedron. False when
+  /// nothing can block the patch from p.
+  bool occluders_may_block(const ShootingPatch& src, const Vec3& p, const Shares& shares) const {
     bool may_be_blocked = false;
     const rc::Bounds3 reach{glm::min(src.box.lo, p), glm::max(src.box.hi, p)};
     for (const rc::Bounds3& box : occluders) {
@@ -539,28 +515,31 @@ struct Receivers {
         may_be_blocked = true;
         break;
       }
-      for (size_t k = 0; k <= last && !may_be_blocked; ++k) {
-        if (!sends(k)) continue;
+      for (size_t k = 0; k <= shares.last && !may_be_blocked; ++k) {
+        if (!shares.sends(k)) continue;
         const auto& el = mesh.elements[src.elements[k]];
         may_be_blocked =
             tetrahedron_may_meet_box(p, mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]], box);
       }
       if (may_be_blocked) break;
     }
-    if (!may_be_blocked) {
-      ++counts.skipped;
-      return gathered;
-    }
-    // Points on the patch, each drawn in proportion to what its element sends to v: a ray from
-    // one of v's origins (taken in turn) to the point at u of the patch's sample square, whose
-    // u.x picks the element by the running sum and is then stretched back to [0, 1).
+    return may_be_blocked;
+  }
+
+  /// What of `gathered` (the patch's light at vertex v, unshadowed) gets past the occluders, by
+  /// shadow rays: points on the patch, each drawn in proportion to what its element sends to v,
+  /// a ray from one of v's origins (taken in turn) to the point at u of the patch's sample
+  /// square, whose u.x picks the element by the running sum and is then stretched back to [0, 1).
+  Rgb visible(const ShootingPatch& src, size_t v, const Shares& shares, const Rgb& gathered, rc::Rng& rng,
+              Counts& counts) const {
     const std::span<const rc::SurfacePoint> from = origins(v);
     const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
     size_t ray_index = 0;
+    const auto& cdf = shares.cdf;
     auto open_at = [&](float ux, float uy) {
-      ux *= total;
-      size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + m, ux) - cdf.begin());
-      k = std::min(k, last);
+      ux *= shares.total;
+      size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + shares.m, ux) - cdf.begin());
+      k = std::min(k, shares.last);
       const float lo = k ? cdf[k - 1] : 0.0f;
       ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
       const rc::Vec2 bary = rc::sample_uniform_triangle({ux, uy});
@@ -602,6 +581,48 @@ struct Receivers {
     for (int j = 0; j < 4; ++j)
       for (int t = 1; t < per_quarter; ++t) hits[j] += open_in_quarter(j);
     return gathered * float(quartered_fraction(hits, per_quarter));
+  }
+
+  /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
+  /// factor times its radiosity, times the patch's visible fraction seen from v. `kept`, when
+  /// given, holds the patch's form factors at v (one per element): read when `known`, else
+  /// computed and stored there.
+  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts, float* kept = nullptr,
+              bool known = false) const {
+    const Vec3& p = origin[v];
+    const Vec3& n = mesh.normals[v];
+    if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
+    Shares shares;
+    const size_t m = shares.m = src.elements.size();
+    std::array<float, SourceBatch::kMaxBatch> computed;
+    const float* factor = kept;
+    if (!kept || !known) {
+      counts.form_factors += m;
+      src.batch.form_factors(p, n, computed.data());
+      if (kept) std::copy_n(computed.data(), m, kept);
+      factor = computed.data();
+    }
+    std::array<float, kMaxPatchElements>& cdf = shares.cdf;
+    float r = 0.0f, g = 0.0f, b = 0.0f, total = 0.0f;
+    for (size_t k = 0; k < m; ++k) {
+      const float f = factor[k];
+      r += f * src.channels[0][k];
+      g += f * src.channels[1][k];
+      b += f * src.channels[2][k];
+      total += f * src.channels[3][k];
+      cdf[k] = total;
+    }
+    if (!(total > 0.0f)) return Rgb(0.0f);
+    shares.total = total;
+    const Rgb gathered(r, g, b);
+    size_t last = m - 1;
+    while (last > 0 && !(cdf[last] > cdf[last - 1])) --last;
+    shares.last = last;
+    if (!occluders_may_block(src, p, shares)) {
+      ++counts.skipped;
+      return gathered;
+    }
+    return visible(src, v, shares, gathered, rng, counts);
   }
 };
 
