@@ -503,44 +503,20 @@ struct Receivers {
     return std::span<const rc::SurfacePoint>(spread).subspan(kVisibilityOrigins * v, kVisibilityOrigins);
   }
 
-  /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
-  /// factor times its radiosity, times the patch's visible fraction seen from v. `kept`, when
-  /// given, holds the patch's form factors at v (one per element): read when `known`, else
-  /// computed and stored there.
-  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts, float* kept = nullptr,
-              bool known = false) const {
-    const Vec3& p = origin[v];
-    const Vec3& n = mesh.normals[v];
-    if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
-    // Per source element: its share of what v receives, as a running sum for sampling. Elements
-    // that send nothing get empty intervals, which sampling never picks.
-    const size_t m = src.elements.size();
-    std::array<float, SourceBatch::kMaxBatch> computed;
-    const float* factor = kept;
-    if (!kept || !known) {
-      counts.form_factors += m;
-      src.batch.form_factors(p, n, computed.data());
-      if (kept) std::copy_n(computed.data(), m, kept);
-      factor = computed.data();
-    }
+  /// A patch's shares of what a vertex receives, per element, as a running sum for sampling
+  /// (receive). Elements that send nothing get empty intervals, which sampling never picks.
+  struct Shares {
     std::array<float, kMaxPatchElements> cdf;
-    float r = 0.0f, g = 0.0f, b = 0.0f, total = 0.0f;
-    for (size_t k = 0; k < m; ++k) {
-      const float f = factor[k];
-      r += f * src.channels[0][k];
-      g += f * src.channels[1][k];
-      b += f * src.channels[2][k];
-      total += f * src.channels[3][k];
-      cdf[k] = total;
-    }
-    if (!(total > 0.0f)) return Rgb(0.0f);
-    const Rgb gathered(r, g, b);
-    size_t last = m - 1;  // the last element with a share, for rounding at the top of the sum
-    while (last > 0 && !(cdf[last] > cdf[last - 1])) --last;
-    auto sends = [&](size_t k) { return k == 0 ? cdf[0] > 0.0f : cdf[k] > cdf[k - 1]; };
+    size_t m = 0;       ///< the patch's element count
+    size_t last = 0;    ///< the last element with a share, for rounding at the top of the sum
+    float total = 0.0f;
+    bool sends(size_t k) const { return k == 0 ? cdf[0] > 0.0f : cdf[k] > cdf[k - 1]; }
+  };
 
-    // Occluders that the box around v and the patch misses cannot block; for the sharp shadows
-    // of emitters the remaining ones are tested against each element's tetrahedron.
+  /// Occluders that the box around p and the patch misses cannot block; for the sharp shadows
+  /// of emitters the remaining ones are tested against each element's tetrahedron. False when
+  /// nothing can block the patch from p.
+  bool occluders_may_block(const ShootingPatch& src, const Vec3& p, const Shares& shares) const {
     bool may_be_blocked = false;
     const rc::Bounds3 reach{glm::min(src.box.lo, p), glm::max(src.box.hi, p)};
     for (const rc::Bounds3& box : occluders) {
@@ -549,28 +525,31 @@ struct Receivers {
         may_be_blocked = true;
         break;
       }
-      for (size_t k = 0; k <= last && !may_be_blocked; ++k) {
-        if (!sends(k)) continue;
+      for (size_t k = 0; k <= shares.last && !may_be_blocked; ++k) {
+        if (!shares.sends(k)) continue;
         const auto& el = mesh.elements[src.elements[k]];
         may_be_blocked =
             tetrahedron_may_meet_box(p, mesh.positions[el[0]], mesh.positions[el[1]], mesh.positions[el[2]], box);
       }
       if (may_be_blocked) break;
     }
-    if (!may_be_blocked) {
-      ++counts.skipped;
-      return gathered;
-    }
-    // Points on the patch, each drawn in proportion to what its element sends to v: a ray from
-    // one of v's origins (taken in turn) to the point at u of the patch's sample square, whose
-    // u.x picks the element by the running sum and is then stretched back to [0, 1).
+    return may_be_blocked;
+  }
+
+  /// What of `gathered` (the patch's light at vertex v, unshadowed) gets past the occluders, by
+  /// shadow rays: points on the patch, each drawn in proportion to what its element sends to v,
+  /// a ray from one of v's origins (taken in turn) to the point at u of the patch's sample
+  /// square, whose u.x picks the element by the running sum and is then stretched back to [0, 1).
+  Rgb visible(const ShootingPatch& src, size_t v, const Shares& shares, const Rgb& gathered, rc::Rng& rng,
+              Counts& counts) const {
     const std::span<const rc::SurfacePoint> from = origins(v);
     const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
     size_t ray_index = 0;
+    const auto& cdf = shares.cdf;
     auto open_at = [&](float ux, float uy) {
-      ux *= total;
-      size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + m, ux) - cdf.begin());
-      k = std::min(k, last);
+      ux *= shares.total;
+      size_t k = size_t(std::upper_bound(cdf.begin(), cdf.begin() + shares.m, ux) - cdf.begin());
+      k = std::min(k, shares.last);
       const float lo = k ? cdf[k - 1] : 0.0f;
       ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
       const rc::Vec2 bary = rc::sample_uniform_triangle({ux, uy});
@@ -613,6 +592,48 @@ struct Receivers {
       for (int t = 1; t < per_quarter; ++t) hits[j] += open_in_quarter(j);
     return gathered * float(quartered_fraction(hits, per_quarter));
   }
+
+  /// Irradiance (W·m⁻²) at vertex v from the patch: each element's exact (or far-field) form
+  /// factor times its radiosity, times the patch's visible fraction seen from v. `kept`, when
+  /// given, holds the patch's form factors at v (one per element): read when `known`, else
+  /// computed and stored there.
+  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts, float* kept = nullptr,
+              bool known = false) const {
+    const Vec3& p = origin[v];
+    const Vec3& n = mesh.normals[v];
+    if (src.sends_nothing_to(p, n)) return Rgb(0.0f);
+    Shares shares;
+    const size_t m = shares.m = src.elements.size();
+    std::array<float, SourceBatch::kMaxBatch> computed;
+    const float* factor = kept;
+    if (!kept || !known) {
+      counts.form_factors += m;
+      src.batch.form_factors(p, n, computed.data());
+      if (kept) std::copy_n(computed.data(), m, kept);
+      factor = computed.data();
+    }
+    std::array<float, kMaxPatchElements>& cdf = shares.cdf;
+    float r = 0.0f, g = 0.0f, b = 0.0f, total = 0.0f;
+    for (size_t k = 0; k < m; ++k) {
+      const float f = factor[k];
+      r += f * src.channels[0][k];
+      g += f * src.channels[1][k];
+      b += f * src.channels[2][k];
+      total += f * src.channels[3][k];
+      cdf[k] = total;
+    }
+    if (!(total > 0.0f)) return Rgb(0.0f);
+    shares.total = total;
+    const Rgb gathered(r, g, b);
+    size_t last = m - 1;
+    while (last > 0 && !(cdf[last] > cdf[last - 1])) --last;
+    shares.last = last;
+    if (!occluders_may_block(src, p, shares)) {
+      ++counts.skipped;
+      return gathered;
+    }
+    return visible(src, v, shares, gathered, rng, counts);
+  }
 };
 
 /// Memory for progressive refinement's kept form factors (a patch's at every vertex; about
@@ -625,6 +646,461 @@ constexpr double kRefinementShare = 0.3;
 
 /// Luminance-like scalar of a colour, for refinement decisions.
 float level(const Rgb& c) { return c.average(); }
+
+/// Seconds since `start`.
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Meshes the scene (solve's first step). Reads the settings; writes sol.mesh, its report and
+/// sol.mesh_seconds.
+void mesh_scene(const rc::Scene& scene, const SolverSettings& settings, std::chrono::steady_clock::time_point start,
+                Solution& sol) {
+  MeshSettings mesh_settings = settings.mesh;
+  mesh_settings.progress = settings.progress;
+  // Under --time, imprinting and remeshing end at meshing's share of the budget; the pieces not
+  // begun by then are left as they were. Processes must all mesh alike, so several never cut it short.
+  if (settings.time_limit > 0.0 && rc::processes().count() == 1)
+    mesh_settings.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                         std::chrono::duration<double>(kMeshShare * settings.time_limit));
+  sol.mesh = build_mesh(scene, mesh_settings, &sol.mesh_report);
+  sol.mesh_seconds = seconds_since(start);
+}
+
+/// Progressive refinement's state from shot to shot (SolveState::shoot_progressive): every
+/// element holds the light it reflects and has not shot yet.
+struct Shooting {
+  std::vector<Rgb> unshot;     ///< per element
+  double emitted_power = 0.0;  ///< what the lights send, directly and by one reflection
+  Patches patches;
+  double total_area = 0.0;
+  // Each patch's form factors at every vertex, kept from its first shot for its later ones
+  // while they fit in kFactorCacheBytes: they depend on the geometry alone, and a patch
+  // shoots several times (about four on cornell), so its later shots trace only visibility.
+  std::vector<std::vector<float>> factor_rows;
+  size_t cached_bytes = 0;
+  std::vector<Rgb> received;  ///< irradiance added by the current shot, per vertex
+  ShootingPatch source;
+  double last_shot = 0.0;  ///< seconds
+};
+
+/// The state of one solve (below), on the mesh it made, which its passes read and write in turn.
+struct SolveState {
+  SolveState(const rc::Scene& s, const SolverSettings& st, Solution& so, std::chrono::steady_clock::time_point t)
+      : scene(s), settings(st), sol(so), start(t), mesh(so.mesh), receivers(s, so.mesh),
+        strata(std::max(1, int(std::round(std::sqrt(double(st.visibility_samples)))))) {
+    sol.convex_enclosure = receivers.occluders.empty();
+    // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
+    sol.solver = choose_solver(settings, mesh.element_count(), &sol.solver_reason);
+    hierarchical = sol.solver == SolverKind::hierarchical;
+    hs = settings.hierarchical;
+    hs.tolerance = settings.tolerance;
+    hs.seed = settings.seed;
+  }
+
+  const rc::Scene& scene;
+  const SolverSettings& settings;
+  Solution& sol;
+  const std::chrono::steady_clock::time_point start;
+  RadiosityMesh& mesh;
+  Receivers receivers;
+  const int strata;
+  std::atomic<uint64_t> rays{0}, form_factors{0}, skipped{0};
+  // Under several processes (mpirun) each computes the chunks of vertices or elements it owns
+  // and the results are joined, so every process holds one process's arrays. The counts of such
+  // a loop are summed over the processes, and rank 0's clock makes every decision about time.
+  const rc::Processes& group = rc::processes();
+  bool hierarchical = false;
+  HierarchicalSettings hs;
+  std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
+  std::vector<Rgb> direct_delta;  // the part of direct_punctual from point, spot and directional lights
+  size_t nv = 0, ne = 0;  // of the final mesh
+
+  double elapsed() const { return seconds_since(start); }
+  auto albedo(uint32_t material) const { return rc::diffuse_reflectance(scene.materials[material]); }
+  auto emitted(uint32_t material) const { return scene.materials[material].emission * kPi; }  // B0 = π Le
+  bool is_emitter(uint32_t e) const { return !scene.materials[mesh.element_material[e]].emission.is_black(); }
+  void add_counts(const Counts& c) {
+    form_factors += c.form_factors;
+    rays += c.rays;
+    skipped += c.skipped;
+  }
+  void joined_counts(uint64_t rays_before, uint64_t form_factors_before, uint64_t skipped_before) {
+    if (group.count() == 1) return;
+    uint64_t own[3] = {rays - rays_before, form_factors - form_factors_before, skipped - skipped_before};
+    group.sum(own);
+    rays = rays_before + own[0], form_factors = form_factors_before + own[1], skipped = skipped_before + own[2];
+  }
+  bool over_budget(double seconds) const {
+    return group.broadcast_value(settings.time_limit > 0.0 && seconds > settings.time_limit);
+  }
+  bool may_be_blocked(const rc::Bounds3& reach) const {
+    return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
+                       [&](const rc::Bounds3& box) { return reach.overlaps(box); });
+  }
+  std::function<bool(const rc::Bounds3&)> blocking() const {
+    return [this](const rc::Bounds3& reach) { return may_be_blocked(reach); };
+  }
+
+  /// The emitting patches, to shoot direct light at the vertices (none for the hierarchical
+  /// solver, whose tree walk takes the emitters: emitted_by_tree).
+  std::vector<ShootingPatch> emitting_patches() const {
+    const Patches patches = build_patches(mesh, settings.patch_elements);
+    std::vector<ShootingPatch> emitters;
+    std::vector<Rgb> radiosity(mesh.element_count());
+    for (size_t q = 0; q < patches.count() && !hierarchical; ++q) {
+      if (!is_emitter(patches.of(q)[0])) continue;
+      for (uint32_t e : patches.of(q)) radiosity[e] = emitted(mesh.element_material[e]);
+      ShootingPatch& sp = emitters.emplace_back();
+      sp.assign(mesh, patches.of(q), radiosity);
+      sp.emitter = true;
+      sp.probe = std::min(2, strata);
+      sp.strata = strata;
+    }
+    return emitters;
+  }
+
+  /// Emitting elements by the tree walk (hierarchical solver): the patches would make pass 1
+  /// cost the vertex count times the emitter count. Writes direct_emitted from first_vertex on.
+  void emitted_by_tree(size_t first_vertex) {
+    const size_t nv_now = mesh.vertex_count();
+    std::vector<Rgb> emission(mesh.element_count());
+    for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
+    // The materials' own albedo is enough here (it only weighs links in the tree walk), and the
+    // textured means cost a few seconds per 100,000 elements at every refinement step.
+    std::vector<Rgb> rho(mesh.element_count());
+    for (size_t e = 0; e < rho.size(); ++e) rho[e] = albedo(mesh.element_material[e]);
+    const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, {}, blocking(), {}, {}};
+    uint64_t tree_rays = 0;
+    const std::vector<Rgb> e = emitted_irradiance(input, emission, first_vertex, hs, settings.visibility_samples, &tree_rays);
+    for (size_t v = first_vertex; v < nv_now; ++v) direct_emitted[v] = e[v];
+    rays += tree_rays;
+  }
+
+  /// Pass 1, direct light, at the vertices from first_vertex on: every vertex gathers from the
+  /// punctual lights and from the emitting patches. Reads the mesh and receivers; writes (and
+  /// grows to the vertex count) direct_punctual, direct_delta and direct_emitted; adds to the counts.
+  void gather_direct(size_t first_vertex) {
+    const std::vector<ShootingPatch> emitters = emitting_patches();
+    const size_t nv_now = mesh.vertex_count();
+    direct_punctual.resize(nv_now, Rgb(0.0f));
+    direct_delta.resize(nv_now, Rgb(0.0f));
+    direct_emitted.resize(nv_now, Rgb(0.0f));
+    const size_t count = nv_now - first_vertex;
+    const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
+    rc::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
+      Counts counts;
+      for (size_t v = first_vertex + chunk * 128; v < std::min(nv_now, first_vertex + chunk * 128 + 128); ++v) {
+        for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
+          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
+          const rc::Light& light = scene.punctual_lights[li];
+          const Rgb e = punctual_irradiance(scene, receivers.geometry, light, receivers.origins(v), mesh.normals[v], rng,
+                                            settings.visibility_samples, counts.rays);
+          direct_punctual[v] += e;
+          if (light.kind != rc::LightKind::environment) direct_delta[v] += e;
+        }
+        for (size_t q = 0; q < emitters.size(); ++q) {
+          // Keyed by the emitter's first element, which refinement never renumbers.
+          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0xa000000000ull + emitters[q].elements[0]);
+          direct_emitted[v] += receivers.receive(emitters[q], v, rng, counts);
+        }
+      }
+      add_counts(counts);
+    });
+    for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::join_ranges(std::span(*values), 128, first_vertex);
+    joined_counts(rays_before, form_factors_before, skipped_before);
+    if (hierarchical) emitted_by_tree(first_vertex);
+  }
+
+  /// Elements whose vertices' direct irradiance spreads by more than the threshold times the
+  /// brightest of them (plus a floor of 1 % of the mean, so that darkness does not refine).
+  std::vector<uint32_t> steep_elements() const {
+    double mean = 0.0, area = 0.0;
+    for (size_t e = 0; e < mesh.element_count(); ++e) {
+      const auto& el = mesh.elements[e];
+      for (uint32_t v : el) mean += double(level(direct_punctual[v] + direct_emitted[v])) * mesh.element_area[e] / 3.0;
+      area += mesh.element_area[e];
+    }
+    const float floor = float(0.01 * mean / std::max(area, 1e-30));
+    std::vector<uint32_t> marked;
+    for (uint32_t e = 0; e < mesh.element_count(); ++e) {
+      if (is_emitter(e)) continue;
+      float lo = std::numeric_limits<float>::max(), hi = 0.0f;
+      for (uint32_t v : mesh.elements[e]) {
+        const float x = level(direct_punctual[v] + direct_emitted[v]);
+        lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+      if (hi - lo > float(settings.subdivision_threshold) * (hi + floor)) marked.push_back(e);
+    }
+    return marked;
+  }
+
+  /// Sharp shadows and near-field falloff show up in the direct light, so this is where the
+  /// mesh is refined: elements whose vertices disagree steeply are bisected and only the new
+  /// vertices gather. Vertex indices are stable under refinement, so the arrays just grow.
+  /// Writes the mesh, the receivers, the direct light (gather_direct) and sol.refined_elements.
+  void refine_direct() {
+    const float base_edge = target_edge_length(scene, settings.mesh);
+    const float min_edge = base_edge * std::ldexp(1.0f, -settings.subdivision_levels);
+    for (int round = 0; round < 2 * settings.subdivision_levels; ++round) {
+      // With a time budget, refinement stops once it has used its share, so shooting gets the rest.
+      if (over_budget(elapsed() / kRefinementShare)) break;
+      const std::vector<uint32_t> marked = steep_elements();
+      const size_t first_new = mesh.vertex_count();
+      if (marked.empty() || split_longest_edges(mesh, marked, min_edge * 1.5f) == 0) break;
+      receivers.update();
+      gather_direct(first_new);
+      sol.refined_elements += marked.size();
+    }
+  }
+
+  /// The direct light's totals on the final mesh. Reads the direct light; writes nv, ne,
+  /// sol.direct_seconds, the vertices' irradiance (direct so far), direct and punctual parts,
+  /// and the elements' and vertices' albedo.
+  void keep_direct() {
+    sol.direct_seconds = elapsed() - sol.mesh_seconds;
+    nv = mesh.vertex_count(), ne = mesh.element_count();
+    sol.vertex_irradiance.resize(nv);
+    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
+    sol.vertex_direct = sol.vertex_irradiance;
+    sol.vertex_punctual = direct_delta;
+    sol.element_albedo = element_reflectance(scene, mesh);
+    sol.vertex_albedo.assign(nv, Rgb(0.0f));
+    std::vector<float> weight(nv, 0.0f);
+    for (size_t e = 0; e < ne; ++e)
+      for (uint32_t v : mesh.elements[e]) {
+        sol.vertex_albedo[v] += sol.element_albedo[e] * mesh.element_area[e];
+        weight[v] += mesh.element_area[e];
+      }
+    for (size_t v = 0; v < nv; ++v)
+      sol.vertex_albedo[v] = weight[v] > 0.0f ? sol.vertex_albedo[v] * (1.0f / weight[v]) : albedo(mesh.vertex_material[v]);
+  }
+
+  /// Progressive refinement's start: reads the direct light; writes the unshot light (each
+  /// element's reflection of its vertices' irradiance), the emitted power, the patches (and
+  /// sol.patches) and the total area.
+  void start_shooting(Shooting& shot) {
+    shot.unshot.resize(ne);
+    const std::vector<Rgb>& element_rho = sol.element_albedo;
+    for (size_t e = 0; e < ne; ++e) {
+      const auto& el = mesh.elements[e];
+      const Rgb rho = element_rho[e];
+      shot.emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
+      shot.emitted_power +=
+          double((rho * (direct_punctual[el[0]] + direct_punctual[el[1]] + direct_punctual[el[2]])).average()) /
+          3.0 * mesh.element_area[e];
+      shot.unshot[e] = rho * (sol.vertex_irradiance[el[0]] + sol.vertex_irradiance[el[1]] + sol.vertex_irradiance[el[2]]) *
+                       (1.0f / 3.0f);
+    }
+    if (!(shot.emitted_power > 0.0))
+      sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
+
+    shot.patches = build_patches(mesh, settings.patch_elements);
+    sol.patches = shot.patches.count();
+    for (size_t e = 0; e < ne; ++e) shot.total_area += mesh.element_area[e];
+    shot.factor_rows.resize(shot.patches.count());
+  }
+
+  /// The patch with the most unshot power, of either sign (see the overshoot in aim), and that
+  /// power; writes sol.residual, the unshot power over the emitted.
+  std::pair<size_t, double> brightest_patch(const Shooting& shot) {
+    size_t src = 0;
+    double best = -1.0, best_signed = 0.0, unshot_power = 0.0;
+    for (size_t q = 0; q < shot.patches.count(); ++q) {
+      double p = 0.0;
+      for (uint32_t e : shot.patches.of(q)) p += double(shot.unshot[e].average()) * mesh.element_area[e];
+      unshot_power += std::abs(p);
+      if (std::abs(p) > best) best = std::abs(p), best_signed = p, src = q;
+    }
+    sol.residual = unshot_power / shot.emitted_power;
+    return {src, best_signed};
+  }
+
+  /// Reflected light is soft: one stratified ray per pair and shot estimates its visibility
+  /// without bias, and the noise averages out over the many shots that reach each vertex.
+  /// Overshooting (Feda & Purgathofer 1992): a patch with light to send also sends now what it
+  /// will receive later, estimated as its reflectance times the mean unshot radiosity of the
+  /// rest of the scene, and keeps that amount as negative unshot light, which a later shot of
+  /// its own corrects. A patch whose unshot light is negative sends it as it is.
+  ///
+  /// Makes patch `src` (of unshot power `best_signed`) the shot's source; writes shot.source and
+  /// the patch's unshot light.
+  void aim(Shooting& shot, size_t src, double best_signed) {
+    const std::vector<Rgb>& element_rho = sol.element_albedo;
+    std::vector<Rgb>& unshot = shot.unshot;
+    const std::span<const uint32_t> shooting = shot.patches.of(src);
+    Rgb overshoot(0.0f);
+    if (best_signed > 0.0) {
+      Rgb own(0.0f), all(0.0f);
+      double own_area = 0.0;
+      for (uint32_t e : shooting) own += unshot[e] * mesh.element_area[e], own_area += mesh.element_area[e];
+      for (size_t e = 0; e < ne; ++e) all += unshot[e] * mesh.element_area[e];
+      if (shot.total_area - own_area > 0.0) {
+        const Rgb rest = (all - own) * float(1.0 / (shot.total_area - own_area));
+        overshoot = Rgb(std::max(rest.r, 0.0f), std::max(rest.g, 0.0f), std::max(rest.b, 0.0f));
+      }
+    }
+    for (uint32_t e : shooting) unshot[e] += element_rho[e] * overshoot;
+    shot.source.assign(mesh, shooting, unshot);
+    for (uint32_t e : shooting) unshot[e] = element_rho[e] * overshoot * -1.0f;
+    shot.source.emitter = false;
+    shot.source.probe = std::min(settings.reflected_visibility_probe, strata);
+    shot.source.strata = shot.source.probe;
+  }
+
+  /// Shoots shot.source (patch `src`) at every vertex: writes shot.received, adds it to the
+  /// vertices' irradiance and its reflection to the unshot light; keeps the patch's form factors
+  /// while they fit; counts the shot (sol.shots) and adds to the counts.
+  void shoot(Shooting& shot, size_t src) {
+    const uint64_t shot_index = sol.shots++;
+    const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
+    std::vector<float>& row = shot.factor_rows[src];
+    const bool known = !row.empty();
+    const size_t width = shot.source.elements.size(), row_bytes = nv * width * sizeof(float);
+    if (!known && shot.cached_bytes + row_bytes <= kFactorCacheBytes) {
+      row.resize(nv * width);
+      shot.cached_bytes += row_bytes;
+    }
+    std::vector<Rgb>& received = shot.received;
+    rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
+      Counts counts;
+      for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
+        rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
+        received[v] = receivers.receive(shot.source, v, rng, counts, row.empty() ? nullptr : &row[v * width], known);
+      }
+      add_counts(counts);
+    });
+    rc::join_ranges(std::span(received), 256);
+    joined_counts(rays_before, form_factors_before, skipped_before);
+    // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
+    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
+    for (size_t e = 0; e < ne; ++e) {
+      const auto& el = mesh.elements[e];
+      shot.unshot[e] += sol.element_albedo[e] * (received[el[0]] + received[el[1]] + received[el[2]]) * (1.0f / 3.0f);
+    }
+  }
+
+  /// The light left unshot, as an ambient term: its mean radiosity over 1 − ρ̄. Writes sol.ambient.
+  void keep_ambient(const Shooting& shot) {
+    Rgb unshot_sum(0.0f), reflectance_sum(0.0f);
+    double area = 0.0;
+    for (size_t e = 0; e < ne; ++e) {
+      unshot_sum += shot.unshot[e] * mesh.element_area[e];
+      reflectance_sum += sol.element_albedo[e] * mesh.element_area[e];
+      area += mesh.element_area[e];
+    }
+    if (area > 0.0) {
+      const float inv_area = float(1.0 / area);
+      const Rgb rho = reflectance_sum * inv_area;
+      for (int k = 0; k < 3; ++k) sol.ambient[k] = unshot_sum[k] * inv_area / std::max(1e-3f, 1.0f - rho[k]);
+    }
+  }
+
+  /// Pass 2, progressive refinement on the final mesh: shoots the patch with the most unshot
+  /// light until what is left falls below the tolerance (or the time runs out). Reads the direct
+  /// light; adds the interreflection to sol.vertex_irradiance; writes sol.residual, shots,
+  /// patches, ambient and shoot_seconds.
+  void shoot_progressive() {
+    Shooting shot;
+    start_shooting(shot);
+    // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
+    rc::Progress progress("radiosity", 1000, "‰", settings.progress);
+    uint64_t shown = 0;
+    shot.received.assign(nv, Rgb(0.0f));
+    while (shot.emitted_power > 0.0) {
+      const auto [src, best_signed] = brightest_patch(shot);
+      const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
+      if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
+      if (sol.residual < settings.tolerance) break;
+      // A shot takes about as long as the last one: stop before one would end past the budget.
+      if (over_budget(elapsed() + shot.last_shot)) break;
+      const double shot_start = elapsed();
+      aim(shot, src, best_signed);
+      shoot(shot, src);
+      shot.last_shot = elapsed() - shot_start;
+    }
+    progress.finish();
+    // An overshoot and the negative shot that corrects it see their own visibility rays, so where
+    // they disagree a dim vertex can be left below zero, which no irradiance is: held at zero.
+    for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
+    keep_ambient(shot);
+    sol.shoot_seconds = elapsed() - sol.mesh_seconds - sol.direct_seconds;
+  }
+
+  /// Copies the hierarchical solve's result into the solution, its interreflection added to
+  /// sol.vertex_irradiance, and its counts into ours.
+  void keep_hierarchical(const HierarchicalResult& h) {
+    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += h.vertex_irradiance[v];
+    sol.nodes = h.nodes;
+    sol.links = h.links;
+    sol.iterations = h.iterations;
+    if (h.clamped_elements > 0)
+      sol.mesh_report.warnings.push_back(std::to_string(h.clamped_elements) +
+                                         " elements were promised more reflected light than they can return "
+                                         "(surfaces a hair apart?); their gathering was scaled down to keep the "
+                                         "solution bounded");
+    sol.residual = h.residual;
+    sol.tail_added = h.tail_added;
+    sol.chebyshev_beta = h.chebyshev_beta;
+    sol.ladder = h.ladder;
+    sol.gather_nodes = h.gather_nodes;
+    sol.final_gather = h.final_gather;
+    sol.final_gather_note = h.final_gather_note;
+    sol.link_tolerance = h.link_tolerance;
+    sol.linking_stopped = h.linking_stopped;
+    sol.link_seconds = h.link_seconds;
+    sol.iterate_seconds = h.iterate_seconds;
+    sol.gather_seconds = h.gather_seconds;
+    rays += h.shadow_rays;
+    form_factors += h.form_factors;
+  }
+
+  /// Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex
+  /// (solve_hierarchical). Reads the direct light; writes sol.element_direct and what
+  /// keep_hierarchical keeps.
+  void gather_hierarchical() {
+    const std::vector<Rgb>& rho = sol.element_albedo;
+    // What each element reflects of the direct light: its own mean of the lights' irradiance,
+    // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
+    uint64_t element_rays = 0;
+    std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh,
+                                                                  settings.visibility_samples, settings.seed, element_rays);
+    rays += element_rays;
+    for (size_t e = 0; e < ne; ++e) {
+      const auto& el = mesh.elements[e];
+      element_direct[e] += (direct_emitted[el[0]] + direct_emitted[el[1]] + direct_emitted[el[2]]) * (1.0f / 3.0f);
+    }
+    const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, sol.vertex_irradiance, blocking(),
+                                  [this] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; },
+                                  settings.time_limit > 0.0 ? std::function<double()>([this] { return settings.time_limit - elapsed(); })
+                                                            : std::function<double()>(),
+                                  element_direct};
+    if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
+                    [](const Rgb& e) { return e.is_black(); }))
+      sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
+    const HierarchicalResult h = solve_hierarchical(input, hs);
+    sol.element_direct = std::move(element_direct);
+    keep_hierarchical(h);
+  }
+
+  /// Radiosity from irradiance: emitted plus reflected, per vertex and per element (the mean of
+  /// its vertices); and the counts and seconds.
+  void finish() {
+    sol.vertex_radiosity.resize(nv);
+    for (size_t v = 0; v < nv; ++v)
+      sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + sol.vertex_albedo[v] * sol.vertex_irradiance[v];
+    sol.element_radiosity.resize(ne);
+    for (size_t e = 0; e < ne; ++e) {
+      const auto& el = mesh.elements[e];
+      sol.element_radiosity[e] =
+          (sol.vertex_radiosity[el[0]] + sol.vertex_radiosity[el[1]] + sol.vertex_radiosity[el[2]]) * (1.0f / 3.0f);
+    }
+    sol.form_factors = form_factors;
+    sol.shadow_rays = rays;
+    sol.skipped_pairs = skipped;
+    sol.seconds = elapsed();
+  }
+};
 
 }  // namespace
 
@@ -688,355 +1164,21 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (!(settings.subdivision_threshold > 0.0) || !std::isfinite(settings.subdivision_threshold))
     throw rc::InputError("the subdivision threshold must be a positive number");
   const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const rc::ThreadLimit limit(settings.threads);
 
   Solution sol;
-  MeshSettings mesh_settings = settings.mesh;
-  mesh_settings.progress = settings.progress;
-  // Under --time, imprinting and remeshing end at meshing's share of the budget; the pieces not
-  // begun by then are left as they were. Processes must all mesh alike, so several never cut it short.
-  if (settings.time_limit > 0.0 && rc::processes().count() == 1)
-    mesh_settings.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                         std::chrono::duration<double>(kMeshShare * settings.time_limit));
-  sol.mesh = build_mesh(scene, mesh_settings, &sol.mesh_report);
-  sol.mesh_seconds = elapsed();
-  RadiosityMesh& mesh = sol.mesh;
-  Receivers receivers(scene, mesh);
-  sol.convex_enclosure = receivers.occluders.empty();
-  auto albedo = [&](uint32_t material) { return rc::diffuse_reflectance(scene.materials[material]); };
-  auto emitted = [&](uint32_t material) { return scene.materials[material].emission * kPi; };  // B0 = π Le
-  auto is_emitter = [&](uint32_t e) { return !scene.materials[mesh.element_material[e]].emission.is_black(); };
-  const int strata = std::max(1, int(std::round(std::sqrt(double(settings.visibility_samples)))));
-  std::atomic<uint64_t> rays{0}, form_factors{0}, skipped{0};
-  auto add_counts = [&](const Counts& c) {
-    form_factors += c.form_factors;
-    rays += c.rays;
-    skipped += c.skipped;
-  };
-  // Under several processes (mpirun) each computes the chunks of vertices or elements it owns
-  // and the results are joined, so every process holds one process's arrays. The counts of such
-  // a loop are summed over the processes, and rank 0's clock makes every decision about time.
-  const rc::Processes& group = rc::processes();
-  auto joined_counts = [&](uint64_t rays_before, uint64_t form_factors_before, uint64_t skipped_before) {
-    if (group.count() == 1) return;
-    uint64_t own[3] = {rays - rays_before, form_factors - form_factors_before, skipped - skipped_before};
-    group.sum(own);
-    rays = rays_before + own[0], form_factors = form_factors_before + own[1], skipped = skipped_before + own[2];
-  };
-  auto over_budget = [&](double seconds) { return group.broadcast_value(settings.time_limit > 0.0 && seconds > settings.time_limit); };
-
-  // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
-  sol.solver = choose_solver(settings, mesh.element_count(), &sol.solver_reason);
-  const bool hierarchical = sol.solver == SolverKind::hierarchical;
-  HierarchicalSettings hs = settings.hierarchical;
-  hs.tolerance = settings.tolerance;
-  hs.seed = settings.seed;
-  auto may_be_blocked = [&](const rc::Bounds3& reach) {
-    return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
-                       [&](const rc::Bounds3& box) { return reach.overlaps(box); });
-  };
-  auto element_albedo = [&] { return element_reflectance(scene, mesh); };
-
-  // Pass 1, direct light: every vertex gathers from the punctual lights and from the emitting
-  // patches. Sharp shadows and near-field falloff show up here, so this is where the mesh is
-  // refined: elements whose vertices disagree steeply are bisected and only the new vertices
-  // gather. Vertex indices are stable under refinement, so the arrays just grow.
-  std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
-  std::vector<Rgb> direct_delta;  // the part of direct_punctual from point, spot and directional lights
-  auto gather_direct = [&](size_t first_vertex) {
-    const Patches patches = build_patches(mesh, settings.patch_elements);
-    std::vector<ShootingPatch> emitters;
-    std::vector<Rgb> radiosity(mesh.element_count());
-    for (size_t q = 0; q < patches.count() && !hierarchical; ++q) {
-      if (!is_emitter(patches.of(q)[0])) continue;
-      for (uint32_t e : patches.of(q)) radiosity[e] = emitted(mesh.element_material[e]);
-      ShootingPatch& sp = emitters.emplace_back();
-      sp.assign(mesh, patches.of(q), radiosity);
-      sp.emitter = true;
-      sp.probe = std::min(2, strata);
-      sp.strata = strata;
-    }
-    const size_t nv = mesh.vertex_count();
-    direct_punctual.resize(nv, Rgb(0.0f));
-    direct_delta.resize(nv, Rgb(0.0f));
-    direct_emitted.resize(nv, Rgb(0.0f));
-    const size_t count = nv - first_vertex;
-    const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
-    rc::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
-      Counts counts;
-      for (size_t v = first_vertex + chunk * 128; v < std::min(nv, first_vertex + chunk * 128 + 128); ++v) {
-        for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
-          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
-          const rc::Light& light = scene.punctual_lights[li];
-          const Rgb e = punctual_irradiance(scene, receivers.geometry, light, receivers.origins(v), mesh.normals[v], rng,
-                                            settings.visibility_samples, counts.rays);
-          direct_punctual[v] += e;
-          if (light.kind != rc::LightKind::environment) direct_delta[v] += e;
-        }
-        for (size_t q = 0; q < emitters.size(); ++q) {
-          // Keyed by the emitter's first element, which refinement never renumbers.
-          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0xa000000000ull + emitters[q].elements[0]);
-          direct_emitted[v] += receivers.receive(emitters[q], v, rng, counts);
-        }
-      }
-      add_counts(counts);
-    });
-    for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::join_ranges(std::span(*values), 128, first_vertex);
-    joined_counts(rays_before, form_factors_before, skipped_before);
-    if (hierarchical) {
-      // Emitting elements by the tree walk: the patches above would make this pass cost the
-      // vertex count times the emitter count.
-      std::vector<Rgb> emission(mesh.element_count());
-      for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
-      // The materials' own albedo is enough here (it only weighs links in the tree walk), and the
-      // textured means cost a few seconds per 100,000 elements at every refinement step.
-      std::vector<Rgb> rho(mesh.element_count());
-      for (size_t e = 0; e < rho.size(); ++e) rho[e] = albedo(mesh.element_material[e]);
-      const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, {}, may_be_blocked, {}, {}};
-      uint64_t tree_rays = 0;
-      const std::vector<Rgb> e = emitted_irradiance(input, emission, first_vertex, hs, settings.visibility_samples, &tree_rays);
-      for (size_t v = first_vertex; v < nv; ++v) direct_emitted[v] = e[v];
-      rays += tree_rays;
-    }
-  };
-  gather_direct(0);
-  const float base_edge = target_edge_length(scene, settings.mesh);
-  const float min_edge = base_edge * std::ldexp(1.0f, -settings.subdivision_levels);
-  for (int round = 0; round < 2 * settings.subdivision_levels; ++round) {
-    // With a time budget, refinement stops once it has used its share, so shooting gets the rest.
-    if (over_budget(elapsed() / kRefinementShare)) break;
-    // Mark elements whose vertices' direct irradiance spreads by more than the threshold times
-    // the brightest of them (plus a floor of 1 % of the mean, so that darkness does not refine).
-    double mean = 0.0, area = 0.0;
-    for (size_t e = 0; e < mesh.element_count(); ++e) {
-      const auto& el = mesh.elements[e];
-      for (uint32_t v : el) mean += double(level(direct_punctual[v] + direct_emitted[v])) * mesh.element_area[e] / 3.0;
-      area += mesh.element_area[e];
-    }
-    const float floor = float(0.01 * mean / std::max(area, 1e-30));
-    std::vector<uint32_t> marked;
-    for (uint32_t e = 0; e < mesh.element_count(); ++e) {
-      if (is_emitter(e)) continue;
-      float lo = std::numeric_limits<float>::max(), hi = 0.0f;
-      for (uint32_t v : mesh.elements[e]) {
-        const float x = level(direct_punctual[v] + direct_emitted[v]);
-        lo = std::min(lo, x), hi = std::max(hi, x);
-      }
-      if (hi - lo > float(settings.subdivision_threshold) * (hi + floor)) marked.push_back(e);
-    }
-    const size_t first_new = mesh.vertex_count();
-    if (marked.empty() || split_longest_edges(mesh, marked, min_edge * 1.5f) == 0) break;
-    receivers.update();
-    gather_direct(first_new);
-    sol.refined_elements += marked.size();
-  }
-
-  sol.direct_seconds = elapsed() - sol.mesh_seconds;
-  const size_t nv = mesh.vertex_count(), ne = mesh.element_count();
-  sol.vertex_irradiance.resize(nv);
-  for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] = direct_punctual[v] + direct_emitted[v];
-  sol.vertex_direct = sol.vertex_irradiance;
-  sol.vertex_punctual = direct_delta;
-  sol.element_albedo = element_albedo();
-  sol.vertex_albedo.assign(nv, Rgb(0.0f));
-  {
-    std::vector<float> weight(nv, 0.0f);
-    for (size_t e = 0; e < ne; ++e)
-      for (uint32_t v : mesh.elements[e]) {
-        sol.vertex_albedo[v] += sol.element_albedo[e] * mesh.element_area[e];
-        weight[v] += mesh.element_area[e];
-      }
-    for (size_t v = 0; v < nv; ++v)
-      sol.vertex_albedo[v] = weight[v] > 0.0f ? sol.vertex_albedo[v] * (1.0f / weight[v]) : albedo(mesh.vertex_material[v]);
-  }
-  // Pass 2, progressive refinement on the final mesh: every element holds the light it reflects
-  // and has not shot yet.
-  auto shoot_progressive = [&] {
-    std::vector<Rgb> unshot(ne);
-    const std::vector<Rgb>& element_rho = sol.element_albedo;
-    double emitted_power = 0.0;
-    for (size_t e = 0; e < ne; ++e) {
-      const auto& el = mesh.elements[e];
-      const Rgb rho = element_rho[e];
-      emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
-      emitted_power += double((rho * (direct_punctual[el[0]] + direct_punctual[el[1]] + direct_punctual[el[2]])).average()) /
-                       3.0 * mesh.element_area[e];
-      unshot[e] = rho * (sol.vertex_irradiance[el[0]] + sol.vertex_irradiance[el[1]] + sol.vertex_irradiance[el[2]]) *
-                  (1.0f / 3.0f);
-    }
-    if (!(emitted_power > 0.0))
-      sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
-
-    const Patches patches = build_patches(mesh, settings.patch_elements);
-    sol.patches = patches.count();
-    double total_area = 0.0;
-    for (size_t e = 0; e < ne; ++e) total_area += mesh.element_area[e];
-    // Each patch's form factors at every vertex, kept from its first shot for its later ones
-    // while they fit in kFactorCacheBytes: they depend on the geometry alone, and a patch
-    // shoots several times (about four on cornell), so its later shots trace only visibility.
-    std::vector<std::vector<float>> factor_rows(patches.count());
-    size_t cached_bytes = 0;
-    // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
-    rc::Progress progress("radiosity", 1000, "‰", settings.progress);
-    uint64_t shown = 0;
-    std::vector<Rgb> received(nv, Rgb(0.0f));  // irradiance added by the current shot
-    ShootingPatch source;
-    double last_shot = 0.0;  // seconds
-    while (emitted_power > 0.0) {
-      // The patch with the most unshot power, of either sign (see the overshoot below).
-      size_t src = 0;
-      double best = -1.0, best_signed = 0.0, unshot_power = 0.0;
-      for (size_t q = 0; q < patches.count(); ++q) {
-        double p = 0.0;
-        for (uint32_t e : patches.of(q)) p += double(unshot[e].average()) * mesh.element_area[e];
-        unshot_power += std::abs(p);
-        if (std::abs(p) > best) best = std::abs(p), best_signed = p, src = q;
-      }
-      sol.residual = unshot_power / emitted_power;
-      const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
-      if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
-      if (sol.residual < settings.tolerance) break;
-      // A shot takes about as long as the last one: stop before one would end past the budget.
-      if (over_budget(elapsed() + last_shot)) break;
-      const double shot_start = elapsed();
-
-      // Reflected light is soft: one stratified ray per pair and shot estimates its visibility
-      // without bias, and the noise averages out over the many shots that reach each vertex.
-      // Overshooting (Feda & Purgathofer 1992): a patch with light to send also sends now what it
-      // will receive later, estimated as its reflectance times the mean unshot radiosity of the
-      // rest of the scene, and keeps that amount as negative unshot light, which a later shot of
-      // its own corrects. A patch whose unshot light is negative sends it as it is.
-      const std::span<const uint32_t> shooting = patches.of(src);
-      Rgb overshoot(0.0f);
-      if (best_signed > 0.0) {
-        Rgb own(0.0f), all(0.0f);
-        double own_area = 0.0;
-        for (uint32_t e : shooting) own += unshot[e] * mesh.element_area[e], own_area += mesh.element_area[e];
-        for (size_t e = 0; e < ne; ++e) all += unshot[e] * mesh.element_area[e];
-        if (total_area - own_area > 0.0) {
-          const Rgb rest = (all - own) * float(1.0 / (total_area - own_area));
-          overshoot = Rgb(std::max(rest.r, 0.0f), std::max(rest.g, 0.0f), std::max(rest.b, 0.0f));
-        }
-      }
-      for (uint32_t e : shooting) unshot[e] += element_rho[e] * overshoot;
-      source.assign(mesh, shooting, unshot);
-      for (uint32_t e : shooting) unshot[e] = element_rho[e] * overshoot * -1.0f;
-      source.emitter = false;
-      source.probe = std::min(settings.reflected_visibility_probe, strata);
-      source.strata = source.probe;
-      const uint64_t shot_index = sol.shots++;
-      const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
-      std::vector<float>& row = factor_rows[src];
-      const bool known = !row.empty();
-      const size_t width = source.elements.size(), row_bytes = nv * width * sizeof(float);
-      if (!known && cached_bytes + row_bytes <= kFactorCacheBytes) {
-        row.resize(nv * width);
-        cached_bytes += row_bytes;
-      }
-      rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
-        Counts counts;
-        for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
-          rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
-          received[v] = receivers.receive(source, v, rng, counts, row.empty() ? nullptr : &row[v * width], known);
-        }
-        add_counts(counts);
-      });
-      rc::join_ranges(std::span(received), 256);
-      joined_counts(rays_before, form_factors_before, skipped_before);
-      // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
-      for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
-      for (size_t e = 0; e < ne; ++e) {
-        const auto& el = mesh.elements[e];
-        unshot[e] += element_rho[e] * (received[el[0]] + received[el[1]] + received[el[2]]) *
-                     (1.0f / 3.0f);
-      }
-      last_shot = elapsed() - shot_start;
-    }
-    progress.finish();
-    // An overshoot and the negative shot that corrects it see their own visibility rays, so where
-    // they disagree a dim vertex can be left below zero, which no irradiance is: held at zero.
-    for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
-
-    {
-      Rgb unshot_sum(0.0f), reflectance_sum(0.0f);
-      double area = 0.0;
-      for (size_t e = 0; e < ne; ++e) {
-        unshot_sum += unshot[e] * mesh.element_area[e];
-        reflectance_sum += element_rho[e] * mesh.element_area[e];
-        area += mesh.element_area[e];
-      }
-      if (area > 0.0) {
-        const float inv_area = float(1.0 / area);
-        const Rgb rho = reflectance_sum * inv_area;
-        for (int k = 0; k < 3; ++k) sol.ambient[k] = unshot_sum[k] * inv_area / std::max(1e-3f, 1.0f - rho[k]);
-      }
-    }
-  };
-  if (hierarchical) {
-    // Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex.
-    const std::vector<Rgb>& rho = sol.element_albedo;
-    // What each element reflects of the direct light: its own mean of the lights' irradiance,
-    // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
-    uint64_t element_rays = 0;
-    std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh,
-                                                                  settings.visibility_samples, settings.seed, element_rays);
-    rays += element_rays;
-    for (size_t e = 0; e < ne; ++e) {
-      const auto& el = mesh.elements[e];
-      element_direct[e] += (direct_emitted[el[0]] + direct_emitted[el[1]] + direct_emitted[el[2]]) * (1.0f / 3.0f);
-    }
-    const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, sol.vertex_irradiance, may_be_blocked,
-                                  [&] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; },
-                                  settings.time_limit > 0.0 ? std::function<double()>([&] { return settings.time_limit - elapsed(); })
-                                                            : std::function<double()>(),
-                                  element_direct};
-    if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
-                    [](const Rgb& e) { return e.is_black(); }))
-      sol.mesh_report.warnings.push_back("the scene has no lights: the radiosity is zero everywhere");
-    const HierarchicalResult h = solve_hierarchical(input, hs);
-    sol.element_direct = std::move(element_direct);
-    for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += h.vertex_irradiance[v];
-    sol.nodes = h.nodes;
-    sol.links = h.links;
-    sol.iterations = h.iterations;
-    if (h.clamped_elements > 0)
-      sol.mesh_report.warnings.push_back(std::to_string(h.clamped_elements) +
-                                         " elements were promised more reflected light than they can return "
-                                         "(surfaces a hair apart?); their gathering was scaled down to keep the "
-                                         "solution bounded");
-    sol.residual = h.residual;
-    sol.tail_added = h.tail_added;
-    sol.chebyshev_beta = h.chebyshev_beta;
-    sol.ladder = h.ladder;
-    sol.gather_nodes = h.gather_nodes;
-    sol.final_gather = h.final_gather;
-    sol.final_gather_note = h.final_gather_note;
-    sol.link_tolerance = h.link_tolerance;
-    sol.linking_stopped = h.linking_stopped;
-    sol.link_seconds = h.link_seconds;
-    sol.iterate_seconds = h.iterate_seconds;
-    sol.gather_seconds = h.gather_seconds;
-    rays += h.shadow_rays;
-    form_factors += h.form_factors;
-  } else {
-    shoot_progressive();
-    sol.shoot_seconds = elapsed() - sol.mesh_seconds - sol.direct_seconds;
-  }
-
-  sol.vertex_radiosity.resize(nv);
-  for (size_t v = 0; v < nv; ++v)
-    sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + sol.vertex_albedo[v] * sol.vertex_irradiance[v];
-  sol.element_radiosity.resize(ne);
-  for (size_t e = 0; e < ne; ++e) {
-    const auto& el = mesh.elements[e];
-    sol.element_radiosity[e] =
-        (sol.vertex_radiosity[el[0]] + sol.vertex_radiosity[el[1]] + sol.vertex_radiosity[el[2]]) * (1.0f / 3.0f);
-  }
-  sol.form_factors = form_factors;
-  sol.shadow_rays = rays;
-  sol.skipped_pairs = skipped;
-  sol.seconds = elapsed();
+  mesh_scene(scene, settings, start, sol);
+  SolveState state(scene, settings, sol, start);
+  // Pass 1, direct light, refining the mesh where it changes steeply.
+  state.gather_direct(0);
+  state.refine_direct();
+  state.keep_direct();
+  // Pass 2, the interreflection.
+  if (state.hierarchical)
+    state.gather_hierarchical();
+  else
+    state.shoot_progressive();
+  state.finish();
   return sol;
 }
 
