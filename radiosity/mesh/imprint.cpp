@@ -502,10 +502,14 @@ TriangleSoup merge_cut_faces(const TriangleSoup& surface, const std::vector<char
 }  // namespace
 
 TriangleSoup imprint(const TriangleSoup& surface, std::span<const std::array<DVec3, 3>> tools, ImprintCounts* counts) {
+  return imprint(surface, tools, face_tool_pairs(surface, tools), counts);
+}
+
+TriangleSoup imprint(const TriangleSoup& surface, std::span<const std::array<DVec3, 3>> tools,
+                     const std::vector<std::pair<uint32_t, uint32_t>>& pairs, ImprintCounts* counts) {
   ImprintCounts local;
   ImprintCounts& c = counts ? *counts : local;
   c = {};
-  const std::vector<std::pair<uint32_t, uint32_t>> pairs = face_tool_pairs(surface, tools);
   c.face_pairs = pairs.size();
   std::vector<std::vector<Segment>> segments = contact_segments(surface, tools, pairs);
   const std::vector<EdgePoint> edge_points = merged_edge_points(surface, segments, c);

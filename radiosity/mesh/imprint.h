@@ -5,6 +5,8 @@
 #include <array>
 #include <cstddef>
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "radiosity/mesh/mesh_detail.h"
 
@@ -12,7 +14,7 @@ namespace gilt::radiosity::mesh::detail {
 
 /// What imprint() did.
 struct ImprintCounts {
-  size_t face_pairs = 0;     ///< pairs of a surface face and a tool triangle whose boxes meet
+  size_t face_pairs = 0;     ///< pairs of a surface face and a tool triangle tested (whose boxes meet)
   size_t segments = 0;       ///< pieces of contact line found (one per crossing face pair)
   size_t faces_cut = 0;      ///< faces of the surface retriangulated
   size_t segments_lost = 0;  ///< segments left out: an end outside its face by rounding
@@ -33,5 +35,11 @@ struct ImprintCounts {
 /// faces and k meeting pairs. The tools may intersect themselves.
 TriangleSoup imprint(const TriangleSoup& surface, std::span<const std::array<DVec3, 3>> tools,
                      ImprintCounts* counts = nullptr);
+
+/// The same, given which faces may meet which tool triangles: `pairs` of (face, tool triangle),
+/// ascending and unique, holding at least every pair whose closed triangles meet (a caller that
+/// has found them already, as the mesher's contact search has, saves imprint() its own search).
+TriangleSoup imprint(const TriangleSoup& surface, std::span<const std::array<DVec3, 3>> tools,
+                     const std::vector<std::pair<uint32_t, uint32_t>>& pairs, ImprintCounts* counts = nullptr);
 
 }  // namespace gilt::radiosity::mesh::detail

@@ -388,11 +388,16 @@ double triangle_area(const DVec3& a, const DVec3& b, const DVec3& d) { return 0.
 /// nothing and costs only its own elements. Returns the buried area.
 double mark_buried(const rc::Scene& scene, const TriangleSoup& surface, std::vector<char>& buried) {
   buried.assign(surface.triangles.size(), 0);
+  // In parallel over triangles (a furnished room's furniture is one mesh of most of its faces),
+  // the area summed afterwards in triangle order, so it does not depend on the thread count.
+  rc::parallel_for(surface.triangles.size(), [&](size_t t) {
+    const auto& c = surface.triangles[t];
+    buried[t] = triangle_buried(scene, surface.points[c[0]], surface.points[c[1]], surface.points[c[2]]);
+  });
   double area = 0.0;
   for (size_t t = 0; t < surface.triangles.size(); ++t) {
     const auto& c = surface.triangles[t];
-    const DVec3 &a = surface.points[c[0]], &b = surface.points[c[1]], &d = surface.points[c[2]];
-    if (triangle_buried(scene, a, b, d)) buried[t] = 1, area += triangle_area(a, b, d);
+    if (buried[t]) area += triangle_area(surface.points[c[0]], surface.points[c[1]], surface.points[c[2]]);
   }
   return area;
 }
@@ -416,20 +421,24 @@ bool on_input(const rc::Scene& scene, const DVec3& p, const DVec3& n, uint32_t m
 double mark_buried_flat(const rc::Scene& scene, const SplitSurface& surface, uint32_t mesh_index,
                         std::vector<char>& buried) {
   buried.assign(surface.corners.size(), 0);
-  double area = 0.0;
-  for (size_t t = 0; t < surface.corners.size(); ++t) {
+  rc::parallel_for(surface.corners.size(), [&](size_t t) {  // as mark_buried
     const auto& c = surface.corners[t];
     const DVec3 &a = surface.positions[c[0]], &b = surface.positions[c[1]], &d = surface.positions[c[2]];
     const DVec3 n = glm::normalize(glm::cross(b - a, d - a));
     if (!(glm::dot(n, surface.normals[c[0]]) > 0.99999 && glm::dot(n, surface.normals[c[1]]) > 0.99999 &&
           glm::dot(n, surface.normals[c[2]]) > 0.99999))
-      continue;
+      return;
     const double size = std::max({glm::distance(a, b), glm::distance(b, d), glm::distance(d, a)});
     bool on_surface = true;
     for (const DVec3& p : burial_points(a, b, d))
       on_surface = on_surface && on_input(scene, p, n, mesh_index,
                                           1e-4 * size + double(rc::error_gamma(16)) * glm::length(p));
-    if (on_surface && triangle_buried(scene, a, b, d)) buried[t] = 1, area += triangle_area(a, b, d);
+    buried[t] = on_surface && triangle_buried(scene, a, b, d);
+  });
+  double area = 0.0;
+  for (size_t t = 0; t < surface.corners.size(); ++t) {
+    const auto& c = surface.corners[t];
+    if (buried[t]) area += triangle_area(surface.positions[c[0]], surface.positions[c[1]], surface.positions[c[2]]);
   }
   return area;
 }
@@ -686,7 +695,10 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   RepairedMeshes repaired(st.mesh_count);
   repair_pass(st, repaired);
   st.end_stage("repair");
-  repaired.find_contacts();
+  {
+    rc::Progress progress("mesh: finding contacts", 0, "pairs of pieces", settings.progress);
+    repaired.find_contacts(&progress, settings.deadline);
+  }
   st.end_stage("contacts");
   imprint_pass(st, repaired);  // ends the "imprint" and "buried faces" stages
   remesh_pass(st, repaired);

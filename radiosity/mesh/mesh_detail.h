@@ -43,7 +43,7 @@ struct RepairCounts {
   size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
   size_t contact_segments_lost = 0;  ///< pieces of contact line left out: an end outside its face by rounding
   size_t remesh_failed = 0;        ///< pieces CGAL could not remesh, kept as they were
-  size_t not_imprinted = 0;        ///< pieces with contacts left as they were: the deadline had passed
+  size_t not_imprinted = 0;        ///< pieces with contacts not all imprinted: the deadline had passed
   size_t not_remeshed = 0;         ///< pieces left as imprinted: the deadline had passed
 };
 
@@ -68,9 +68,12 @@ class RepairedMeshes {
   /// Mends mesh m; calls for different m may run in parallel.
   void repair(size_t m, const rc::TriangleMesh& mesh);
 
-  /// Finds which faces of which pieces meet: one box-intersection pass over every repaired mesh,
-  /// so call it after every repair(). imprint() calls it on first use.
-  void find_contacts();
+  /// Finds which faces of which pieces meet, over every repaired mesh, so call it after every
+  /// repair(); imprint() calls it on first use. `progress`, when given, counts pairs of pieces
+  /// searched; pairs not begun by `deadline` are left out, and their pieces counted as not
+  /// imprinted (they keep the contacts that were found).
+  void find_contacts(rc::Progress* progress = nullptr,
+                     std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   /// Imprints on mesh m the lines where the `touching` meshes (repaired too) and its own pieces
   /// meet it, and keeps the result for remesh(). Returns the imprinted surface, which lies on the

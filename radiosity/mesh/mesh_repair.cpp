@@ -364,12 +364,14 @@ using Constrained = SurfaceMesh::Property_map<edge_descriptor, bool>;
 /// imprinted by other meshes only.
 constexpr size_t kMaxImprintedParts = 4096;
 
-/// A piece of some mesh that may imprint another piece, cropped to the faces whose boxes meet
-/// the other piece's faces' boxes (found by find_contacts): only they can cut it, so
-/// imprinting reads them alone, whatever the size of the tool.
+/// A piece of some mesh that may imprint another piece, cropped to the faces that meet the other
+/// piece's faces (found by find_contacts): only they can cut it, so imprinting reads them alone,
+/// whatever the size of the tool.
 struct ToolContact {
   uint32_t mesh = 0, part = 0;
   std::vector<uint32_t> faces;  ///< ascending
+  /// (face of the imprinted piece, index into `faces`) for every pair of faces that meet, ascending
+  std::vector<std::array<uint32_t, 2>> pairs;
 };
 
 /// The mesh as a soup (face f is triangle f), with its constrained edges as cuts when given.
@@ -387,7 +389,10 @@ TriangleSoup to_soup(const SurfaceMesh& mesh, const Constrained* constrained = n
 size_t imprint_contacts(Part& part, const std::vector<std::pair<const Part*, const ToolContact*>>& tools,
                         Constrained& constrained, RepairCounts& counts) {
   std::vector<std::array<DVec3, 3>> triangles;
-  for (const auto& [tool, contact] : tools)
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;  // (face of the piece, index into triangles)
+  for (const auto& [tool, contact] : tools) {
+    const auto first = static_cast<uint32_t>(triangles.size());
+    for (const auto& [own, k] : contact->pairs) pairs.emplace_back(own, first + k);
     for (uint32_t f : contact->faces) {
       std::array<DVec3, 3> t;
       int k = 0;
@@ -396,12 +401,14 @@ size_t imprint_contacts(Part& part, const std::vector<std::pair<const Part*, con
         const Point& p = tool->mesh.point(v);
         t[k++] = DVec3(p.x(), p.y(), p.z());
       }
-      if (k == 3) triangles.push_back(t);
+      triangles.push_back(t);
     }
+  }
   if (triangles.empty()) return 0;
+  std::sort(pairs.begin(), pairs.end());
   if (part.mesh.has_garbage()) part.mesh.collect_garbage();
   ImprintCounts imprinted;
-  const TriangleSoup cut = imprint(to_soup(part.mesh), triangles, &imprinted);
+  const TriangleSoup cut = imprint(to_soup(part.mesh), triangles, pairs, &imprinted);
   counts.contact_segments_lost += imprinted.segments_lost;
   if (imprinted.faces_cut == 0) return 0;
 
@@ -803,89 +810,207 @@ struct RepairedMeshes::Impl {
   /// Per mesh and piece, the pieces that may imprint it, cropped (find_contacts), in order of
   /// (mesh, piece).
   std::vector<std::vector<std::vector<ToolContact>>> contacts;
+  /// Per mesh and piece, whether its contact search was cut short by the deadline.
+  std::vector<std::vector<char>> searched_in_part;
   std::once_flag contacts_found;
 
-  void find_contacts();
+  void find_contacts(rc::Progress* progress, std::chrono::steady_clock::time_point deadline);
 };
 
-/// Finds, for every piece of every repaired mesh, the pieces whose faces' boxes meet its own
-/// faces' boxes, and which of their faces do: one box-intersection pass over all faces of all
-/// pieces (Zomorodian & Edelsbrunner's streamed segment tree, CGAL's box_intersection_d),
-/// O((n + k) log n) for n faces and k meeting pairs, where testing every piece against every
-/// other costs the product of their sizes. Of the faces whose boxes meet, those where either lies
-/// on one side of the other's plane (exact orientation tests) are dropped at once: in a furnished
-/// room most meeting boxes are of such faces, and keeping them was most of this step's time and
-/// memory. Pieces of one mesh of more than kMaxImprintedParts
-/// pieces (foliage, gravel) do not imprint each other. Boxes are closed, so faces that only
-/// touch are found; their ids are explicit, given in the order of (mesh, piece, face), so the
-/// result does not depend on memory addresses.
-void RepairedMeshes::Impl::find_contacts() {
-  struct FaceRef {
-    uint32_t mesh, part, face;
-  };
-  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, uint32_t, CGAL::Box_intersection_d::ID_EXPLICIT>;
-  std::vector<Box> boxes;
-  std::vector<FaceRef> refs;
+namespace {
+
+using FaceBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, uint32_t, CGAL::Box_intersection_d::ID_EXPLICIT>;
+
+/// One piece's faces as corner triples (face f is entry f) with their boxes.
+struct PieceFaces {
   std::vector<std::array<Point, 3>> corners;
+  std::vector<CGAL::Bbox_3> boxes;
+};
+
+PieceFaces piece_faces(const SurfaceMesh& mesh) {
+  PieceFaces out;
+  out.corners.resize(mesh.number_of_faces());
+  out.boxes.resize(mesh.number_of_faces());
+  for (face_descriptor f : mesh.faces()) {
+    std::array<Point, 3>& t = out.corners[f.idx()];
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+      if (k < 3) t[k++] = mesh.point(v);
+    out.boxes[f.idx()] = t[0].bbox() + t[1].bbox() + t[2].bbox();
+  }
+  return out;
+}
+
+/// Whether the corners of `t` all lie on one side of the plane of `plane`, or all in it: then the
+/// two faces meet in no line, and imprint() would skip the pair by the same exact test
+/// (imprint.cpp), so leaving it out changes nothing but the time spent on it.
+bool one_side(const std::array<Point, 3>& plane, const std::array<Point, 3>& t) {
+  const auto s0 = CGAL::orientation(plane[0], plane[1], plane[2], t[0]);
+  return s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[1]) &&
+         s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[2]);
+}
+
+/// Whether the two closed triangles meet (exact), where each crosses the other's plane: a finely
+/// cut round table top's fan and its leg's strips cross each other's planes pairwise, nearly all
+/// far from the leg, and those pairs grow as the square of the tessellation (a million-triangle
+/// room kept 104 million of them, 2.5 GB, and imprinting re-tested each). A triangle with
+/// collinear corners is kept: CGAL's test does not take it.
+bool faces_meet(const std::array<Point, 3>& s, const std::array<Point, 3>& t) {
+  if (one_side(s, t) || one_side(t, s)) return false;
+  if (CGAL::collinear(s[0], s[1], s[2]) || CGAL::collinear(t[0], t[1], t[2])) return true;
+  return CGAL::do_intersect(Kernel::Triangle_3(s[0], s[1], s[2]), Kernel::Triangle_3(t[0], t[1], t[2]));
+}
+
+/// The faces of one piece whose boxes meet `box`, ascending.
+std::vector<uint32_t> faces_in_box(const PieceFaces& faces, const CGAL::Bbox_3& box) {
+  std::vector<uint32_t> out;
+  for (size_t f = 0; f < faces.boxes.size(); ++f)
+    if (CGAL::do_overlap(faces.boxes[f], box)) out.push_back(static_cast<uint32_t>(f));
+  return out;
+}
+
+/// For each of `boxes`, the faces of a piece whose boxes meet it (ascending): one box-intersection
+/// pass, O((n + k) log n), so a floor that a thousand chairs stand on is not scanned a thousand
+/// times.
+std::vector<std::vector<uint32_t>> faces_in_boxes(const PieceFaces& faces, const std::vector<CGAL::Bbox_3>& boxes) {
+  std::vector<std::vector<uint32_t>> out(boxes.size());
+  if (boxes.size() == 1) {
+    out[0] = faces_in_box(faces, boxes[0]);
+    return out;
+  }
+  std::vector<FaceBox> face_boxes, other;
+  face_boxes.reserve(faces.boxes.size());
+  for (size_t f = 0; f < faces.boxes.size(); ++f) face_boxes.emplace_back(faces.boxes[f], static_cast<uint32_t>(f));
+  for (size_t k = 0; k < boxes.size(); ++k) other.emplace_back(boxes[k], static_cast<uint32_t>(k));
+  CGAL::box_intersection_d(face_boxes.begin(), face_boxes.end(), other.begin(), other.end(),
+                           [&](const FaceBox& f, const FaceBox& b) { out[b.info()].push_back(f.info()); });
+  for (auto& list : out) std::sort(list.begin(), list.end());
+  return out;
+}
+
+/// The pairs (face of a, face of b) that meet, of the faces `fa` of a and `fb` of b.
+std::vector<std::array<uint32_t, 2>> meeting_faces(const PieceFaces& a, const std::vector<uint32_t>& fa,
+                                                   const PieceFaces& b, const std::vector<uint32_t>& fb) {
+  std::vector<std::array<uint32_t, 2>> out;
+  std::vector<FaceBox> boxes_a, boxes_b;
+  boxes_a.reserve(fa.size());
+  boxes_b.reserve(fb.size());
+  for (uint32_t f : fa) boxes_a.emplace_back(a.boxes[f], f);
+  for (uint32_t f : fb) boxes_b.emplace_back(b.boxes[f], f);
+  CGAL::box_intersection_d(boxes_a.begin(), boxes_a.end(), boxes_b.begin(), boxes_b.end(),
+                           [&](const FaceBox& x, const FaceBox& y) {
+                             if (faces_meet(a.corners[x.info()], b.corners[y.info()])) out.push_back({x.info(), y.info()});
+                           });
+  return out;
+}
+
+}  // namespace
+
+/// Finds, for every piece of every repaired mesh, the faces of other pieces that meet its own
+/// faces, in three passes, each O((n + k) log n) for n faces and k meeting pairs (Zomorodian &
+/// Edelsbrunner's streamed segment tree, CGAL's box_intersection_d), where testing every piece
+/// against every other costs the product of their sizes:
+///   1. pairs of pieces whose boxes meet;
+///   2. per piece, in parallel, its faces inside each such neighbour's box (the crop);
+///   3. per pair of pieces, in parallel, the cropped faces of the two whose boxes meet, kept where
+///      the closed triangles meet (faces_meet).
+/// Pieces of one mesh of more than kMaxImprintedParts pieces (foliage, gravel) do not imprint each
+/// other. Boxes are closed, so faces that only touch are found. Every list is sorted by its
+/// indices (mesh, piece, face), so the result does not depend on memory addresses or the thread
+/// count. Piece pairs are searched largest first; those not begun by `deadline` are left out, and
+/// their pieces marked as searched only in part.
+void RepairedMeshes::Impl::find_contacts(rc::Progress* progress, std::chrono::steady_clock::time_point deadline) {
+  // Pieces numbered in (mesh, piece) order.
+  std::vector<std::array<uint32_t, 2>> pieces;
   for (size_t m = 0; m < parts.size(); ++m)
-    for (size_t p = 0; p < parts[m].size(); ++p) {
-      const SurfaceMesh& mesh = parts[m][p].mesh;
-      for (face_descriptor f : mesh.faces()) {
-        std::array<Point, 3> t;
-        int k = 0;
-        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
-          if (k < 3) t[k++] = mesh.point(v);
-        if (k < 3) continue;
-        boxes.emplace_back(t[0].bbox() + t[1].bbox() + t[2].bbox(), static_cast<uint32_t>(refs.size()));
-        refs.push_back({static_cast<uint32_t>(m), static_cast<uint32_t>(p), static_cast<uint32_t>(f.idx())});
-        corners.push_back(t);
-      }
-    }
-  // Whether the corners of `t` all lie on one side of the plane of `plane`, or all in it: then
-  // the two faces meet in no line, and imprint() would skip the pair by the same exact test
-  // (imprint.cpp), so leaving it out here changes nothing but the time spent on it.
-  const auto one_side = [](const std::array<Point, 3>& plane, const std::array<Point, 3>& t) {
-    const auto s0 = CGAL::orientation(plane[0], plane[1], plane[2], t[0]);
-    return s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[1]) &&
-           s0 == CGAL::orientation(plane[0], plane[1], plane[2], t[2]);
-  };
-  // Whether the two closed triangles meet (exact), where each crosses the other's plane: a
-  // finely cut round table top's fan and its leg's strips cross each other's planes pairwise,
-  // nearly all far from the leg, and those pairs grow as the square of the tessellation (a
-  // million-triangle room kept 104 million of them, 2.5 GB, and imprinting re-tested each).
-  // A triangle with collinear corners is kept, as before: CGAL's test does not take it.
-  const auto meet = [](const std::array<Point, 3>& s, const std::array<Point, 3>& t) {
-    if (CGAL::collinear(s[0], s[1], s[2]) || CGAL::collinear(t[0], t[1], t[2])) return true;
-    return CGAL::do_intersect(Kernel::Triangle_3(s[0], s[1], s[2]), Kernel::Triangle_3(t[0], t[1], t[2]));
-  };
-  // Per receiving piece, its (tool mesh, piece, face) triples, both ways round; each piece's list
-  // is sorted on its own, in parallel, so no list of every pair is ever sorted.
-  std::vector<size_t> first_piece(parts.size() + 1, 0);
-  for (size_t m = 0; m < parts.size(); ++m) first_piece[m + 1] = first_piece[m] + parts[m].size();
-  std::vector<std::vector<std::array<uint32_t, 3>>> found(first_piece.back());
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& a, const Box& b) {
-    const FaceRef x = refs[a.info()], y = refs[b.info()];
-    if (x.mesh == y.mesh && (x.part == y.part || parts[x.mesh].size() > kMaxImprintedParts)) return;
-    if (one_side(corners[a.info()], corners[b.info()]) || one_side(corners[b.info()], corners[a.info()])) return;
-    if (!meet(corners[a.info()], corners[b.info()])) return;
-    found[first_piece[x.mesh] + x.part].push_back({y.mesh, y.part, y.face});
-    found[first_piece[y.mesh] + y.part].push_back({x.mesh, x.part, x.face});
+    for (size_t p = 0; p < parts[m].size(); ++p) pieces.push_back({uint32_t(m), uint32_t(p)});
+  const auto part = [&](uint32_t i) -> const Part& { return parts[pieces[i][0]][pieces[i][1]]; };
+  std::vector<PieceFaces> faces(pieces.size());
+  rc::parallel_for(pieces.size(), [&](size_t i) { faces[i] = piece_faces(part(uint32_t(i)).mesh); });
+
+  // 1. Pieces whose boxes meet.
+  std::vector<FaceBox> piece_boxes;
+  for (size_t i = 0; i < pieces.size(); ++i)
+    if (!faces[i].boxes.empty()) piece_boxes.emplace_back(part(uint32_t(i)).box, static_cast<uint32_t>(i));
+  std::vector<std::array<uint32_t, 2>> pairs;
+  CGAL::box_self_intersection_d(piece_boxes.begin(), piece_boxes.end(), [&](const FaceBox& x, const FaceBox& y) {
+    const uint32_t i = std::min(x.info(), y.info()), j = std::max(x.info(), y.info());
+    if (pieces[i][0] == pieces[j][0] && parts[pieces[i][0]].size() > kMaxImprintedParts) return;
+    pairs.push_back({i, j});
   });
-  boxes = {};
-  corners = {};
+  std::sort(pairs.begin(), pairs.end());
+
+  // 2. Each piece's faces inside each neighbour's box, neighbours in the order of `pairs`.
+  std::vector<std::vector<uint32_t>> neighbours(pieces.size());
+  for (const auto& [i, j] : pairs) neighbours[i].push_back(j), neighbours[j].push_back(i);
+  std::vector<std::vector<std::vector<uint32_t>>> crop(pieces.size());
+  rc::parallel_for(pieces.size(), [&](size_t i) {
+    std::vector<CGAL::Bbox_3> boxes;
+    for (uint32_t j : neighbours[i]) boxes.push_back(part(j).box);
+    if (!boxes.empty()) crop[i] = faces_in_boxes(faces[i], boxes);
+  });
+  // Where each pair's crops sit: pair (i, j) is neighbour k of i and neighbour l of j.
+  std::vector<std::array<uint32_t, 2>> slot(pairs.size());
+  {
+    std::vector<uint32_t> next(pieces.size(), 0);
+    for (size_t q = 0; q < pairs.size(); ++q) slot[q] = {next[pairs[q][0]]++, next[pairs[q][1]]++};
+  }
+
+  // 3. Meeting faces per pair, the pairs with the most cropped faces begun first.
+  std::vector<size_t> order(pairs.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  const auto cropped = [&](size_t q) {
+    return crop[pairs[q][0]][slot[q][0]].size() + crop[pairs[q][1]][slot[q][1]].size();
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return cropped(x) > cropped(y); });
+  std::vector<std::vector<std::array<uint32_t, 2>>> met(pairs.size());
+  std::vector<char> skipped(pairs.size(), 0);
+  if (progress) progress->set_total(pairs.size());
+  rc::parallel_for(order.size(), [&](size_t k) {
+    const size_t q = order[k];
+    const auto [i, j] = pairs[q];
+    if (std::chrono::steady_clock::now() >= deadline) {
+      skipped[q] = 1;
+    } else {
+      met[q] = meeting_faces(faces[i], crop[i][slot[q][0]], faces[j], crop[j][slot[q][1]]);
+      crop[i][slot[q][0]] = {};
+      crop[j][slot[q][1]] = {};
+    }
+    if (progress) progress->advance(1);
+  });
+  faces = {};
+  crop = {};
+
+  // Per receiving piece, its (tool mesh, piece, face, own face) quadruples, both ways round; each
+  // piece's list is sorted on its own, in parallel, so no list of every pair is ever sorted.
+  std::vector<std::vector<std::array<uint32_t, 4>>> found(pieces.size());
+  searched_in_part.assign(parts.size(), {});
+  for (size_t m = 0; m < parts.size(); ++m) searched_in_part[m].assign(parts[m].size(), 0);
+  for (size_t q = 0; q < pairs.size(); ++q) {
+    const auto [i, j] = pairs[q];
+    if (skipped[q]) {
+      searched_in_part[pieces[i][0]][pieces[i][1]] = searched_in_part[pieces[j][0]][pieces[j][1]] = 1;
+      continue;
+    }
+    for (const auto& [fi, fj] : met[q]) {
+      found[i].push_back({pieces[j][0], pieces[j][1], fj, fi});
+      found[j].push_back({pieces[i][0], pieces[i][1], fi, fj});
+    }
+    met[q] = {};
+  }
   contacts.assign(parts.size(), {});
   for (size_t m = 0; m < parts.size(); ++m) contacts[m].resize(parts[m].size());
-  rc::parallel_for(found.size(), [&](size_t piece) {
-    const size_t m = static_cast<size_t>(std::upper_bound(first_piece.begin(), first_piece.end(), piece) -
-                                         first_piece.begin()) - 1;
-    std::vector<std::array<uint32_t, 3>>& tools = found[piece];
+  rc::parallel_for(found.size(), [&](size_t i) {
+    std::vector<std::array<uint32_t, 4>>& tools = found[i];
     std::sort(tools.begin(), tools.end());
-    tools.erase(std::unique(tools.begin(), tools.end()), tools.end());
-    std::vector<ToolContact>& list = contacts[m][piece - first_piece[m]];
-    for (const auto& [tm, tp, tf] : tools) {
-      if (list.empty() || list.back().mesh != tm || list.back().part != tp) list.push_back({tm, tp, {}});
-      list.back().faces.push_back(tf);
+    std::vector<ToolContact>& list = contacts[pieces[i][0]][pieces[i][1]];
+    for (const auto& [tm, tp, tf, own] : tools) {
+      if (list.empty() || list.back().mesh != tm || list.back().part != tp) list.push_back({tm, tp, {}, {}});
+      ToolContact& c = list.back();
+      if (c.faces.empty() || c.faces.back() != tf) c.faces.push_back(tf);
+      c.pairs.push_back({own, static_cast<uint32_t>(c.faces.size() - 1)});
     }
+    for (ToolContact& c : list) std::sort(c.pairs.begin(), c.pairs.end());
     tools = {};
   });
 }
@@ -898,8 +1023,8 @@ RepairedMeshes::RepairedMeshes(size_t mesh_count) : impl_(std::make_unique<Impl>
 
 RepairedMeshes::~RepairedMeshes() = default;
 
-void RepairedMeshes::find_contacts() {
-  std::call_once(impl_->contacts_found, [this] { impl_->find_contacts(); });
+void RepairedMeshes::find_contacts(rc::Progress* progress, std::chrono::steady_clock::time_point deadline) {
+  std::call_once(impl_->contacts_found, [&] { impl_->find_contacts(progress, deadline); });
 }
 
 void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh) {
@@ -932,6 +1057,8 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
       faces += contact.faces.size();
     }
     order.emplace_back(faces, i);
+    // A piece whose contact search ran out of time keeps what was found, and is counted.
+    if (impl_->searched_in_part[m][i]) ++piece_counts[i].not_imprinted;
   }
   std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
@@ -942,7 +1069,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
     if (!tools[i].empty() && std::chrono::steady_clock::now() >= deadline) {
       // Out of time: the piece keeps its input triangles, remeshed without contact lines.
-      ++piece_counts[i].not_imprinted;
+      piece_counts[i].not_imprinted = 1;
       soups[i] = to_soup(part.mesh);
       if (progress) progress->advance(part.mesh.number_of_faces());
       return;
