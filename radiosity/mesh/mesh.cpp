@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -268,6 +269,7 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.reoriented, "faces reoriented to agree with their neighbours");
   warn(c.duplicated_vertices, "vertices duplicated to make the surface manifold");
   warn(c.self_intersecting, "pairs of faces intersect each other (meshed as they are)");
+  warn(c.self_intersections_uncounted, "pieces not searched for faces that intersect each other: --time left no time");
   warn(c.contacts_failed, "touching surfaces whose contact lines could not be imprinted");
   warn(c.contact_segments_lost, "pieces of contact line left out (an end outside its face by rounding)");
   warn(c.remesh_failed, "pieces could not be remeshed and keep their input triangles");
@@ -385,12 +387,18 @@ double triangle_area(const DVec3& a, const DVec3& b, const DVec3& d) { return 0.
 /// surface inside-out with respect to its neighbours is never buried (its rays leave the
 /// scene), nor is one enclosed by glass or in view of the camera. A face lying flat on another
 /// and facing it (a closed box's base on the floor) is not found and is kept: it receives
-/// nothing and costs only its own elements. Returns the buried area.
-double mark_buried(const rc::Scene& scene, const TriangleSoup& surface, std::vector<char>& buried) {
+/// nothing and costs only its own elements. Triangles not begun by `deadline` are kept, and
+/// counted in `untested`. Returns the buried area.
+double mark_buried(const rc::Scene& scene, const TriangleSoup& surface, std::vector<char>& buried,
+                   std::chrono::steady_clock::time_point deadline, std::atomic<size_t>& untested) {
   buried.assign(surface.triangles.size(), 0);
   // In parallel over triangles (a furnished room's furniture is one mesh of most of its faces),
   // the area summed afterwards in triangle order, so it does not depend on the thread count.
   rc::parallel_for(surface.triangles.size(), [&](size_t t) {
+    if (std::chrono::steady_clock::now() >= deadline) {
+      ++untested;
+      return;
+    }
     const auto& c = surface.triangles[t];
     buried[t] = triangle_buried(scene, surface.points[c[0]], surface.points[c[1]], surface.points[c[2]]);
   });
@@ -419,9 +427,14 @@ bool on_input(const rc::Scene& scene, const DVec3& p, const DVec3& n, uint32_t m
 /// in view). It finds what imprinting left whole: a floor under an object that stands a rounding
 /// error above it, or one that intersects itself and so imprints nothing. Returns the area.
 double mark_buried_flat(const rc::Scene& scene, const SplitSurface& surface, uint32_t mesh_index,
-                        std::vector<char>& buried) {
+                        std::vector<char>& buried, std::chrono::steady_clock::time_point deadline,
+                        std::atomic<size_t>& untested) {
   buried.assign(surface.corners.size(), 0);
   rc::parallel_for(surface.corners.size(), [&](size_t t) {  // as mark_buried
+    if (std::chrono::steady_clock::now() >= deadline) {
+      ++untested;
+      return;
+    }
     const auto& c = surface.corners[t];
     const DVec3 &a = surface.positions[c[0]], &b = surface.positions[c[1]], &d = surface.positions[c[2]];
     const DVec3 n = glm::normalize(glm::cross(b - a, d - a));
@@ -483,6 +496,7 @@ struct MeshingState {
   std::vector<double> buried_area;
   std::vector<size_t> imprinted_faces;
   double total_buried = 0.0;
+  std::atomic<size_t> untested{0};  ///< faces and elements not tested for burial: out of time
   std::vector<SplitSurface> surfaces;  ///< per mesh, then per sphere: the remeshed surface
   std::vector<std::vector<char>> buried_elements;
   std::vector<double> buried_element_area;
@@ -553,7 +567,7 @@ void repair_pass(MeshingState& st, RepairedMeshes& repaired) {
   rc::Progress progress("mesh: repairing", st.faces_of(st.repair), "faces", st.settings.progress);
   rc::parallel_for(st.mesh_count, [&](size_t m) {
     if (!st.repair[m]) return;
-    repaired.repair(m, st.scene.meshes[m]);
+    repaired.repair(m, st.scene.meshes[m], st.settings.deadline);
     progress.advance(st.scene.meshes[m].indices.size() / 3);
   });
 }
@@ -574,7 +588,8 @@ void imprint_pass(MeshingState& st, RepairedMeshes& repaired) {
   st.imprinted_faces.assign(st.mesh_count, 0);
   rc::parallel_for(st.mesh_count, [&](size_t m) {
     st.imprinted_faces[m] = imprinted[m].triangles.size();
-    if (st.meshed[m] && st.scene.committed()) st.buried_area[m] = mark_buried(st.scene, imprinted[m], st.buried[m]);
+    if (st.meshed[m] && st.scene.committed())
+      st.buried_area[m] = mark_buried(st.scene, imprinted[m], st.buried[m], st.settings.deadline, st.untested);
     imprinted[m] = TriangleSoup();
   });
   st.end_stage("buried faces");
@@ -607,7 +622,8 @@ void remesh_pass(MeshingState& st, RepairedMeshes& repaired) {
       st.surfaces[s] = split_sharp_vertices(soup, st.settings.sharp_angle_degrees);
       if (scene.committed() && st.total_buried <= kMaxBuriedShare * st.area)
         st.buried_element_area[s] =
-            mark_buried_flat(scene, st.surfaces[s], static_cast<uint32_t>(s), st.buried_elements[s]);
+            mark_buried_flat(scene, st.surfaces[s], static_cast<uint32_t>(s), st.buried_elements[s],
+                             st.settings.deadline, st.untested);
     } else {
       const rc::Sphere& sphere = scene.spheres[s - st.mesh_count];
       if (!is_meshed(scene.materials[sphere.material])) return;
@@ -634,6 +650,10 @@ void assemble_pass(MeshingState& st, RadiosityMesh& out) {
       rep.buried_elements += remove_triangles(st.surfaces[m], st.buried_elements[m]);
   }
   rep.buried_area = st.total_buried;
+  if (st.untested > 0)
+    rep.warnings.push_back(std::to_string(st.untested.load()) +
+                           " faces and elements were not tested for lying buried inside other surfaces: --time left "
+                           "no time (they are kept)");
   for (size_t s = 0; s < st.surface_count; ++s) {
     const uint32_t material =
         s < st.mesh_count ? st.scene.meshes[s].material : st.scene.spheres[s - st.mesh_count].material;

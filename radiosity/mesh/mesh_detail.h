@@ -39,6 +39,7 @@ struct RepairCounts {
   size_t reoriented = 0;           ///< faces whose winding was reversed to agree with their neighbours
   size_t duplicated_vertices = 0;  ///< vertices copied to make the surface manifold
   size_t self_intersecting = 0;    ///< pairs of faces that intersect away from a shared vertex or edge
+  size_t self_intersections_uncounted = 0;  ///< pieces not (wholly) searched for them: the deadline had passed
   size_t contact_edges = 0;        ///< edges imprinted where another surface touches or crosses this one
   size_t contacts_failed = 0;      ///< other surfaces whose contact could not be imprinted
   size_t contact_segments_lost = 0;  ///< pieces of contact line left out: an end outside its face by rounding
@@ -65,8 +66,10 @@ class RepairedMeshes {
   RepairedMeshes(const RepairedMeshes&) = delete;
   RepairedMeshes& operator=(const RepairedMeshes&) = delete;
 
-  /// Mends mesh m; calls for different m may run in parallel.
-  void repair(size_t m, const rc::TriangleMesh& mesh);
+  /// Mends mesh m; calls for different m may run in parallel. Counting each piece's
+  /// self-intersections, a warning only, stops at `deadline` (counts->self_intersections_uncounted).
+  void repair(size_t m, const rc::TriangleMesh& mesh,
+              std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   /// Finds which faces of which pieces meet, over every repaired mesh, so call it after every
   /// repair(); imprint() calls it on first use. `progress`, when given, counts pairs of pieces

@@ -166,6 +166,7 @@ struct Part {
   SurfaceMesh mesh;
   CGAL::Bbox_3 box;
   size_t self_intersecting = 0;  ///< pairs of its faces that intersect away from shared vertices and edges
+  bool counted = true;           ///< false when the deadline cut the count short (self_intersecting is a part)
 };
 
 /// Whether an edge of triangle `t` keeps the points `others`, which lie in its plane, strictly off
@@ -207,7 +208,10 @@ bool apart_in_plane(const Kernel::Triangle_3& t, const std::array<Point, 3>& oth
 /// CGAL settles with exact arithmetic on every call (the rotated box's quad halves are coplanar,
 /// so no filter can decide them); here two faces on an edge whose normals agree, or two faces on a
 /// vertex whose far corners lie strictly off the other's plane, are settled in floating point.
-size_t count_self_intersections(const SurfaceMesh& mesh) {
+/// A count is a warning only, so under a deadline it stops there (`counted` false): the meeting
+/// boxes are still visited, but no more are tested.
+size_t count_self_intersections(const SurfaceMesh& mesh, std::chrono::steady_clock::time_point deadline,
+                                bool& counted) {
   using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, face_descriptor, CGAL::Box_intersection_d::ID_EXPLICIT>;
   using HalfedgeIndex = SurfaceMesh::Halfedge_index;
   size_t count = 0;
@@ -272,8 +276,16 @@ size_t count_self_intersections(const SurfaceMesh& mesh) {
     }
     return CGAL::do_intersect(tf, tg);
   };
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(),
-                                [&](const Box& a, const Box& b) { count += meet(a.info(), b.info()); });
+  counted = std::chrono::steady_clock::now() < deadline;
+  size_t tested = 0;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& a, const Box& b) {
+    if (!counted) return;
+    if (++tested % 4096 == 0 && std::chrono::steady_clock::now() >= deadline) {
+      counted = false;
+      return;
+    }
+    count += meet(a.info(), b.info());
+  });
   return count;
 }
 
@@ -281,7 +293,7 @@ size_t count_self_intersections(const SurfaceMesh& mesh) {
 /// edges (a block standing on the floor, both in one OBJ material) are not a self-intersection
 /// but a contact, imprinted like a contact between meshes; only what intersects within a piece
 /// counts as one.
-std::vector<Part> split_parts(const SurfaceMesh& mesh) {
+std::vector<Part> split_parts(const SurfaceMesh& mesh, std::chrono::steady_clock::time_point deadline) {
   // Faces joined across edges, pieces numbered in the order of their first face. One pass over
   // the faces (CGAL's split_connected_components walks the whole mesh once per piece, which on a
   // room of two thousand chairs took most of the repair).
@@ -316,7 +328,7 @@ std::vector<Part> split_parts(const SurfaceMesh& mesh) {
   }
   rc::parallel_for(parts.size(), [&](size_t i) {
     parts[i].box = PMP::bbox(parts[i].mesh);
-    parts[i].self_intersecting = count_self_intersections(parts[i].mesh);
+    parts[i].self_intersecting = count_self_intersections(parts[i].mesh, deadline, parts[i].counted);
   });
   return parts;
 }
@@ -1027,9 +1039,9 @@ void RepairedMeshes::find_contacts(rc::Progress* progress, std::chrono::steady_c
   std::call_once(impl_->contacts_found, [&] { impl_->find_contacts(progress, deadline); });
 }
 
-void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh) {
+void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh, std::chrono::steady_clock::time_point deadline) {
   const SurfaceMesh repaired = detail::repair(mesh, impl_->counts[m]);
-  if (repaired.number_of_faces() > 0) impl_->parts[m] = split_parts(repaired);
+  if (repaired.number_of_faces() > 0) impl_->parts[m] = split_parts(repaired, deadline);
 }
 
 TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
@@ -1094,6 +1106,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
   TriangleSoup soup;
   for (size_t i = 0; i < own.size(); ++i) {
     c.self_intersecting += own[i].self_intersecting;
+    c.self_intersections_uncounted += !own[i].counted;
     c.contact_edges += piece_counts[i].contact_edges;
     c.contacts_failed += piece_counts[i].contacts_failed;
     c.contact_segments_lost += piece_counts[i].contact_segments_lost;
