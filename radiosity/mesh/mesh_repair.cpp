@@ -12,6 +12,7 @@
 #include <iterator>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <unordered_map>
@@ -383,6 +384,32 @@ using Constrained = SurfaceMesh::Property_map<edge_descriptor, bool>;
 /// imprinted by other meshes only.
 constexpr size_t kMaxImprintedParts = 4096;
 
+/// The edge joining a and b, if any: CGAL::halfedge(a, b) walks round one end, which at the centre
+/// of a finely cut fan costs its whole degree on every call; this walks round both ends at once
+/// and stops with the first to find it or run out, so it costs the smaller degree.
+std::optional<edge_descriptor> edge_between(SurfaceMesh::Vertex_index a, SurfaceMesh::Vertex_index b,
+                                            const SurfaceMesh& mesh) {
+  using HalfedgeIndex = SurfaceMesh::Halfedge_index;
+  const HalfedgeIndex start_a = mesh.halfedge(a), start_b = mesh.halfedge(b);
+  if (start_a == SurfaceMesh::null_halfedge() || start_b == SurfaceMesh::null_halfedge()) return std::nullopt;
+  HalfedgeIndex ha = start_a, hb = start_b;  // halfedges into a and into b
+  bool more_a = true, more_b = true;
+  while (more_a || more_b) {
+    if (more_a) {
+      if (mesh.source(ha) == b) return mesh.edge(ha);
+      ha = mesh.opposite(mesh.next(ha));
+      more_a = ha != start_a;
+    }
+    if (more_b) {
+      if (mesh.source(hb) == a) return mesh.edge(hb);
+      hb = mesh.opposite(mesh.next(hb));
+      more_b = hb != start_b;
+    }
+    if (!more_a || !more_b) break;  // one end's whole ring seen: it has no such edge
+  }
+  return std::nullopt;
+}
+
 /// A piece of some mesh that may imprint another piece, cropped to the faces that meet the other
 /// piece's faces (found by find_contacts): only they can cut it, so imprinting reads them alone,
 /// whatever the size of the tool.
@@ -445,9 +472,9 @@ size_t imprint_contacts(Part& part, const std::vector<std::pair<const Part*, con
   Constrained marks = mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
   size_t lines = 0;
   for (const auto& [a, b] : cut.cuts) {
-    const auto [h, found] = CGAL::halfedge(vertex[a], vertex[b], mesh);
-    if (found && !marks[mesh.edge(h)]) {
-      marks[mesh.edge(h)] = true;
+    const std::optional<edge_descriptor> e = edge_between(vertex[a], vertex[b], mesh);
+    if (e && !marks[*e]) {
+      marks[*e] = true;
       ++lines;
     }
   }
@@ -576,8 +603,7 @@ void canonicalize(SurfaceMesh& mesh, Constrained& constrained) {
     for (std::size_t ca : copies[a])
       for (std::size_t cb : copies[b]) {
         if (ca >= points.size() || cb >= points.size() || !used[ca] || !used[cb]) continue;
-        const auto [h, found] = CGAL::halfedge(vertex[ca], vertex[cb], out);
-        if (found) marks[out.edge(h)] = true;
+        if (const std::optional<edge_descriptor> e = edge_between(vertex[ca], vertex[cb], out)) marks[*e] = true;
       }
 
   // Lawson flips, in edge order, until none applies. Each flip removes a locally non-Delaunay
@@ -589,7 +615,7 @@ void canonicalize(SurfaceMesh& mesh, Constrained& constrained) {
       const auto h = out.halfedge(e), o = out.opposite(h);
       const vertex_descriptor a = out.source(h), b = out.target(h), c = out.target(out.next(h)),
                               d = out.target(out.next(o));
-      if (c == d || CGAL::halfedge(c, d, out).second) continue;
+      if (c == d || edge_between(c, d, out)) continue;
       const Point &pa = out.point(a), &pb = out.point(b), &pc = out.point(c), &pd = out.point(d);
       if (!flat_pair(pa, pb, pc, pd)) continue;
       const Kernel::Vector_3 normal = CGAL::cross_product(pb - pa, pc - pa) + CGAL::cross_product(pa - pb, pd - pb);
