@@ -734,6 +734,12 @@ struct SolveState {
   bool over_budget(double seconds) const {
     return group.broadcast_value(settings.time_limit > 0.0 && seconds > settings.time_limit);
   }
+  /// The time limit less what is kept back for the export, on the mesh as it stands.
+  double solve_limit() const { return settings.time_limit - seconds_kept_back(settings, mesh.element_count()); }
+  /// Whether `seconds` since the start run past solve_limit().
+  bool over_solve_limit(double seconds) const {
+    return group.broadcast_value(settings.time_limit > 0.0 && seconds > solve_limit());
+  }
   bool may_be_blocked(const rc::Bounds3& reach) const {
     return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
                        [&](const rc::Bounds3& box) { return reach.overlaps(box); });
@@ -1013,7 +1019,7 @@ struct SolveState {
       if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
       if (sol.residual < settings.tolerance) break;
       // A shot takes about as long as the last one: stop before one would end past the budget.
-      if (over_budget(elapsed() + shot.last_shot)) break;
+      if (over_solve_limit(elapsed() + shot.last_shot)) break;
       const double shot_start = elapsed();
       aim(shot, src, best_signed);
       shoot(shot, src);
@@ -1071,8 +1077,8 @@ struct SolveState {
       element_direct[e] += (direct_emitted[el[0]] + direct_emitted[el[1]] + direct_emitted[el[2]]) * (1.0f / 3.0f);
     }
     const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, sol.vertex_irradiance, blocking(),
-                                  [this] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; },
-                                  settings.time_limit > 0.0 ? std::function<double()>([this] { return settings.time_limit - elapsed(); })
+                                  [this] { return settings.time_limit > 0.0 && elapsed() > solve_limit(); },
+                                  settings.time_limit > 0.0 ? std::function<double()>([this] { return solve_limit() - elapsed(); })
                                                             : std::function<double()>(),
                                   element_direct};
     if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
@@ -1099,6 +1105,7 @@ struct SolveState {
     sol.shadow_rays = rays;
     sol.skipped_pairs = skipped;
     sol.seconds = elapsed();
+    sol.seconds_kept_back = seconds_kept_back(settings, ne);
   }
 };
 
@@ -1111,6 +1118,11 @@ const char* to_string(SolverKind kind) {
     case SolverKind::hierarchical: return "hierarchical";
   }
   return "?";
+}
+
+double seconds_kept_back(const SolverSettings& settings, size_t elements) {
+  if (!(settings.time_limit > 0.0)) return 0.0;
+  return std::max(0.0, settings.after_seconds) + std::max(0.0, settings.after_seconds_per_element) * double(elements);
 }
 
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why) {
