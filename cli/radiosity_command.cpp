@@ -351,7 +351,11 @@ void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityO
                 sol.iterations, chebyshev, sol.residual,
                 o.solver.tolerance, sol.tail_added ? "; the geometric tail added" : "", sol.final_gather_note.c_str(),
                 double(sol.gather_nodes) / double(std::max<size_t>(1, sol.mesh.vertex_count())));
-  else
+  if (sol.shot_without_links)
+    std::printf("  solve:   no links fitted in the time: the reflected light shot progressively instead, %llu shots "
+                "of %zu patches, residual %.3g\n",
+                static_cast<unsigned long long>(sol.shots), sol.patches, sol.residual);
+  if (sol.solver != radiosity::solver::SolverKind::hierarchical)
     std::printf("  solve:   progressive (%s): %llu shots, residual %.3g (tolerance %.3g)\n", sol.solver_reason.c_str(),
                 static_cast<unsigned long long>(sol.shots), sol.residual, o.solver.tolerance);
   // A timed solve's ladder, level by level, when it had more than one.
@@ -366,10 +370,12 @@ void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityO
               static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
               static_cast<unsigned long long>(sol.shadow_rays),
               sol.convex_enclosure ? " (convex enclosure: visibility rays skipped)" : "");
+  char shooting[48] = "";
+  if (sol.shot_without_links) std::snprintf(shooting, sizeof shooting, ", shooting %.3g", sol.shoot_seconds);
   if (sol.solver == radiosity::solver::SolverKind::hierarchical)
-    std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, links %.3g, iterations %.3g, final gather %.3g)\n",
+    std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, links %.3g, iterations %.3g, final gather %.3g%s)\n",
                 sol.seconds, sol.mesh_seconds, sol.direct_seconds, sol.link_seconds, sol.iterate_seconds,
-                sol.gather_seconds);
+                sol.gather_seconds, shooting);
   else
     std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, shooting %.3g)\n", sol.seconds, sol.mesh_seconds,
                 sol.direct_seconds, sol.shoot_seconds);

@@ -1007,6 +1007,7 @@ struct SolveState {
   /// light; adds the interreflection to sol.vertex_irradiance; writes sol.residual, shots,
   /// patches, ambient and shoot_seconds.
   void shoot_progressive() {
+    const double shoot_start = elapsed();
     Shooting shot;
     start_shooting(shot);
     // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
@@ -1030,7 +1031,7 @@ struct SolveState {
     // they disagree a dim vertex can be left below zero, which no irradiance is: held at zero.
     for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
     keep_ambient(shot);
-    sol.shoot_seconds = elapsed() - sol.mesh_seconds - sol.direct_seconds;
+    sol.shoot_seconds = elapsed() - shoot_start;
   }
 
   /// Copies the hierarchical solve's result into the solution, its interreflection added to
@@ -1186,9 +1187,16 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   state.refine_direct();
   state.keep_direct();
   // Pass 2, the interreflection.
-  if (state.hierarchical)
+  if (state.hierarchical) {
     state.gather_hierarchical();
-  else
+    // No level of links fitted in the time (a furnished room's clusters, close together, split
+    // down to millions of links at any tolerance): the brightest patches shoot in what is left, a
+    // coarse reflected solution rather than none.
+    if (settings.time_limit > 0.0 && sol.links == 0 && !state.over_solve_limit(state.elapsed())) {
+      sol.shot_without_links = true;
+      state.shoot_progressive();
+    }
+  } else
     state.shoot_progressive();
   state.finish();
   return sol;

@@ -97,6 +97,9 @@ struct Solution {
   std::string final_gather_note; ///< hierarchical: how the final gather ran, or why it did not
   double link_tolerance = 0.0;   ///< hierarchical: the tolerance of the links used
   bool linking_stopped = false;  ///< hierarchical: time ran out while linking finer
+  /// hierarchical under a time limit: no level of links fitted, so the reflected light was shot
+  /// by progressive refinement for the time left instead (`shots`, `residual`)
+  bool shot_without_links = false;
   double residual = 0.0;         ///< progressive: unshot power / emitted power at the end;
                                  ///< hierarchical: relative change of the last iteration
   bool tail_added = false;       ///< hierarchical: the iteration's geometric tail was added
