@@ -12,11 +12,14 @@ namespace gilt::radiosity::solver {
 /// been merged and measured (two cores: 17 M links in about 0.9 s on a furnished room).
 inline constexpr double kMergeSecondsPerLink = 6e-8;
 /// Seconds per link of one gather, until a level has been iterated and measured (two cores:
-/// 31-36 ns on Šibenik and a furnished room).
-inline constexpr double kGatherSecondsPerLink = 4e-8;
-/// Gathers foretold for the first level of a ladder, bounding the gains included: about the
-/// bounces that carry most of the reflected light (Šibenik's first level iterated 9 times).
-inline constexpr int kFirstLevelGathers = 8;
+/// 19-36 ns on Šibenik and a furnished room, as busy as the machine was).
+inline constexpr double kGatherSecondsPerLink = 3e-8;
+/// Gathers foretold for the first level of a ladder, bounding the gains included: the first
+/// three bounces above the direct light, which carry most of the reflected light at the albedos
+/// of interiors; the iteration goes on while time is left (Šibenik's first level iterated 9
+/// times). Foretelling all of them (8) made a furnished room at `--time 20` link nothing where
+/// 17 M links and 8 gathers fitted in a quieter run.
+inline constexpr int kFirstLevelGathers = 4;
 /// A timed solve's first level may link this many decades coarser than the ladder's top.
 inline constexpr int kFirstLevelDecades = 3;
 /// The final gather runs only when this many times its foretold seconds fit in the time left.
