@@ -646,7 +646,7 @@ RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats) {
 
 WriteForecast write_forecast(const std::string& path) {
   // The slowest rate measured, 0.11-0.35 M elements on three scenes, with 30 % for the machine's
-  // noise (bench/README.md, "Time kept back for the export"): snapping to the input costs as
+  // noise (bench/README.md, "The solver's budget"): snapping to the input costs as
   // much as encoding, so binary PLY and glTF take about as long, and OBJ's text a tenth longer.
   switch (format_of(fs::path(path))) {
     case Format::ply:
@@ -659,8 +659,7 @@ WriteForecast write_forecast(const std::string& path) {
 
 WriteForecast onto_input_forecast(size_t input_triangles, int lightmap_size) {
   // Šibenik (75,277 triangles) at `--time 20`: the fit and write took 0.47 s, a 1024² lightmap
-  // 1.33 s; the rates with 30 % for the machine's noise (bench/README.md, "Time kept back for
-  // the export").
+  // 1.33 s; the rates with 30 % for the machine's noise (bench/README.md, "The solver's budget").
   const double texels = lightmap_size > 0 ? double(lightmap_size) * double(lightmap_size) : 0.0;
   return {kWriteSeconds + kOntoSecondsPerTriangle * double(input_triangles) + kLightmapSecondsPerTexel * texels, 0.0};
 }

@@ -89,8 +89,8 @@ void write_solution(const std::string& path, const rc::Scene& scene, const solve
                     const ExportSettings& settings, SnapStats* snap = nullptr);
 
 /// What write_solution is foretold to take on a mesh of n elements: seconds + seconds_per_element
-/// × n, snapping, merging and encoding included (measured on two cores: bench/README.md, "Time
-/// kept back for the export").
+/// × n, snapping, merging and encoding included (measured on two cores: bench/README.md, "The
+/// solver's budget").
 struct WriteForecast {
   double seconds = 0.0;
   double seconds_per_element = 0.0;
