@@ -1676,13 +1676,15 @@ struct HierarchicalSolve {
   }
 
   /// Gathers at the listed vertices in parallel, each process at the chunks of 64 it owns, into
-  /// gathered_at; adds to the counters. False when time ran out first on any process.
-  bool gather_at(const TreeWalk& walker, const std::vector<uint32_t>& list) {
+  /// gathered_at; adds to the counters. False when time ran out first on any process, or when
+  /// fewer than `keep_back` seconds were left (0: none kept back).
+  bool gather_at(const TreeWalk& walker, const std::vector<uint32_t>& list, double keep_back = 0.0) {
     std::atomic<bool> stopped{false};
     const uint64_t rays_before = counters.rays, nodes_before = counters.gather_nodes,
                    form_factors_before = counters.form_factors;
     rc::parallel_for_owned((list.size() + 63) / 64, [&](size_t chunk) {
-      if (stopped.load(std::memory_order_relaxed) || (in.out_of_time && in.out_of_time())) {
+      if (stopped.load(std::memory_order_relaxed) || (in.out_of_time && in.out_of_time()) ||
+          (keep_back > 0.0 && in.seconds_left && in.seconds_left() < keep_back)) {
         stopped = true;
         return;
       }
@@ -1741,8 +1743,12 @@ struct HierarchicalSolve {
     for (uint32_t v = 0; v < nv; ++v) (v % stride == 0 ? probe : rest).push_back(v);
     const uint64_t rays_before = counters.rays;
     const auto probe_start = std::chrono::steady_clock::now();
-    bool complete = gather_at(walker, probe);
     const double scale = double(nv) / double(std::max<size_t>(1, probe.size()));
+    // Under a time limit the probe stops once the gather it foretells could no longer fit: with
+    // L seconds left, a probe that takes more than L / (1 + kFinalGatherMargin (scale − 1)).
+    const double probe_keep_back =
+        timed ? in.seconds_left() * (1.0 - 1.0 / (1.0 + kFinalGatherMargin * std::max(0.0, scale - 1.0))) : 0.0;
+    bool complete = gather_at(walker, probe, probe_keep_back);
     result.final_gather_predicted_rays = uint64_t(double(counters.rays - rays_before) * scale);
     const double predicted_seconds = group.broadcast_value(seconds_since(probe_start) * (scale - 1.0));
     if (complete && settings.final_gather == FinalGather::automatic &&
@@ -1762,7 +1768,7 @@ struct HierarchicalSolve {
       result.final_gather = complete;
       result.final_gather_note = complete ? "at every vertex" : "stopped by --time";
     } else {
-      result.final_gather_note = "stopped by --time";
+      result.final_gather_note = "skipped: its probe ran past the time it could take under --time";
     }
     // A partial gather would leave its boundary visible between vertices that had it and their
     // neighbours that did not: only a complete one is used.
