@@ -57,6 +57,8 @@ struct RadiosityRun {
   bool lightmap = false;    ///< --lightmap: bake onto the input model, in its UVs
   bool onto_input = false;  ///< the colours go onto the input model (--onto input or --lightmap)
   std::chrono::steady_clock::time_point start;  ///< before loading: --time covers the whole command
+  double time_limit = 0.0;                      ///< --time (0: none), the whole command's
+  double export_seconds = 0.0;                  ///< the bake and the write, after the solve
   radiosity::bake::BakeGather gather;
   radiosity::solver::BudgetFit budget_fit;
   radiosity::bake::VertexFit fit = radiosity::bake::VertexFit::least_squares;
@@ -122,9 +124,11 @@ rc::Scene load_radiosity_scene(const RadiosityOptions& o, RadiosityRun& run) {
   return scene;
 }
 
-/// Reads o.quiet, o.json, o.bake_gather, o.solver and run.start; writes o.solver.progress,
-/// o.solver.time_limit (what is left of --time for the solve) and run.gather (its deadline).
-void plan_radiosity_budget(RadiosityOptions& o, RadiosityRun& run) {
+/// Reads the scene, o.quiet, o.json, o.bake_gather, o.output, o.lightmap, o.solver, run.onto_input
+/// and run.start; writes o.solver.progress, o.solver.time_limit (what is left of --time for the
+/// solve), the time it keeps back for the export (o.solver.after_seconds and
+/// after_seconds_per_element), run.time_limit and run.gather (its deadline).
+void plan_radiosity_budget(const rc::Scene& scene, RadiosityOptions& o, RadiosityRun& run) {
   o.solver.progress = !o.quiet && !o.json;
   radiosity::bake::BakeGather& gather = run.gather;
   gather = radiosity::bake::BakeGather{o.bake_gather, o.solver.seed};
@@ -136,7 +140,17 @@ void plan_radiosity_budget(RadiosityOptions& o, RadiosityRun& run) {
     const double left = o.solver.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     gather.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                   std::chrono::duration<double>(o.solver.time_limit));
+    run.time_limit = o.solver.time_limit;
     o.solver.time_limit = std::max(1e-3, o.bake_gather > 0 ? (1.0 - kBakeGatherShare) * left : left);
+    // The write is foretold, from the final mesh's size for the elements and from the input's
+    // for a bake onto it, and kept back from the solve. With --bake-gather the bake's share and
+    // deadline above take its place.
+    const radiosity::bake::WriteForecast write =
+        o.bake_gather > 0 ? radiosity::bake::WriteForecast{}
+        : run.onto_input  ? radiosity::bake::onto_input_forecast(scene.triangle_count(), o.lightmap)
+                          : radiosity::bake::write_forecast(o.output);
+    o.solver.after_seconds = write.seconds;
+    o.solver.after_seconds_per_element = write.seconds_per_element;
   }
 }
 
@@ -168,6 +182,10 @@ void export_radiosity(const rc::Scene& scene, const radiosity::solver::Solution&
     radiosity::bake::write_onto_input(o.output, scene, *run.onto, ex);
   } else {
     if (o.bake_gather > 0) {
+      // The gather ends where the write, foretold on the solution's mesh, still fits.
+      if (run.time_limit > 0.0)
+        run.gather.deadline -= std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(
+            radiosity::bake::write_forecast(o.output).at(sol.mesh.element_count())));
       const auto gather_start = std::chrono::steady_clock::now();
       run.vertex_gather.emplace(radiosity::bake::gather_at_vertices(scene, sol, run.gather, &run.vertex_gather_count));
       run.vertex_gather_seconds =
@@ -300,7 +318,9 @@ void report_radiosity_json(const radiosity::solver::Solution& sol, const Radiosi
                           {"largest_move_onto_input", snap.largest},
                           {"coincident_faces_merged", snap.coincident_merged},
                           {"coincident_back_to_back_pairs", snap.back_to_back},
-                          {"output", o.output}});
+                          {"output", o.output},
+                          {"export_seconds", run.export_seconds},
+                          {"export_seconds_kept_back", sol.seconds_kept_back}});
   add_bake_json(j, sol, o, run);
   add_check_json(j, o, run);
   std::cout << j.dump() << std::endl;
@@ -331,7 +351,11 @@ void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityO
                 sol.iterations, chebyshev, sol.residual,
                 o.solver.tolerance, sol.tail_added ? "; the geometric tail added" : "", sol.final_gather_note.c_str(),
                 double(sol.gather_nodes) / double(std::max<size_t>(1, sol.mesh.vertex_count())));
-  else
+  if (sol.shot_without_links)
+    std::printf("  solve:   no links fitted in the time: the reflected light shot progressively instead, %llu shots "
+                "of %zu patches, residual %.3g\n",
+                static_cast<unsigned long long>(sol.shots), sol.patches, sol.residual);
+  if (sol.solver != radiosity::solver::SolverKind::hierarchical)
     std::printf("  solve:   progressive (%s): %llu shots, residual %.3g (tolerance %.3g)\n", sol.solver_reason.c_str(),
                 static_cast<unsigned long long>(sol.shots), sol.residual, o.solver.tolerance);
   // A timed solve's ladder, level by level, when it had more than one.
@@ -346,10 +370,12 @@ void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityO
               static_cast<unsigned long long>(sol.form_factors), double(sol.form_factors) / secs,
               static_cast<unsigned long long>(sol.shadow_rays),
               sol.convex_enclosure ? " (convex enclosure: visibility rays skipped)" : "");
+  char shooting[48] = "";
+  if (sol.shot_without_links) std::snprintf(shooting, sizeof shooting, ", shooting %.3g", sol.shoot_seconds);
   if (sol.solver == radiosity::solver::SolverKind::hierarchical)
-    std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, links %.3g, iterations %.3g, final gather %.3g)\n",
+    std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, links %.3g, iterations %.3g, final gather %.3g%s)\n",
                 sol.seconds, sol.mesh_seconds, sol.direct_seconds, sol.link_seconds, sol.iterate_seconds,
-                sol.gather_seconds);
+                sol.gather_seconds, shooting);
   else
     std::printf("  time:    %.3f s (mesh %.3g, direct %.3g, shooting %.3g)\n", sol.seconds, sol.mesh_seconds,
                 sol.direct_seconds, sol.shoot_seconds);
@@ -454,12 +480,14 @@ void run_radiosity(RadiosityOptions& o) {
   RadiosityRun run;
   validate_radiosity_options(o, run);
   const rc::Scene scene = load_radiosity_scene(o, run);
-  plan_radiosity_budget(o, run);
+  plan_radiosity_budget(scene, o, run);
   const radiosity::solver::Solution sol = solve_radiosity(scene, o, run);
   // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
   if (rc::processes().rank() > 0) return;
   print_solve_warnings(sol, o, run);
+  const auto export_start = std::chrono::steady_clock::now();
   export_radiosity(scene, sol, o, run);
+  run.export_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - export_start).count();
   check_radiosity(scene, sol, o, run);
   if (o.json) {
     report_radiosity_json(sol, o, run);

@@ -66,6 +66,12 @@ namespace {
 
 enum class Format { ply, obj, gltf, glb, unsupported };
 
+/// write_forecast's fixed part and its parts per element, binary files and OBJ's text (see
+/// write_forecast).
+constexpr double kWriteSeconds = 0.3, kWriteSecondsPerElement = 7e-6, kObjSecondsPerElement = 8e-6;
+/// onto_input_forecast's parts per input triangle and per lightmap texel.
+constexpr double kOntoSecondsPerTriangle = 8e-6, kLightmapSecondsPerTexel = 1.7e-6;
+
 Format format_of(const fs::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -636,6 +642,26 @@ RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats) {
   compact(out.element_normal);
   compact(out.element_area);
   return out;
+}
+
+WriteForecast write_forecast(const std::string& path) {
+  // The slowest rate measured, 0.11-0.35 M elements on three scenes, with 30 % for the machine's
+  // noise (bench/README.md, "The solver's budget"): snapping to the input costs as
+  // much as encoding, so binary PLY and glTF take about as long, and OBJ's text a tenth longer.
+  switch (format_of(fs::path(path))) {
+    case Format::ply:
+    case Format::gltf:
+    case Format::glb: return {kWriteSeconds, kWriteSecondsPerElement};
+    case Format::obj: return {kWriteSeconds, kObjSecondsPerElement};
+    default: return {};
+  }
+}
+
+WriteForecast onto_input_forecast(size_t input_triangles, int lightmap_size) {
+  // Šibenik (75,277 triangles) at `--time 20`: the fit and write took 0.47 s, a 1024² lightmap
+  // 1.33 s; the rates with 30 % for the machine's noise (bench/README.md, "The solver's budget").
+  const double texels = lightmap_size > 0 ? double(lightmap_size) * double(lightmap_size) : 0.0;
+  return {kWriteSeconds + kOntoSecondsPerTriangle * double(input_triangles) + kLightmapSecondsPerTexel * texels, 0.0};
 }
 
 void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,

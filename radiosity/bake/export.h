@@ -88,4 +88,22 @@ mesh::RadiosityMesh without_coincident(const mesh::RadiosityMesh& mesh, SnapStat
 void write_solution(const std::string& path, const rc::Scene& scene, const solver::Solution& solution,
                     const ExportSettings& settings, SnapStats* snap = nullptr);
 
+/// What write_solution is foretold to take on a mesh of n elements: seconds + seconds_per_element
+/// × n, snapping, merging and encoding included (measured on two cores: bench/README.md, "The
+/// solver's budget").
+struct WriteForecast {
+  double seconds = 0.0;
+  double seconds_per_element = 0.0;
+  /// The forecast at `elements` elements.
+  double at(size_t elements) const { return seconds + seconds_per_element * double(elements); }
+};
+
+/// The forecast for a file of `path`'s type (.ply, .obj, .gltf, .glb); zero for any other.
+WriteForecast write_forecast(const std::string& path);
+
+/// What a bake onto the input model is foretold to take, fitting and writing included (its
+/// seconds; no part per element): a part per input triangle, and with `lightmap_size` > 0 a part
+/// per texel of the SIZE × SIZE atlas. Without --bake-gather; a gather keeps its own deadline.
+WriteForecast onto_input_forecast(size_t input_triangles, int lightmap_size);
+
 }  // namespace gilt::radiosity::bake

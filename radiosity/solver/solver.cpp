@@ -734,6 +734,12 @@ struct SolveState {
   bool over_budget(double seconds) const {
     return group.broadcast_value(settings.time_limit > 0.0 && seconds > settings.time_limit);
   }
+  /// The time limit less what is kept back for the export, on the mesh as it stands.
+  double solve_limit() const { return settings.time_limit - seconds_kept_back(settings, mesh.element_count()); }
+  /// Whether `seconds` since the start run past solve_limit().
+  bool over_solve_limit(double seconds) const {
+    return group.broadcast_value(settings.time_limit > 0.0 && seconds > solve_limit());
+  }
   bool may_be_blocked(const rc::Bounds3& reach) const {
     return std::any_of(receivers.occluders.begin(), receivers.occluders.end(),
                        [&](const rc::Bounds3& box) { return reach.overlaps(box); });
@@ -1001,6 +1007,7 @@ struct SolveState {
   /// light; adds the interreflection to sol.vertex_irradiance; writes sol.residual, shots,
   /// patches, ambient and shoot_seconds.
   void shoot_progressive() {
+    const double shoot_start = elapsed();
     Shooting shot;
     start_shooting(shot);
     // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
@@ -1013,7 +1020,7 @@ struct SolveState {
       if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
       if (sol.residual < settings.tolerance) break;
       // A shot takes about as long as the last one: stop before one would end past the budget.
-      if (over_budget(elapsed() + shot.last_shot)) break;
+      if (over_solve_limit(elapsed() + shot.last_shot)) break;
       const double shot_start = elapsed();
       aim(shot, src, best_signed);
       shoot(shot, src);
@@ -1024,7 +1031,7 @@ struct SolveState {
     // they disagree a dim vertex can be left below zero, which no irradiance is: held at zero.
     for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
     keep_ambient(shot);
-    sol.shoot_seconds = elapsed() - sol.mesh_seconds - sol.direct_seconds;
+    sol.shoot_seconds = elapsed() - shoot_start;
   }
 
   /// Copies the hierarchical solve's result into the solution, its interreflection added to
@@ -1071,8 +1078,8 @@ struct SolveState {
       element_direct[e] += (direct_emitted[el[0]] + direct_emitted[el[1]] + direct_emitted[el[2]]) * (1.0f / 3.0f);
     }
     const HierarchicalInput input{mesh, receivers.geometry, receivers.point, receivers.spread, rho, sol.vertex_irradiance, blocking(),
-                                  [this] { return settings.time_limit > 0.0 && elapsed() > settings.time_limit; },
-                                  settings.time_limit > 0.0 ? std::function<double()>([this] { return settings.time_limit - elapsed(); })
+                                  [this] { return settings.time_limit > 0.0 && elapsed() > solve_limit(); },
+                                  settings.time_limit > 0.0 ? std::function<double()>([this] { return solve_limit() - elapsed(); })
                                                             : std::function<double()>(),
                                   element_direct};
     if (std::all_of(sol.vertex_irradiance.begin(), sol.vertex_irradiance.end(),
@@ -1099,6 +1106,7 @@ struct SolveState {
     sol.shadow_rays = rays;
     sol.skipped_pairs = skipped;
     sol.seconds = elapsed();
+    sol.seconds_kept_back = seconds_kept_back(settings, ne);
   }
 };
 
@@ -1111,6 +1119,11 @@ const char* to_string(SolverKind kind) {
     case SolverKind::hierarchical: return "hierarchical";
   }
   return "?";
+}
+
+double seconds_kept_back(const SolverSettings& settings, size_t elements) {
+  if (!(settings.time_limit > 0.0)) return 0.0;
+  return std::max(0.0, settings.after_seconds) + std::max(0.0, settings.after_seconds_per_element) * double(elements);
 }
 
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why) {
@@ -1174,9 +1187,16 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   state.refine_direct();
   state.keep_direct();
   // Pass 2, the interreflection.
-  if (state.hierarchical)
+  if (state.hierarchical) {
     state.gather_hierarchical();
-  else
+    // No level of links fitted in the time (a furnished room's clusters, close together, split
+    // down to millions of links at any tolerance): the brightest patches shoot in what is left, a
+    // coarse reflected solution rather than none.
+    if (settings.time_limit > 0.0 && sol.links == 0 && !state.over_solve_limit(state.elapsed())) {
+      sol.shot_without_links = true;
+      state.shoot_progressive();
+    }
+  } else
     state.shoot_progressive();
   state.finish();
   return sol;

@@ -47,7 +47,12 @@ struct SolverSettings {
   double tolerance = 1e-3;   ///< stop when unshot power < tolerance × emitted power
   double time_limit = 0.0;   ///< seconds for the whole solve, meshing included (0 = no limit); imprinting
                              ///< and remeshing stop after kMeshShare of it, refinement after 30 %, and no shot
-                             ///< starts that would end past it
+                             ///< starts that would end past it less the time kept back (below)
+  /// Under time_limit: seconds of it kept back for what the caller does after the solve (writing
+  /// the export), after_seconds plus after_seconds_per_element per element of the final mesh (see
+  /// seconds_kept_back). The solve stops that much before its limit; without a limit, unused.
+  double after_seconds = 0.0;
+  double after_seconds_per_element = 0.0;
   int visibility_samples = 16;  ///< shadow rays per vertex–patch pair in a penumbra (a quarter in
                                 ///< each quarter of the source); pairs a 4-ray probe finds all open or all blocked take 4
   int reflected_visibility_probe = 1;  ///< probe side (rays = side²) for patches that only reflect light
@@ -92,6 +97,9 @@ struct Solution {
   std::string final_gather_note; ///< hierarchical: how the final gather ran, or why it did not
   double link_tolerance = 0.0;   ///< hierarchical: the tolerance of the links used
   bool linking_stopped = false;  ///< hierarchical: time ran out while linking finer
+  /// hierarchical under a time limit: no level of links fitted, so the reflected light was shot
+  /// by progressive refinement for the time left instead (`shots`, `residual`)
+  bool shot_without_links = false;
   double residual = 0.0;         ///< progressive: unshot power / emitted power at the end;
                                  ///< hierarchical: relative change of the last iteration
   bool tail_added = false;       ///< hierarchical: the iteration's geometric tail was added
@@ -102,6 +110,7 @@ struct Solution {
   /// radiosity times the interreflection factor 1 / (1 − ρ̄). Never part of exported values.
   Rgb ambient{0.0f};
   double seconds = 0.0;
+  double seconds_kept_back = 0.0;  ///< of the time limit, for what follows the solve (see SolverSettings::after_seconds)
   /// Where the time went: meshing, the direct light with adaptive subdivision, and the
   /// interreflection (hierarchical: linking, iterating, the final gather; progressive: shooting).
   double mesh_seconds = 0.0, direct_seconds = 0.0, link_seconds = 0.0, iterate_seconds = 0.0, gather_seconds = 0.0,
@@ -130,6 +139,10 @@ std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, cons
 
 /// The solver `settings` asks for on a mesh of `elements` elements, and why.
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why = nullptr);
+
+/// Seconds of settings.time_limit a solve on a mesh of `elements` elements keeps back for what
+/// follows it: after_seconds + after_seconds_per_element × elements (0 without a time limit).
+double seconds_kept_back(const SolverSettings& settings, size_t elements);
 
 /// Meshes and solves the committed scene.
 Solution solve(const rc::Scene& scene, const SolverSettings& settings);
