@@ -1,6 +1,7 @@
 // solve_within: a radiosity mesh sized to a time budget. What it chooses depends on the
 // machine's speed, so these tests check the model and which solves run, not times.
 
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include "radiosity/solver/budget.h"
@@ -75,9 +76,15 @@ TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
     // The final solve meshes at the request: its mesh is the one build_mesh makes for it. (How
     // near a request the mesher lands depends on the count, as whole edges divide the walls: not
     // this test's concern, and the request itself depends on this machine's speed.)
+    // Unless the final solve's meshing ran out of its share of the time (a slow build, under the
+    // sanitizers): then it says so, and keeps pieces as they came.
+    const bool cut_short = std::any_of(sol.mesh_report.warnings.begin(), sol.mesh_report.warnings.end(),
+                                       [](const std::string& w) { return w.find("--time left no time") != std::string::npos; });
     rad::solver::SolverSettings asked = quiet();
     asked.mesh.elements = fit.requested_elements;
-    EXPECT_EQ(sol.mesh.element_count(), rad::mesh::build_mesh(scene, asked.mesh).element_count());
+    if (!cut_short) {
+      EXPECT_EQ(sol.mesh.element_count(), rad::mesh::build_mesh(scene, asked.mesh).element_count());
+    }
   }
 }
 
