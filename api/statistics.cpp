@@ -89,6 +89,7 @@ nlohmann::json solution_statistics(const radiosity::solver::Solution& sol, const
           {"link_tolerance", sol.link_tolerance},
           {"linking_stopped_by_time", sol.linking_stopped},
           {"shots", sol.shots},
+          {"element_direct_samples", sol.element_direct_samples},
           {"residual", sol.residual},
           {"tail_added", sol.tail_added},
           {"chebyshev_beta", sol.chebyshev_beta},

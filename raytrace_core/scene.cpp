@@ -560,11 +560,18 @@ bool nearest_triangle_callback(RTCPointQueryFunctionArguments* args) {
 std::optional<Hit> Scene::nearest_triangle(uint32_t geom_id, const Vec3& p, float radius, const Vec3& n,
                                            float min_cosine) const {
   if (geom_id >= meshes.size() || !(radius > 0.0f)) return std::nullopt;
-  NearestQuery q{&meshes[geom_id], geom_id, p, n, min_cosine, Hit{}, sqr(radius)};
-  q.best.prim_id = ~0u;
-  point_query(impl_->scene, p, radius, nearest_triangle_callback, &q);
-  if (q.best.prim_id == ~0u) return std::nullopt;
-  return q.best;
+  // Searched in balls growing eightfold up to `radius`: most callers ask about points on or next
+  // to a face (an element's vertex snapped back onto the face it was meshed from), which the
+  // smallest ball settles after a handful of triangles, where one search of the whole radius
+  // meets every triangle whose box reaches into it before the first hit shrinks it. The nearest
+  // face inside a ball is the nearest inside `radius`, ties included, so the answer is the same.
+  for (float reach = radius * (1.0f / 64.0f);; reach = std::min(radius, reach * 8.0f)) {
+    NearestQuery q{&meshes[geom_id], geom_id, p, n, min_cosine, Hit{}, sqr(reach)};
+    q.best.prim_id = ~0u;
+    point_query(impl_->scene, p, reach, nearest_triangle_callback, &q);
+    if (q.best.prim_id != ~0u) return q.best;
+    if (reach >= radius) return std::nullopt;
+  }
 }
 
 namespace {

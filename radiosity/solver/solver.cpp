@@ -22,6 +22,7 @@
 
 #include "radiosity/mesh/element_albedo.h"
 #include "radiosity/mesh/element_scene.h"
+#include "radiosity/solver/element_direct.h"
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/probe_fraction.h"
 #include "raytrace_core/bsdf.h"
@@ -52,9 +53,6 @@ constexpr float kPi = rc::kPi;
 
 constexpr auto surface_point = mesh_surface_point;
 
-/// How many of five probes (along the normal and four directions 60° from it, each `reach`
-/// long) from a candidate receiver hit the back of a surface: a receiver that sees a back so
-/// close lies behind part of the mesh around it.
 /// The elements around each vertex: vertex v's are fan[offsets[v] .. offsets[v + 1]), in
 /// element order.
 std::pair<std::vector<uint32_t>, std::vector<uint32_t>> element_fans(const RadiosityMesh& mesh) {
@@ -69,7 +67,12 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> element_fans(const Radio
   return {std::move(offsets), std::move(fan)};
 }
 
-int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach) {
+/// How many of five probes (along the normal and four directions 60° from it, each `reach`
+/// long) from a candidate receiver hit the back of a surface: a receiver that sees a back so
+/// close lies behind part of the mesh around it.
+/// Probing stops once `enough` backs are seen (the callers only compare the count with the
+/// fewest so far, or with zero).
+int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach, int enough) {
   const rc::SurfacePoint at = surface_point(p, n);
   const rc::Frame frame = rc::Frame::from_normal(n);
   static const std::array<Vec3, 5> dirs = {Vec3(0.0f, 0.0f, 1.0f), Vec3(0.8660254f, 0.0f, 0.5f),
@@ -77,6 +80,7 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
                                            Vec3(0.0f, -0.8660254f, 0.5f)};
   int backs = 0;
   for (const Vec3& d : dirs) {
+    if (backs >= enough) break;
     rc::Ray ray = rc::spawn_ray(at, frame.to_world(d));
     ray.tmax = reach;
     const std::optional<rc::Hit> hit = scene.intersect(ray);
@@ -109,7 +113,7 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
       const Vec3 p = mesh.positions[v], n = mesh.normals[v];
       int fewest = std::numeric_limits<int>::max();
       const auto consider = [&](const Vec3& candidate, float reach) {
-        const int backs = backs_seen(geometry, candidate, n, reach);
+        const int backs = backs_seen(geometry, candidate, n, reach, fewest);
         if (backs < fewest) fewest = backs, origin[v] = candidate;
       };
       for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
@@ -158,7 +162,7 @@ std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, cons
         if (!(size > 0.0f)) continue;
         const Vec3 n = mesh.element_normal[e];
         const Vec3 q = p + towards * (radius / size) + (1e-3f * size) * n;
-        if (backs_seen(geometry, q, n, 2.0f * size) == 0) out[kVisibilityOrigins * v + taken++] = surface_point(q, n);
+        if (backs_seen(geometry, q, n, 2.0f * size, 1) == 0) out[kVisibilityOrigins * v + taken++] = surface_point(q, n);
       }
       if (taken == 0) out[kVisibilityOrigins * v + taken++] = surface_point(receivers[v], mesh.normals[v]);
       for (size_t k = taken; k < kVisibilityOrigins; ++k) out[kVisibilityOrigins * v + k] = out[kVisibilityOrigins * v + k % taken];
@@ -336,81 +340,6 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const
   ++rays;
   if (geometry.occluded(ls.shadow_ray)) return Rgb(0.0f);
   return ls.radiance * cos_theta;
-}
-
-/// The mean over each element of the irradiance from the scene's punctual and environment
-/// lights: `samples` stratified points on the element, one light sample each (a cosine-weighted
-/// direction for the sky). This, not the mean of the element's vertices, is what the element
-/// reflects into the rest of the scene: a vertex reads the light at one corner, and where a
-/// shadow edge crosses an element the mean of three corners may be anything from none to all of
-/// it. On Šibenik's nave, whose elements are the input's, the vertex mean made the sunlight's
-/// first bounce 1.45 times too bright.
-///
-/// An element larger than the mean takes at least `samples` × its area / the mean area points (a
-/// grid of up to 8² times as many): the noise of the light the elements reflect in all is
-/// Σ A² σ² / n over them, least for a given number of rays when n grows with A. On an interior
-/// such as Šibenik's, whose floor is a few large triangles, the sun patches and the sky through
-/// the windows fall on a few dozen large elements, and their first bounce lights everything:
-/// with 16 points on every element, the two-pass render's mean moved as a whole with the seed
-/// (a standard deviation of 2.2 % over six seeds, 0.6 % now; bench/README.md, "Direct light on
-/// large elements: the seed's spread").
-std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry,
-                                             const RadiosityMesh& mesh, int samples, uint64_t seed,
-                                             uint64_t& rays) {
-  const size_t ne = mesh.element_count();
-  std::vector<Rgb> out(ne, Rgb(0.0f));
-  if (scene.punctual_lights.empty()) return out;
-  const int base_side = std::max(1, int(std::lround(std::sqrt(double(std::max(1, samples))))));
-  double mean_area = 0.0;
-  for (size_t e = 0; e < ne; ++e) mean_area += double(mesh.element_area[e]);
-  mean_area = mean_area / double(ne);
-  std::atomic<uint64_t> traced{0};
-  rc::parallel_for_owned((ne + 255) / 256, [&](size_t chunk) {
-    uint64_t count = 0;
-    std::vector<int> pairing;
-    for (size_t e = chunk * 256; e < std::min(ne, chunk * 256 + 256); ++e) {
-      const double relative_area = mean_area > 0.0 ? double(mesh.element_area[e]) / mean_area : 1.0;
-      const int side = base_side * std::clamp(int(std::ceil(std::sqrt(relative_area))), 1, 8);
-      pairing.resize(size_t(side * side));
-      const auto& el = mesh.elements[e];
-      const Vec3 n = mesh.element_normal[e];
-      const rc::Frame frame = rc::Frame::from_normal(n);
-      Rgb sum(0.0f);
-      for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
-        const rc::Light& light = scene.punctual_lights[li];
-        rc::Rng rng = rc::Rng::for_item(seed, e, 0xb000000000ull + li);
-        // Points stratified over the element and directions (sky) over the hemisphere, their
-        // strata paired at random.
-        std::iota(pairing.begin(), pairing.end(), 0);
-        for (size_t k = pairing.size(); k > 1; --k)
-          std::swap(pairing[k - 1], pairing[std::min(k - 1, size_t(rng.uniform() * float(k)))]);
-        for (int i = 0; i < side; ++i)
-          for (int j = 0; j < side; ++j) {
-            const rc::Vec2 b = rc::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
-            const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] +
-                           b.y * mesh.positions[el[2]];
-            const rc::SurfacePoint at = mesh_surface_point(q, n);
-            ++count;
-            if (light.kind == rc::LightKind::environment) {
-              const int k = pairing[size_t(i * side + j)];
-              const rc::Vec2 u((k / side + rng.uniform()) / side, (k % side + rng.uniform()) / side);
-              const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(u));
-              if (!geometry.occluded(rc::spawn_shadow_ray_to_infinity(at, w))) sum += rc::environment_radiance(light, w) * kPi;
-              continue;
-            }
-            const rc::LightSample ls = rc::sample_light(scene, light, at, rng.uniform2());
-            const float cos_theta = glm::dot(ls.wi, n);
-            if (!(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
-            if (!geometry.occluded(ls.shadow_ray)) sum += ls.radiance * cos_theta;
-          }
-      }
-      out[e] = sum * (1.0f / float(side * side));
-    }
-    traced += count;
-  });
-  rc::join_ranges(std::span(out), 256);
-  rays += rc::processes().total(traced);
-  return out;
 }
 
 /// A patch about to shoot: its elements, each with its own form-factor geometry and the
@@ -644,6 +573,9 @@ constexpr size_t kFactorCacheBytes = size_t(512) << 20;
 /// Share of a time budget that adaptive subdivision may use before it stops refining.
 constexpr double kRefinementShare = 0.3;
 
+/// Share of the time left to the solve that the elements' direct light may take under a budget.
+constexpr double kElementDirectShare = 0.25;
+
 /// Luminance-like scalar of a colour, for refinement decisions.
 float level(const Rgb& c) { return c.average(); }
 
@@ -715,6 +647,7 @@ struct SolveState {
   std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
   std::vector<Rgb> direct_delta;  // the part of direct_punctual from point, spot and directional lights
   size_t nv = 0, ne = 0;  // of the final mesh
+  double direct_rays_per_second = 0.0;  // the last gather_direct's shadow rays per second (0: none)
 
   double elapsed() const { return seconds_since(start); }
   auto albedo(uint32_t material) const { return rc::diffuse_reflectance(scene.materials[material]); }
@@ -794,6 +727,7 @@ struct SolveState {
     direct_emitted.resize(nv_now, Rgb(0.0f));
     const size_t count = nv_now - first_vertex;
     const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
+    const double seconds_before = elapsed();
     rc::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
       Counts counts;
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv_now, first_vertex + chunk * 128 + 128); ++v) {
@@ -815,6 +749,8 @@ struct SolveState {
     });
     for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::join_ranges(std::span(*values), 128, first_vertex);
     joined_counts(rays_before, form_factors_before, skipped_before);
+    const double seconds = elapsed() - seconds_before;
+    if (rays > rays_before && seconds > 0.0) direct_rays_per_second = double(rays - rays_before) / seconds;
     if (hierarchical) emitted_by_tree(first_vertex);
   }
 
@@ -1062,6 +998,26 @@ struct SolveState {
     form_factors += h.form_factors;
   }
 
+  /// Samples per element and light of the elements' direct light: settings.visibility_samples,
+  /// or under a time limit as many as fit in kElementDirectShare of the time left to the solve at
+  /// the rate the vertices' direct light was traced (a 1.0M-element room takes 16 × 2 lights ×
+  /// 1.0M rays otherwise, 7 s, before linking can start). Writes sol.element_direct_samples.
+  int element_direct_samples() {
+    int samples = settings.visibility_samples;
+    if (settings.time_limit > 0.0 && direct_rays_per_second > 0.0) {
+      const double seconds = kElementDirectShare * std::max(0.0, solve_limit() - elapsed());
+      // Rank 0's choice, so that every process traces its elements alike.
+      samples = group.broadcast_value(
+          element_samples_within(mesh, scene.punctual_lights.size(), samples, direct_rays_per_second, seconds));
+      if (samples < settings.visibility_samples)
+        sol.mesh_report.warnings.push_back("the direct light on elements took " + std::to_string(samples) +
+                                           " sample(s) per element and light, not " +
+                                           std::to_string(settings.visibility_samples) + ": --time left no more");
+    }
+    sol.element_direct_samples = samples;
+    return samples;
+  }
+
   /// Pass 2, hierarchical: the interreflection above the direct light, gathered at every vertex
   /// (solve_hierarchical). Reads the direct light; writes sol.element_direct and what
   /// keep_hierarchical keeps.
@@ -1071,7 +1027,7 @@ struct SolveState {
     // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
     uint64_t element_rays = 0;
     std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh,
-                                                                  settings.visibility_samples, settings.seed, element_rays);
+                                                                  element_direct_samples(), settings.seed, element_rays);
     rays += element_rays;
     for (size_t e = 0; e < ne; ++e) {
       const auto& el = mesh.elements[e];

@@ -100,6 +100,7 @@ struct Solution {
   /// hierarchical under a time limit: no level of links fitted, so the reflected light was shot
   /// by progressive refinement for the time left instead (`shots`, `residual`)
   bool shot_without_links = false;
+  int element_direct_samples = 0;  ///< hierarchical: samples per element and light of the elements' direct light
   double residual = 0.0;         ///< progressive: unshot power / emitted power at the end;
                                  ///< hierarchical: relative change of the last iteration
   bool tail_added = false;       ///< hierarchical: the iteration's geometric tail was added

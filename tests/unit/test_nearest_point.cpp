@@ -47,7 +47,8 @@ TEST(NearestPoint, ClosestPointOnTriangleMatchesAGrid) {
 
 // Scene::nearest_triangle against a scan of every triangle of the mesh, with the same radius and
 // facing test; the two must agree on the distance (to float rounding) and, but for exact ties,
-// on the triangle.
+// on the triangle. Half the queries lie next to a face, where the query's first, smallest ball
+// settles them; the rest anywhere, where it grows to the whole radius.
 TEST(NearestPoint, SceneQueryMatchesALinearScan) {
   rc::Scene scene;
   scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
@@ -66,9 +67,17 @@ TEST(NearestPoint, SceneQueryMatchesALinearScan) {
   const rc::TriangleMesh& m = scene.meshes[0];
   int found = 0;
   for (int i = 0; i < 3000; ++i) {
-    const Vec3 p(rng.uniform() * 12 - 6, rng.uniform() * 12 - 6, rng.uniform() * 12 - 6);
+    Vec3 p(rng.uniform() * 12 - 6, rng.uniform() * 12 - 6, rng.uniform() * 12 - 6);
     const Vec3 n = rc::sample_uniform_sphere(rng.uniform2());
     const float radius = 0.2f + 2.0f * rng.uniform();
+    if (i % 2 == 1) {
+      // Every other query next to a face (nearer than radius / 64, the query's first ball), as an
+      // element's vertex is to the face it was meshed from.
+      const size_t t = size_t(rng.uniform() * float(m.triangle_count())) % m.triangle_count();
+      const Vec2 uv = rc::sample_uniform_triangle(rng.uniform2());
+      p = at(m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]], uv) +
+          rc::sample_uniform_sphere(rng.uniform2()) * (radius * 0.01f * rng.uniform());
+    }
     const float min_cosine = i % 3 == 0 ? -2.0f : 0.5f;  // every third query accepts any facing
     float best = radius;
     int best_t = -1;
