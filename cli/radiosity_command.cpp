@@ -132,6 +132,8 @@ void plan_radiosity_budget(const rc::Scene& scene, RadiosityOptions& o, Radiosit
   o.solver.progress = !o.quiet && !o.json;
   radiosity::bake::BakeGather& gather = run.gather;
   gather = radiosity::bake::BakeGather{o.bake_gather, o.solver.seed};
+  gather.progress = o.solver.progress;
+  run.ex.progress = o.solver.progress;
   const auto start = run.start;
   // --time covers the whole command: loading has used some of it. A final gather of the bake
   // takes what the solve leaves of kBakeGatherShare of it; points it cannot reach in time read

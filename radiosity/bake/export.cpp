@@ -490,7 +490,8 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
 
 }  // namespace
 
-RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats) {
+RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats,
+                               rc::Progress* progress) {
   RadiosityMesh out = mesh;
   if (mesh.element_surface.size() != mesh.element_count() || mesh.element_normal.size() != mesh.element_count() ||
       mesh.normals.size() != mesh.vertex_count()) {
@@ -513,6 +514,7 @@ RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh
   }
   std::vector<float> moved(mesh.vertex_count(), -1.0f);
   rc::parallel_for(mesh.vertex_count(), [&](size_t v) {
+    if (progress) progress->advance(1);
     std::optional<rc::Hit> best;
     for (uint8_t k = 0; k < count[v]; ++k) {
       const std::optional<rc::Hit> h =
@@ -675,8 +677,9 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
   require_folder(destination);
   // Vertices on the input's own surface: remeshing, contact imprints and repairs leave some a
   // little off it, and a viewer shows the model, not gilt's approximation of it.
+  rc::Progress snapping("export: snapping onto the input", solution.mesh.vertex_count(), "vertices", settings.progress);
   const RadiosityMesh mesh =
-      without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap), snap);
+      without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap, &snapping), snap);
   check_mesh(mesh, scene.materials.size());
   const std::vector<Rgb> colours = vertex_colours(solution, settings.quantity);
   const auto groups = elements_by_material(mesh, scene.materials.size());

@@ -26,6 +26,7 @@ struct ExportSettings {
   bool linear_float = false;
   /// Display colours (PLY and OBJ by default, glTF COLOR_0) show the quantity × 2^exposure.
   float exposure = 0.0f;
+  bool progress = false;  ///< report snapping the vertices onto the input on stderr (rc::Progress)
 };
 
 /// Linear value to a display value: scaled, clamped to [0, 1], sRGB-encoded (IEC 61966-2-1).
@@ -62,9 +63,9 @@ struct SnapStats {
 /// meshed from, on triangles facing within 60° of the vertex normal and within `reach`; vertices
 /// with none keep their place, and so do the vertices of an element the moves would turn over
 /// (and every vertex of a mesh without element_surface and element_normal for each element).
-/// write_solution exports this.
+/// write_solution exports this. Advances `progress` (if any) by one per vertex.
 mesh::RadiosityMesh snapped_to_input(const rc::Scene& scene, const mesh::RadiosityMesh& mesh, float reach,
-                               SnapStats* stats = nullptr);
+                               SnapStats* stats = nullptr, rc::Progress* progress = nullptr);
 
 /// The mesh without elements that repeat an earlier element: the same three corner positions (to
 /// the bit, after snapping) in the same turning order, so the same face facing the same way, which

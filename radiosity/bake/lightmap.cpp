@@ -22,6 +22,7 @@
 #include "raytrace_core/error.h"
 #include "raytrace_core/io/loaders.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/progress.h"
 
 namespace gilt::radiosity::bake {
 
@@ -613,11 +614,14 @@ std::vector<TexelOwner> rasterise_owners(const LightmapLayout& layout, const Lig
 
 /// Reads the owners and out.corner_uv; writes out.image: each owned texel the mean of the solution
 /// at four points of its footprint, clamped onto its face. Returns which texels were filled.
+/// `report`: show the rows filled on stderr.
 std::vector<char> fill_texels(const rc::Scene& scene, const SolutionAtInput& at_input,
-                              const std::vector<TexelOwner>& owner, Lightmap& out) {
+                              const std::vector<TexelOwner>& owner, Lightmap& out, bool report) {
   const int size = out.size;
   std::vector<char> filled(owner.size(), 0);
+  rc::Progress progress("bake: lightmap", size_t(size), "rows", report);
   rc::parallel_for(size_t(size), [&](size_t y) {
+    progress.advance(1);
     for (size_t x = 0; x < size_t(size); ++x) {
       const TexelOwner& o = owner[y * size_t(size) + x];
       if (o.mesh == UINT32_MAX) continue;
@@ -692,7 +696,7 @@ Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantit
   const SolutionAtInput at_input(scene, solution, quantity, gather);
   out.image.width = out.image.height = size;
   out.image.pixels.assign(owner.size(), Rgb(0.0f));
-  std::vector<char> filled = fill_texels(scene, at_input, owner, out);
+  std::vector<char> filled = fill_texels(scene, at_input, owner, out, gather.progress);
   for (char f : filled) out.stats.texels += size_t(f);
   pad_border(filled, out);
   out.stats.gather = at_input.gather_count();

@@ -11,6 +11,7 @@
 #include "radiosity/bake/view.h"
 #include "raytrace_core/bsdf.h"
 #include "raytrace_core/parallel.h"
+#include "raytrace_core/progress.h"
 #include "raytrace_core/sampling.h"
 #include "raytrace_core/light.h"
 #include "raytrace_core/error.h"
@@ -131,7 +132,9 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
         if (buried[face]) return std::nullopt;
         return value(material, p, n);
       };
-      out.per_mesh[m] = fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats);
+      rc::Progress progress("bake: onto " + mesh.name, fit == VertexFit::point ? mesh.positions.size() : mesh.triangle_count(),
+                            fit == VertexFit::point ? "vertices" : "faces", gather.progress);
+      out.per_mesh[m] = fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats, &progress);
     }
   } else {  // OBJ, PLY: the file's vertices, shared by the meshes of its materials
     std::vector<Vec3> positions;
@@ -156,7 +159,9 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
       if (buried[face]) return std::nullopt;
       return value(scene.materials[face_material[face]], p, n);
     };
-    out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats);
+    rc::Progress progress("bake: onto the input", fit == VertexFit::point ? positions.size() : indices.size() / 3,
+                          fit == VertexFit::point ? "vertices" : "faces", gather.progress);
+    out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats, &progress);
   }
   out.gather = at_input.gather_count();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -195,7 +200,9 @@ Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, Ba
   const std::vector<float> radius = vertex_disk_radius(mesh);
   const int rays = std::max(gather.rays, 1);
   std::atomic<uint64_t> gathered{0}, late{0};
+  rc::Progress progress("bake: final gather", mesh.vertex_count(), "vertices", gather.progress);
   rc::parallel_for(mesh.vertex_count(), [&](size_t v) {
+    progress.advance(1);
     if (std::chrono::steady_clock::now() >= gather.deadline) {
       ++late;
       return;

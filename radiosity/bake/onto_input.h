@@ -42,6 +42,7 @@ struct BakeGather {
   int rays = 0;       ///< samples per point (one shadow ray and one gather ray each); 0: read the solution
   uint64_t seed = 0;
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  bool progress = false;  ///< report the bake's long loops on stderr (rc::Progress)
 };
 
 /// Points a bake evaluated, by how.

@@ -77,7 +77,7 @@ FaceTerms face_terms(const Vec3& p0, const Vec3& p1, const Vec3& p2, size_t face
 }
 
 std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
-                               const SurfaceField& field, FitStats& stats) {
+                               const SurfaceField& field, FitStats& stats, rc::Progress* progress) {
   // The vertex's normal: its faces' normals weighted by area.
   std::vector<Vec3> normal(positions.size(), Vec3(0.0f));
   std::vector<size_t> face_of(positions.size(), 0);  // the largest face around the vertex
@@ -102,6 +102,7 @@ std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const 
     const std::optional<Rgb> f = field(positions[v], normal[v] / len, face_of[v]);
     if (f) out[v] = *f;
     missing[v] = !f;
+    if (progress) progress->advance(1);
   });
   for (size_t v = 0; v < positions.size(); ++v) {
     stats.samples += glm::length(normal[v]) > 0.0f;
@@ -113,16 +114,18 @@ std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const 
 }  // namespace
 
 std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
-                                    const SurfaceField& field, VertexFit fit, float spacing, FitStats* stats) {
+                                    const SurfaceField& field, VertexFit fit, float spacing, FitStats* stats,
+                                    rc::Progress* progress) {
   FitStats local;
   FitStats& st = stats ? *stats : local;
-  if (fit == VertexFit::point) return point_colours(positions, indices, field, st);
+  if (fit == VertexFit::point) return point_colours(positions, indices, field, st, progress);
 
   const size_t faces = indices.size() / 3;
   std::vector<FaceTerms> terms(faces);
   rc::parallel_for(faces, [&](size_t f) {
     terms[f] = face_terms(positions[indices[3 * f]], positions[indices[3 * f + 1]], positions[indices[3 * f + 2]], f,
                           field, spacing);
+    if (progress) progress->advance(1);
   });
 
   const auto n = Eigen::Index(positions.size());

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "raytrace_core/math.h"
+#include "raytrace_core/progress.h"
 #include "raytrace_core/rgb.h"
 
 namespace gilt::radiosity {
@@ -63,8 +64,9 @@ struct FitStats {
 /// face at the centroids of a regular split into parts whose edges are at most `spacing` (at
 /// least 2, at most kMaxFitSplit per edge). Colours are never negative: the fit's overshoot at a
 /// sharp change is clamped. Vertices no face uses are black.
+/// Advances `progress` (if any) by one per face sampled (per vertex for VertexFit::point).
 std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
                                     const SurfaceField& field, VertexFit fit, float spacing,
-                                    FitStats* stats = nullptr);
+                                    FitStats* stats = nullptr, rc::Progress* progress = nullptr);
 
 }  // namespace gilt::radiosity::bake

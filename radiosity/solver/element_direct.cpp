@@ -42,7 +42,7 @@ int element_grid_scale(float area, double mean_area) {
 
 std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry,
                                              const RadiosityMesh& mesh, int samples, uint64_t seed,
-                                             uint64_t& rays) {
+                                             uint64_t& rays, rc::Progress* progress) {
   const size_t ne = mesh.element_count();
   std::vector<Rgb> out(ne, Rgb(0.0f));
   if (scene.punctual_lights.empty()) return out;
@@ -90,6 +90,7 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
       out[e] = sum * (1.0f / float(side * side));
     }
     traced += count;
+    if (progress) progress->advance(std::min(ne, chunk * 256 + 256) - chunk * 256);
   });
   rc::join_ranges(std::span(out), 256);
   rays += rc::processes().total(traced);

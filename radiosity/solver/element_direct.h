@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
+#include "raytrace_core/progress.h"
 #include "raytrace_core/rgb.h"
 #include "raytrace_core/scene.h"
 
@@ -30,10 +31,10 @@ namespace gilt::radiosity::solver {
 /// the windows fall on a few dozen large elements, and their first bounce lights everything:
 /// with 16 points on every element, the two-pass render's mean moved as a whole with the seed
 /// (a standard deviation of 2.2 % over six seeds, 0.6 % now; bench/README.md, "Direct light on
-/// large elements: the seed's spread").
+/// large elements: the seed's spread"). Advances `progress` (if any) by one per element.
 std::vector<rc::Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry,
                                              const mesh::RadiosityMesh& mesh, int samples, uint64_t seed,
-                                             uint64_t& rays);
+                                             uint64_t& rays, rc::Progress* progress = nullptr);
 
 /// Under a time limit: the most samples per element and light, up to `samples` and a square as
 /// element_punctual_irradiance takes them, whose rays fit in `seconds` at `rays_per_second`; at

@@ -47,6 +47,7 @@
 #include "radiosity/solver/probe_fraction.h"
 #include "raytrace_core/parallel.h"
 #include "raytrace_core/processes.h"
+#include "raytrace_core/progress.h"
 #include "raytrace_core/rng.h"
 #include "raytrace_core/sampling.h"
 #include "raytrace_core/scene.h"
@@ -505,6 +506,12 @@ class Linker {
     return *this;
   }
 
+  /// Reports link()'s chunks of pairs as they finish (null: none).
+  Linker& reporting(rc::Progress* progress) {
+    progress_ = progress;
+    return *this;
+  }
+
   /// How many of the accepted pairs `open` (a coarser level's) this linker would split rather
   /// than accept again: those whose error or pilot no longer passes (see refine).
   size_t splits(std::span<const OpenPair> open) const {
@@ -559,6 +566,7 @@ class Linker {
     const size_t per_chunk = (frontier.size() + 4095) / 4096;
     std::vector<LinkLevel> parts(per_chunk == 0 ? 0 : (frontier.size() + per_chunk - 1) / per_chunk);
     std::atomic<bool> stopped{false};
+    if (progress_) progress_->set_total(parts.size());
     rc::parallel_for(parts.size(), [&](size_t i) {
       // The clock is read as each chunk starts and every 1,024 pairs within it, often enough to
       // stop within milliseconds even where a chunk holds few pairs, and the flag at every pair,
@@ -580,6 +588,7 @@ class Linker {
         }
       }
       keep_mine(parts[i]);
+      if (progress_) progress_->advance(1);
     });
     keep_mine(level);
     if (group.count() > 1) {
@@ -771,6 +780,7 @@ class Linker {
   int rank_ = 0;
   bool keep_open_ = false;
   double keep_back_ = 0.0;
+  rc::Progress* progress_ = nullptr;
 };
 
 /// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
@@ -1397,6 +1407,10 @@ struct HierarchicalSolve {
   /// writes result.residual, result.chebyshev_beta and result.tail_added.
   void iterate(double tolerance) {
     result.tail_added = false;
+    // The count of gathers is not known ahead (the iteration stops at the tolerance): the
+    // progress counts them against the most there may be.
+    rc::Progress progress("radiosity: iterating", uint64_t(std::max(0, settings.max_iterations - result.iterations)),
+                          "gathers", settings.progress);
     while (result.iterations < settings.max_iterations) {
       if (out_of_time()) break;
       // Under a time limit a gather takes about as long as the last: none starts that would end past it.
@@ -1404,6 +1418,7 @@ struct HierarchicalSolve {
       const auto step_start = std::chrono::steady_clock::now();
       const bool chebyshev = iteration_step();
       last_gather_seconds = seconds_since(step_start);
+      progress.advance(1);
       radiosity.swap(next);
       if (beta > 0.0 ? result.residual < tolerance * (1.0 - beta) : result.residual < tolerance) break;
       read_beta(chebyshev);
@@ -1594,10 +1609,14 @@ struct HierarchicalSolve {
     record.open_pairs = count_as_one_process(open_pairs, cut.owner);
     record.splits = plan.splits;
     Linker linker = linker_at(plan.tolerance);
-    linker.owned_by(cut.owner, group.rank()).keeping_open_pairs(!plan.last).keeping_back(plan.reserve);
+    char label[64];
+    std::snprintf(label, sizeof label, "radiosity: linking at tolerance %.3g", plan.tolerance);
+    rc::Progress progress(label, 0, "chunks of pairs", settings.progress);
+    linker.owned_by(cut.owner, group.rank()).keeping_open_pairs(!plan.last).keeping_back(plan.reserve).reporting(&progress);
     const auto link_start = std::chrono::steady_clock::now();
     std::optional<LinkLevel> made = linker.link(plan.expanded ? std::span<const OpenPair>(plan.start)
                                                                : std::span<const OpenPair>(open_pairs));
+    progress.finish();
     if (!made) {
       result.link_seconds += seconds_since(link_start);
       result.linking_stopped = true;
@@ -1678,7 +1697,8 @@ struct HierarchicalSolve {
   /// Gathers at the listed vertices in parallel, each process at the chunks of 64 it owns, into
   /// gathered_at; adds to the counters. False when time ran out first on any process, or when
   /// fewer than `keep_back` seconds were left (0: none kept back).
-  bool gather_at(const TreeWalk& walker, const std::vector<uint32_t>& list, double keep_back = 0.0) {
+  bool gather_at(const TreeWalk& walker, const std::vector<uint32_t>& list, double keep_back = 0.0,
+                 rc::Progress* progress = nullptr) {
     std::atomic<bool> stopped{false};
     const uint64_t rays_before = counters.rays, nodes_before = counters.gather_nodes,
                    form_factors_before = counters.form_factors;
@@ -1700,6 +1720,7 @@ struct HierarchicalSolve {
       counters.rays += walk.rays;
       counters.gather_nodes += walk.nodes;
       counters.form_factors += walk.form_factors;
+      if (progress) progress->advance(std::min(list.size(), chunk * 64 + 64) - chunk * 64);
     });
     if (group.count() == 1) return !stopped;
     std::vector<Rgb> values(list.size());
@@ -1764,7 +1785,8 @@ struct HierarchicalSolve {
       result.final_gather_note = note;
       complete = false;
     } else if (complete) {
-      complete = gather_at(walker, rest);
+      rc::Progress progress("radiosity: final gather", rest.size(), "vertices", settings.progress);
+      complete = gather_at(walker, rest, 0.0, &progress);
       result.final_gather = complete;
       result.final_gather_note = complete ? "at every vertex" : "stopped by --time";
     } else {

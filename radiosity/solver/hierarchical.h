@@ -48,6 +48,7 @@ struct HierarchicalSettings {
   /// vertex takes the area-weighted mean of its elements' gathered irradiance.
   FinalGather final_gather = FinalGather::automatic;
   uint64_t seed = 0;
+  bool progress = false;  ///< report linking, iterating and the final gather on stderr (rc::Progress)
 };
 
 /// How many points each vertex's visibility rays start from (see visibility_origins in solver.h).

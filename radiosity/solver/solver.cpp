@@ -104,7 +104,7 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
 /// (backs_seen, reaching twice the element's size) meet no back is taken, or else the one that
 /// meets fewest. (Traced against the input instead of the elements, the milk truck's rounded
 /// roof edge came out as a ragged black band.)
-std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh) {
+std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh, rc::Progress* progress) {
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<Vec3> origin(mesh.positions);
@@ -132,13 +132,14 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
         if (fewest > 0) consider(p + 1e-3f * size * mesh.element_normal[fan[i]], 2.0f * size);
       }
     }
+    if (progress) progress->advance(std::min(nv, chunk * 256 + 256) - chunk * 256);
   });
   rc::join_ranges(std::span(origin), 256);
   return origin;
 }
 
 std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, const RadiosityMesh& mesh,
-                                                 std::span<const Vec3> receivers) {
+                                                 std::span<const Vec3> receivers, rc::Progress* progress) {
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<rc::SurfacePoint> out(kVisibilityOrigins * nv);
@@ -167,6 +168,7 @@ std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, cons
       if (taken == 0) out[kVisibilityOrigins * v + taken++] = surface_point(receivers[v], mesh.normals[v]);
       for (size_t k = taken; k < kVisibilityOrigins; ++k) out[kVisibilityOrigins * v + k] = out[kVisibilityOrigins * v + k % taken];
     }
+    if (progress) progress->advance(std::min(nv, chunk * 256 + 256) - chunk * 256);
   });
   rc::join_ranges(std::span(out), 256 * kVisibilityOrigins);
   return out;
@@ -417,15 +419,19 @@ struct Receivers {
   std::vector<rc::SurfacePoint> spread;     ///< kVisibilityOrigins per vertex, where its shadow rays start
   std::vector<rc::Bounds3> occluders;
 
-  Receivers(const rc::Scene& s, const RadiosityMesh& m) : scene(s), mesh(m), occluders(occluder_boxes(s, m)) {
+  bool progress = false;                    ///< report placing the receivers on stderr
+
+  Receivers(const rc::Scene& s, const RadiosityMesh& m, bool report)
+      : scene(s), mesh(m), occluders(occluder_boxes(s, m)), progress(report) {
     update();
   }
   void update() {
     geometry = element_scene(scene, mesh);
-    origin = receiver_points(geometry, mesh);
+    rc::Progress placing("radiosity: placing receivers", 2 * mesh.vertex_count(), "vertices", progress);
+    origin = receiver_points(geometry, mesh, &placing);
     point.resize(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) point[v] = surface_point(origin[v], mesh.normals[v]);
-    spread = visibility_origins(geometry, mesh, origin);
+    spread = visibility_origins(geometry, mesh, origin, &placing);
   }
   /// Vertex v's visibility origins.
   std::span<const rc::SurfacePoint> origins(size_t v) const {
@@ -619,7 +625,7 @@ struct Shooting {
 /// The state of one solve (below), on the mesh it made, which its passes read and write in turn.
 struct SolveState {
   SolveState(const rc::Scene& s, const SolverSettings& st, Solution& so, std::chrono::steady_clock::time_point t)
-      : scene(s), settings(st), sol(so), start(t), mesh(so.mesh), receivers(s, so.mesh),
+      : scene(s), settings(st), sol(so), start(t), mesh(so.mesh), receivers(s, so.mesh, st.progress),
         strata(std::max(1, int(std::round(std::sqrt(double(st.visibility_samples)))))) {
     sol.convex_enclosure = receivers.occluders.empty();
     // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
@@ -628,6 +634,7 @@ struct SolveState {
     hs = settings.hierarchical;
     hs.tolerance = settings.tolerance;
     hs.seed = settings.seed;
+    hs.progress = settings.progress;
   }
 
   const rc::Scene& scene;
@@ -728,6 +735,7 @@ struct SolveState {
     const size_t count = nv_now - first_vertex;
     const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
     const double seconds_before = elapsed();
+    rc::Progress progress("radiosity: direct light", count, "vertices", settings.progress);
     rc::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
       Counts counts;
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv_now, first_vertex + chunk * 128 + 128); ++v) {
@@ -746,6 +754,7 @@ struct SolveState {
         }
       }
       add_counts(counts);
+      progress.advance(std::min(nv_now, first_vertex + chunk * 128 + 128) - (first_vertex + chunk * 128));
     });
     for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::join_ranges(std::span(*values), 128, first_vertex);
     joined_counts(rays_before, form_factors_before, skipped_before);
@@ -1026,8 +1035,10 @@ struct SolveState {
     // What each element reflects of the direct light: its own mean of the lights' irradiance,
     // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
     uint64_t element_rays = 0;
-    std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh,
-                                                                  element_direct_samples(), settings.seed, element_rays);
+    rc::Progress progress("radiosity: direct light on elements", ne, "elements", settings.progress);
+    std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh, element_direct_samples(),
+                                                                  settings.seed, element_rays, &progress);
+    progress.finish();
     rays += element_rays;
     for (size_t e = 0; e < ne; ++e) {
       const auto& el = mesh.elements[e];

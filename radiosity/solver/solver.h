@@ -14,6 +14,7 @@
 
 #include "radiosity/solver/hierarchical.h"
 #include "radiosity/mesh/mesh.h"
+#include "raytrace_core/progress.h"
 #include "raytrace_core/rgb.h"
 
 namespace gilt::radiosity::solver {
@@ -125,8 +126,9 @@ struct Solution {
 
 /// Where each vertex of the mesh receives light: just inside one of its elements and in front of
 /// the mesh's other elements (see solver.cpp). `geometry` is element_scene() of the mesh, whose
-/// rays place the points.
-std::vector<Vec3> receiver_points(const rc::Scene& geometry, const mesh::RadiosityMesh& mesh);
+/// rays place the points. Advances `progress` (if any) by one per vertex.
+std::vector<Vec3> receiver_points(const rc::Scene& geometry, const mesh::RadiosityMesh& mesh,
+                                  rc::Progress* progress = nullptr);
 
 /// Where each vertex's visibility rays start: kVisibilityOrigins points per vertex (vertex v's at
 /// [v · kVisibilityOrigins, (v + 1) · kVisibilityOrigins)), towards the centroids of elements
@@ -134,9 +136,10 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const mesh::Radiosi
 /// front of the mesh around them (the receiver point of receiver_points stands in where none is). A vertex colour
 /// stands for the surface around the vertex, and a ray from the vertex alone decides on a line:
 /// on Šibenik, vertices where a moulding meets a wall saw every light through the wall's edge
-/// and came out black while the surface on either side was lit.
+/// and came out black while the surface on either side was lit. Advances `progress` (if any)
+/// by one per vertex.
 std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, const mesh::RadiosityMesh& mesh,
-                                                 std::span<const Vec3> receivers);
+                                                 std::span<const Vec3> receivers, rc::Progress* progress = nullptr);
 
 /// The solver `settings` asks for on a mesh of `elements` elements, and why.
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why = nullptr);
