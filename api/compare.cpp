@@ -350,7 +350,8 @@ Report compare_methods(rc::Scene& scene, const CompareSettings& given,
   rc::RenderSettings settings;
   settings.width = o.width, settings.height = o.height, settings.seed = o.seed, settings.threads = o.threads;
   settings.sampler = rc::parse_sampler(o.sampler);
-  settings.progress = false;
+  // Each method's run reports its own stages (the budgets run minutes in all).
+  settings.progress = o.progress;
   for (double budget : o.budgets) {
     for (const std::string& m : o.methods) {
       settings.time_limit = budget;
@@ -360,7 +361,7 @@ Report compare_methods(rc::Scene& scene, const CompareSettings& given,
       const double share = std::min(1.0, budget / 8.0);
       mo.photon.photons.global_photons = mo.photon.photons.caustic_photons =
           std::max<uint64_t>(20000, uint64_t(200000 * share));
-      mo.solver.progress = false;
+      mo.solver.progress = o.progress;
       const MethodResult result = run_method(scene, camera, m, settings, mo);
       const std::vector<rc::Rgb> pixels = result.film.pixels();
       ReportEntry e;
