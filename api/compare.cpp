@@ -14,11 +14,11 @@
 
 #include "api/methods.h"
 #include "photonmap/photon_map.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/io/staged_file.h"
-#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/util/staged_file.h"
+#include "raytrace_core/render/path_tracer.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "api/report.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::api {
 

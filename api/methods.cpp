@@ -6,10 +6,10 @@
 
 #include "radiosity/solver/budget.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/whitted.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/whitted.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;

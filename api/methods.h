@@ -12,9 +12,9 @@
 #include "photonmap/sppm.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/camera.h"
-#include "raytrace_core/film.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/scene/camera.h"
+#include "raytrace_core/render/film.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::api {
 

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::api {
 namespace {

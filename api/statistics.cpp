@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;

@@ -8,8 +8,8 @@
 
 #include "api/methods.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::api {
 

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

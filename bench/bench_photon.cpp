@@ -27,11 +27,11 @@
 
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

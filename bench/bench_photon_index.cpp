@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "photonmap/photon_index.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

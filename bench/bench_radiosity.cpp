@@ -48,12 +48,12 @@
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/util/rng.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 using rc::Vec3;

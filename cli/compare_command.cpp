@@ -9,7 +9,7 @@
 
 #include "api/compare.h"
 #include "cli/commands.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {

@@ -64,7 +64,7 @@ struct MethodPlan {
 std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
   std::vector<MethodPlan> plans;
   const bool lit = !scene.lights().empty();
-  // How a shadow ray's light is chosen (raytrace_core/light_sampler.h).
+  // How a shadow ray's light is chosen (raytrace_core/scene/light_sampler.h).
   const rc::LightSampler& sampler = scene.light_sampler();
   const std::string choice =
       sampler.node_count() > 1

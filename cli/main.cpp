@@ -12,8 +12,8 @@
 
 #include "cli/commands.h"
 #include "cli/mpi_processes.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace {
 

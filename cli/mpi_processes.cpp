@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/processes.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;

@@ -16,9 +16,9 @@
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {

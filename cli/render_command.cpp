@@ -16,14 +16,14 @@
 #include "api/statistics.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/whitted.h"
+#include "raytrace_core/render/whitted.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;

@@ -3,7 +3,7 @@
 # is replaced by a call to gilt's checked one (raytrace_core/io/gltf_draco.h, which says why).
 # Nothing else changes, so every other file keeps including <tiny_gltf.h> itself; only
 # raytrace_core/io/tinygltf_impl.cpp, which compiles tinygltf's implementation, includes the copy.
-# Run at build time by raytrace_core/CMakeLists.txt:
+# Run at build time by raytrace_core/io/CMakeLists.txt:
 #   cmake -DHEADER=/path/to/tiny_gltf.h -DOUTPUT=/path/to/tiny_gltf_draco.h -P TinyGltfDraco.cmake
 
 if(NOT HEADER OR NOT OUTPUT)

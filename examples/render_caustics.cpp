@@ -8,8 +8,8 @@
 #include <string>
 
 #include "photonmap/photon_mapper.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {

@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <string>
 
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {

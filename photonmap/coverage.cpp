@@ -4,9 +4,9 @@
 #include <atomic>
 #include <cmath>
 
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 
 namespace gilt::photonmap {

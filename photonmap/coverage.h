@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::photonmap {
 

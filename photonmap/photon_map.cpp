@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <chrono>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/rng.h"
 
 namespace gilt::photonmap {
 namespace {

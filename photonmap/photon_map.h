@@ -14,9 +14,9 @@
 #include "photonmap/coverage.h"
 #include "photonmap/photon.h"
 #include "photonmap/photon_index.h"
-#include "raytrace_core/material.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/material.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::photonmap {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <type_traits>
 
-#include "raytrace_core/bsdf.h"
+#include "raytrace_core/scene/bsdf.h"
 
 namespace gilt::photonmap {
 

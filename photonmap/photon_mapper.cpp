@@ -7,13 +7,13 @@
 #include <cmath>
 
 #include "photonmap/coverage.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::photonmap {
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "photonmap/photon_map.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::photonmap {
 

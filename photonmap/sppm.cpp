@@ -12,14 +12,14 @@
 
 #include "photonmap/photon_index.h"
 #include "photonmap/photon_map.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/sobol.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/sobol.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::photonmap {
 namespace {

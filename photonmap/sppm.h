@@ -8,9 +8,9 @@
 #include <cstdint>
 
 #include "photonmap/photon_index.h"
-#include "raytrace_core/camera.h"
-#include "raytrace_core/film.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/scene/camera.h"
+#include "raytrace_core/render/film.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::photonmap {
 

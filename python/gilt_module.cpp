@@ -23,9 +23,9 @@
 #include "api/statistics.h"
 #include "radiosity/solver/budget.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace py = pybind11;
 namespace rc = gilt::raytrace_core;

@@ -19,11 +19,11 @@
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/bsdf.h"
+#include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

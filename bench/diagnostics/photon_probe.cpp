@@ -17,10 +17,10 @@
 #include "photonmap/coverage.h"
 #include "photonmap/photon_map.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

@@ -29,11 +29,11 @@
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/staged_file.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/staged_file.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::bake {
 

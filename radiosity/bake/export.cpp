@@ -3,7 +3,7 @@
 // PLY is written directly (binary little-endian); OBJ + MTL are written as text, since no OBJ writer among
 // gilt's libraries emits `v x y z r g b` vertex colours; glTF and GLB go through tinygltf. Every
 // file is encoded in memory first, then written to a hidden temporary beside its destination,
-// flushed to disk and renamed into place (the scheme of raytrace_core/image_io.cpp): a failure
+// flushed to disk and renamed into place (the scheme of raytrace_core/util/image_io.cpp): a failure
 // leaves the destination as it was and no temporary behind.
 //
 // Materials are written so that gilt's own loaders read them back as the same kind:
@@ -45,9 +45,9 @@
 #include <system_error>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::radiosity::bake {
 

@@ -19,9 +19,9 @@
 #include "raytrace_core/io/gltf_file.h"
 
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace gilt::radiosity::bake {
 

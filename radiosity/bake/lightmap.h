@@ -31,7 +31,7 @@
 #include "radiosity/bake/export.h"
 #include "radiosity/bake/onto_input.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 
 namespace gilt::radiosity::bake {
 

@@ -9,11 +9,11 @@
 
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 
 namespace gilt::radiosity::bake {

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::radiosity::bake {
 

@@ -17,7 +17,7 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
 
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace gilt::radiosity::bake {
 

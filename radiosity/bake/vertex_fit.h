@@ -15,8 +15,8 @@
 #include <span>
 #include <vector>
 
-#include "raytrace_core/math.h"
-#include "raytrace_core/rgb.h"
+#include "raytrace_core/util/math.h"
+#include "raytrace_core/util/rgb.h"
 
 namespace gilt::radiosity {
 namespace rc = gilt::raytrace_core;

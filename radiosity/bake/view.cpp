@@ -12,9 +12,9 @@
 #include <cmath>
 
 #include "radiosity/mesh/element_scene.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::bake {
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::radiosity::bake {
 

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::mesh {
 

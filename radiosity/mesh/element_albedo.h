@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::mesh {
 

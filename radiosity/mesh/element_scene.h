@@ -5,8 +5,8 @@
 // geometry the radiosity world does not have (the Stanford bunny came out in black blotches).
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/ray.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/ray.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::mesh {
 

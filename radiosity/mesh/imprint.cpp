@@ -23,7 +23,7 @@
 #include <CGAL/box_intersection_d.h>
 #include <glm/geometric.hpp>
 
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace gilt::radiosity::mesh::detail {
 namespace {

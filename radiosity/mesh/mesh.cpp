@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh_detail.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::radiosity::mesh {
 namespace detail {

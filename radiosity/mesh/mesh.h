@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 // Every room of radiosity (mesh, solver, bake) builds on the ray core and names its vectors and
 // colours alike.

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/math.h"
+#include "raytrace_core/util/math.h"
 
 namespace gilt::raytrace_core {
 class Progress;

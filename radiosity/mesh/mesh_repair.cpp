@@ -35,8 +35,8 @@
 
 #include "radiosity/mesh/mesh_detail.h"
 #include "radiosity/mesh/imprint.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::radiosity::mesh::detail {
 namespace {

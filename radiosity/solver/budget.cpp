@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/processes.h"
 
 namespace gilt::radiosity::solver {
 

@@ -45,11 +45,11 @@
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/ladder_forecast.h"
 #include "radiosity/solver/probe_fraction.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::solver {
 

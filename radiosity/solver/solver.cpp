@@ -24,14 +24,14 @@
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/probe_fraction.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/progress.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::solver {
 

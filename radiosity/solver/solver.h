@@ -14,7 +14,7 @@
 
 #include "radiosity/solver/hierarchical.h"
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/rgb.h"
+#include "raytrace_core/util/rgb.h"
 
 namespace gilt::radiosity::solver {
 

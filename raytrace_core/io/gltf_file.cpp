@@ -3,7 +3,7 @@
 #include <cctype>
 #include <sstream>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/gltf_draco.h"
 #include "raytrace_core/io/loaders.h"
 

@@ -13,7 +13,7 @@
 //   m = 1, r² ≤ kMinGgxAlpha, untextured     → mirror, reflectance base
 //   m = 0, KHR_materials_specular's specularFactor = 0 → diffuse (F0 = 0: exactly Lambertian)
 //   otherwise                               → metallic_roughness (the specification's appendix B,
-//       raytrace_core/bsdf.cpp), ior from KHR_materials_ior for the dielectric's F0
+//       raytrace_core/scene/bsdf.cpp), ior from KHR_materials_ior for the dielectric's F0
 //   emission = emissiveFactor × KHR_materials_emissive_strength; doubleSided → two-sided emission
 // Photometric light units are read as radiometric: point/spot intensity (cd) as W·sr⁻¹,
 // directional illuminance (lx) as W·m⁻², i.e. no 683 lm/W factor.
@@ -48,9 +48,9 @@
 #include "raytrace_core/io/gltf_file.h"
 #include <glm/gtc/quaternion.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/microfacet.h"
+#include "raytrace_core/scene/microfacet.h"
 
 namespace gilt::raytrace_core {
 

@@ -12,7 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 #include "raytrace_core/io/scene_io.h"
 

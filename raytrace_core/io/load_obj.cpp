@@ -36,7 +36,7 @@
 
 #include <tiny_obj_loader.h>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 
 namespace gilt::raytrace_core {

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 #include "raytrace_core/io/ply_header.h"
 

@@ -8,7 +8,7 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::raytrace_core {
 

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 
 namespace gilt::raytrace_core {
 

@@ -14,9 +14,9 @@
 
 #include <glm/glm.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/sun_sky.h"
+#include "raytrace_core/scene/sun_sky.h"
 
 namespace gilt::raytrace_core {
 

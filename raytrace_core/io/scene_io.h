@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::raytrace_core {
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <string_view>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::fuzz {

@@ -7,7 +7,7 @@
 
 #include <optional>
 
-#include "raytrace_core/bsdf.h"
+#include "raytrace_core/scene/bsdf.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::test {

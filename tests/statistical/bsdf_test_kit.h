@@ -6,8 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "raytrace_core/material.h"
-#include "raytrace_core/math.h"
+#include "raytrace_core/scene/material.h"
+#include "raytrace_core/util/math.h"
 
 namespace gilt::test {
 

@@ -23,8 +23,8 @@
 #include <gtest/gtest.h>
 #include <boost/math/distributions/chi_squared.hpp>
 
-#include "raytrace_core/math.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/math.h"
+#include "raytrace_core/util/rng.h"
 
 namespace gilt::test {
 

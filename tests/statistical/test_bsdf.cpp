@@ -1,4 +1,4 @@
-// Statistical and exact tests of raytrace_core/bsdf.h.
+// Statistical and exact tests of raytrace_core/scene/bsdf.h.
 //
 // Non-delta lobes (diffuse, glossy): the directions bsdf_sample draws must follow bsdf_pdf
 // (chi-square, see chi2.h; α = 0.01 Šidák-corrected over the kChi2Tests tests of this program),
@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 #include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"

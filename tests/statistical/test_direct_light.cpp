@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 using rc::Rgb;

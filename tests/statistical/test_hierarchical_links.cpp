@@ -10,7 +10,7 @@
 
 #include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/rng.h"
 #include "tests/support/mesh_builders.h"
 
 namespace rc = gilt::raytrace_core;

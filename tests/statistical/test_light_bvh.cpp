@@ -1,4 +1,4 @@
-// Tests of the light BVH (raytrace_core/light_sampler.h).
+// Tests of the light BVH (raytrace_core/scene/light_sampler.h).
 //
 // - Exactness: for any query, the probabilities pmf() gives sum to 1 over the lights, and every
 //   light sample() draws carries the probability pmf() gives it, to the bit (MIS depends on it).
@@ -18,10 +18,10 @@
 #include <vector>
 
 #include "radiosity/solver/form_factor.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/light_sampler.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/scene/light_sampler.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::raytrace_core {

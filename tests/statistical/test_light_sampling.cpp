@@ -1,4 +1,4 @@
-// Chi-square tests of light sampling (raytrace_core/light.h): the directions sample_light draws
+// Chi-square tests of light sampling (raytrace_core/scene/light.h): the directions sample_light draws
 // from a reference point must be distributed as light_pdf says, and light_pdf must agree with the
 // pdf the sample reports. Method and significance as in chi2.h: α = 0.01 Šidák-corrected over the
 // kChi2Tests tests of this program, 10⁶ samples from fixed seeds.
@@ -18,10 +18,10 @@
 #include <numbers>
 #include <optional>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::raytrace_core {

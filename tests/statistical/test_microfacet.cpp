@@ -1,5 +1,5 @@
-// Tests of the GGX distribution (raytrace_core/microfacet.h) and of the glTF metallic-roughness
-// BSDF built on it (raytrace_core/bsdf.cpp), plus the thin-walled and tinted dielectric.
+// Tests of the GGX distribution (raytrace_core/scene/microfacet.h) and of the glTF metallic-roughness
+// BSDF built on it (raytrace_core/scene/bsdf.cpp), plus the thin-walled and tinted dielectric.
 //
 //   - D is normalised: ∫ D(h) cos θh dω = 1, by quadrature in cos θ.
 //   - Visible normals: sample_visible follows visible_d (chi-square; visible_d integrating to one
@@ -24,10 +24,10 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/microfacet.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/scene/microfacet.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 #include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"

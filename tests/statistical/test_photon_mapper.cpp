@@ -26,8 +26,8 @@
 
 #include "photonmap/photon_mapper.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

@@ -14,8 +14,8 @@
 
 #include "radiosity/bake/check.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

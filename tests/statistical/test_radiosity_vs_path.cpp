@@ -15,11 +15,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/util/image_error.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

@@ -1,4 +1,4 @@
-// Tests of the rough dielectric (raytrace_core/rough_dielectric.h): GGX reflection and
+// Tests of the rough dielectric (raytrace_core/scene/rough_dielectric.h): GGX reflection and
 // refraction, solid and thin-walled, and next-event estimation through it.
 //
 //   - Sampling: bsdf_sample's directions follow bsdf_pdf over the whole sphere (chi-square, both
@@ -26,12 +26,12 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"

@@ -13,8 +13,8 @@
 
 #include <cmath>
 
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 

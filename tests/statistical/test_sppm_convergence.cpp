@@ -15,10 +15,10 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/util/image_error.h"
 #include "photonmap/sppm.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 

@@ -18,10 +18,10 @@
 #include "photonmap/sppm.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
-#include "raytrace_core/whitted.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
+#include "raytrace_core/render/whitted.h"
 
 namespace gilt::stress {
 

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 #include "tests/stress/bad_files.h"
 
 namespace fs = std::filesystem;

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/stress/bad_files.h"
 #include "tests/stress/stress_support.h"

@@ -23,10 +23,10 @@
 
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {

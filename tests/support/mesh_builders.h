@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::test {
 namespace rc = gilt::raytrace_core;

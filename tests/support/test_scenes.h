@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::test {
 namespace rc = gilt::raytrace_core;

@@ -1,4 +1,4 @@
-// The default view of a scene without a camera (raytrace_core/camera.h, default_camera): every
+// The default view of a scene without a camera (raytrace_core/scene/camera.h, default_camera): every
 // corner of the bounds is in the picture, and the model fills it rather than sitting small in the
 // middle.
 
@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "raytrace_core/camera.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/scene/camera.h"
+#include "raytrace_core/util/rng.h"
 
 namespace gilt::raytrace_core {
 namespace {

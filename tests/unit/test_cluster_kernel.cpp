@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "radiosity/solver/cluster_kernel.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/rng.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 
 #include "tests/support/cli_run.h"
 

@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "radiosity/bake/check.h"
-#include "raytrace_core/closest_point.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/closest_point.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 

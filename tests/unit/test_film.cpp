@@ -1,6 +1,6 @@
 // Film accumulation and reconstruction-filter sampling.
 
-#include "raytrace_core/film.h"
+#include "raytrace_core/render/film.h"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::raytrace_core {
 namespace {

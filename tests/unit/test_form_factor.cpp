@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "radiosity/solver/form_factor.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/rng.h"
 
 namespace {
 

@@ -26,7 +26,7 @@
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/model_files.h"

@@ -20,8 +20,8 @@
 #include <utility>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::raytrace_core {

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/rng.h"
 
 namespace rc = gilt::raytrace_core;
 

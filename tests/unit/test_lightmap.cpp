@@ -22,10 +22,10 @@
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/model_files.h"
 

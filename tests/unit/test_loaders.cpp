@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::raytrace_core {

@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 

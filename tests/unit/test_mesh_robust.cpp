@@ -26,7 +26,7 @@
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/mesh/mesh_detail.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/mesh_builders.h"
 

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <limits>
 
-#include "raytrace_core/closest_point.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/closest_point.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 using rc::Vec2;

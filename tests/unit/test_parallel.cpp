@@ -1,6 +1,6 @@
 // parallel_for visits every index exactly once, whatever the thread cap.
 
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 #include <gtest/gtest.h>
 

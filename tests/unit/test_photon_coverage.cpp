@@ -9,8 +9,8 @@
 
 #include "photonmap/coverage.h"
 #include "photonmap/photon_map.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;

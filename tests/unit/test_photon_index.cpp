@@ -17,8 +17,8 @@
 
 #include "photonmap/photon.h"
 #include "photonmap/photon_index.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
 
 // ---------------------------------------------------------------------------------------------
 // Counting global allocation functions (every replaceable form that allocates).

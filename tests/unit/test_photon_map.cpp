@@ -9,8 +9,8 @@
 #include <numeric>
 
 #include "photonmap/photon_map.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;

@@ -10,7 +10,7 @@
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
 #include "radiosity/mesh/element_scene.h"
-#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/render/path_tracer.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;

@@ -9,9 +9,9 @@
 
 #include <optional>
 
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;

@@ -1,7 +1,7 @@
 // The camera-sample samplers: the Sobol points' stratification, their scrambling's randomness,
 // the independence of dimensions and pixels, and the dimension layout along a path.
 
-#include "raytrace_core/sampler.h"
+#include "raytrace_core/render/sampler.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <set>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::raytrace_core {
 namespace {

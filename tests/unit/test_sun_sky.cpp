@@ -1,4 +1,4 @@
-// The command line's daylight (raytrace_core/sun_sky.h): the sun's direction convention, its
+// The command line's daylight (raytrace_core/scene/sun_sky.h): the sun's direction convention, its
 // disk, and Preetham's sky against the paper's own zenith formula, its horizon and its sun side.
 
 #include <gtest/gtest.h>
@@ -8,13 +8,13 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/scene.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sun_sky.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/scene/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/sun_sky.h"
 
 namespace gilt::raytrace_core {
 namespace {

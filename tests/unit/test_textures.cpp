@@ -18,13 +18,13 @@
 
 #include "radiosity/mesh/element_albedo.h"
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/normal_map.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
-#include "raytrace_core/texture.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/scene/normal_map.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
+#include "raytrace_core/scene/texture.h"
 
 namespace gilt {
 namespace {
