@@ -20,7 +20,7 @@ namespace {
 /// The first Ctrl-C asks the run to stop at its next work item, so no output is half-written;
 /// a second one ends the process at once.
 extern "C" void on_interrupt(int) {
-  gilt::raytrace_core::request_stop();
+  gilt::raytrace_core::util::request_stop();
   std::signal(SIGINT, SIG_DFL);
 }
 

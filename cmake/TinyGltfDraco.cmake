@@ -35,7 +35,7 @@ string(SUBSTRING "${source}" ${end} -1 tail)
 set(replacement [=[
 static bool ParseDracoExtension(Primitive *primitive, Model *model, std::string * /*err*/,
                                 const Value &dracoExtensionValue) {
-  ::gilt::raytrace_core::decode_draco_primitive(*primitive, *model, dracoExtensionValue);
+  ::gilt::raytrace_core::io::decode_draco_primitive(*primitive, *model, dracoExtensionValue);
   return true;
 }
 #endif

@@ -63,8 +63,8 @@ struct SnapStats {
 /// with none keep their place, and so do the vertices of an element the moves would turn over
 /// (and every vertex of a mesh without element_surface and element_normal for each element).
 /// write_solution exports this.
-mesh::RadiosityMesh snapped_to_input(const rc::Scene& scene, const mesh::RadiosityMesh& mesh, float reach,
-                               SnapStats* stats = nullptr);
+mesh::RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const mesh::RadiosityMesh& mesh,
+                                     float reach, SnapStats* stats = nullptr);
 
 /// The mesh without elements that repeat an earlier element: the same three corner positions (to
 /// the bit, after snapping) in the same turning order, so the same face facing the same way, which
@@ -85,7 +85,7 @@ mesh::RadiosityMesh without_coincident(const mesh::RadiosityMesh& mesh, SnapStat
 /// solution's target edge), then coincident elements dropped (without_coincident); `snap`
 /// receives what both did. Throws InputError for an unsupported
 /// extension or an unwritable destination.
-void write_solution(const std::string& path, const rc::Scene& scene, const solver::Solution& solution,
+void write_solution(const std::string& path, const rc::scene::Scene& scene, const solver::Solution& solution,
                     const ExportSettings& settings, SnapStats* snap = nullptr);
 
 /// What write_solution is foretold to take on a mesh of n elements: seconds + seconds_per_element

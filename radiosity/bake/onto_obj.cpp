@@ -82,7 +82,7 @@ void write_onto_obj(const std::string& input, const std::string& output, const I
   }
   if (vertex < colours.per_file_vertex.size())
     throw std::logic_error("write_onto_obj: the file has fewer vertices than were read from it");
-  rc::StagedFile(output, out).commit();
+  rc::util::StagedFile(output, out).commit();
 }
 
 }  // namespace gilt::radiosity::bake

@@ -96,7 +96,7 @@ std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const 
   }
   std::vector<Rgb> out(positions.size(), Rgb(0.0f));
   std::vector<uint8_t> missing(positions.size(), 0);
-  rc::parallel_for(positions.size(), [&](size_t v) {
+  rc::util::parallel_for(positions.size(), [&](size_t v) {
     const float len = glm::length(normal[v]);
     if (!(len > 0.0f)) return;  // no face uses it, or only degenerate ones
     const std::optional<Rgb> f = field(positions[v], normal[v] / len, face_of[v]);
@@ -120,7 +120,7 @@ std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<c
 
   const size_t faces = indices.size() / 3;
   std::vector<FaceTerms> terms(faces);
-  rc::parallel_for(faces, [&](size_t f) {
+  rc::util::parallel_for(faces, [&](size_t f) {
     terms[f] = face_terms(positions[indices[3 * f]], positions[indices[3 * f + 1]], positions[indices[3 * f + 2]], f,
                           field, spacing);
   });

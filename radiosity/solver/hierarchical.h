@@ -58,9 +58,10 @@ inline constexpr size_t kVisibilityOrigins = 4;
 /// vertex's direct irradiance.
 struct HierarchicalInput {
   const mesh::RadiosityMesh& mesh;
-  const rc::Scene& geometry;
-  std::span<const rc::SurfacePoint> vertex_point;  ///< per vertex: receiver point (see receiver_points)
-  std::span<const rc::SurfacePoint> visibility_origin;  ///< kVisibilityOrigins per vertex (see visibility_origins)
+  const rc::scene::Scene& geometry;
+  std::span<const rc::scene::SurfacePoint>
+      vertex_point;  ///< per vertex: receiver point (see receiver_points)
+  std::span<const rc::scene::SurfacePoint> visibility_origin;  ///< kVisibilityOrigins per vertex (see visibility_origins)
   std::span<const Rgb> albedo;                     ///< per element
   std::span<const Rgb> direct_irradiance;          ///< per vertex, W·m⁻²
   /// Whether a segment between the two boxes' contents may be blocked at all (false: no rays).

@@ -12,7 +12,7 @@
 
 #include "raytrace_core/util/error.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
 namespace {
 
@@ -128,4 +128,4 @@ size_t Film::non_finite_count() const {
   return n;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

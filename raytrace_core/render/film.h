@@ -11,7 +11,7 @@
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/util/rgb.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
 /// Pixel reconstruction filter.
 enum class FilterKind : uint8_t { box, tent, gaussian };
@@ -62,4 +62,4 @@ class Film {
   std::vector<uint32_t> count_;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

@@ -6,21 +6,21 @@
 #include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/render/direct_light.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
-Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx, const PathSettings& settings) {
+Rgb path_radiance(const scene::Scene& scene, const scene::Ray& camera_ray, SampleContext& ctx, const PathSettings& settings) {
   const auto& lights = scene.lights();
   Rgb radiance(0.0f), beta(1.0f);
-  Ray ray = camera_ray;
+  scene::Ray ray = camera_ray;
   bool specular_bounce = true;  // the camera counts as a delta event: emission seen directly is not weighted
   float bsdf_pdf_prev = 0.0f;
-  SurfacePoint prev;
-  LightQuery prev_query;  // what light sampling at prev chose lights for
+  scene::SurfacePoint prev;
+  scene::LightQuery prev_query;  // what light sampling at prev chose lights for
 
   for (int depth = 0;; ++depth) {
     ctx.sampler.start_bounce(depth);
     ++ctx.rays;
-    const std::optional<Hit> hit = scene.intersect(ray);
+    const std::optional<scene::Hit> hit = scene.intersect(ray);
     const Vec3 wo_world = -glm::normalize(ray.direction);
     if (!hit) {
       // Escaped: environment lights, MIS-weighted against light sampling.
@@ -28,31 +28,31 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
         float weight = 1.0f;
         if (!specular_bounce) {
           const float light_pdf_v = light_choice_pmf(scene, prev_query, li) *
-                                    light_pdf(scene, lights[li], prev, -wo_world, prev, receiving_normal(prev_query));
-          weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
+                                    scene::light_pdf(scene, lights[li], prev, -wo_world, prev, scene::receiving_normal(prev_query));
+          weight = util::power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
-        radiance += beta * environment_radiance(lights[li], -wo_world) * weight;
+        radiance += beta * scene::environment_radiance(lights[li], -wo_world) * weight;
       }
       // The sun's disk, where light sampling could not stand for it (the camera, a mirror, glass).
-      if (specular_bounce) radiance += beta * sun_disk_radiance(scene.punctual_lights, -wo_world);
+      if (specular_bounce) radiance += beta * scene::sun_disk_radiance(scene.punctual_lights, -wo_world);
       break;
     }
-    const SurfaceInteraction si = scene.surface(ray, *hit);
-    Material textured;
-    const Material& m = depth == 0 && settings.first_surface ? *settings.first_surface : scene.shading_material(si, textured);
+    const scene::SurfaceInteraction si = scene.surface(ray, *hit);
+    scene::Material textured;
+    const scene::Material& m = depth == 0 && settings.first_surface ? *settings.first_surface : scene.shading_material(si, textured);
 
     // Leaving the inside of a dielectric: attenuate by its absorption over the segment.
-    if (m.kind == MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+    if (m.kind == scene::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
       beta *= exp(m.absorption * (-hit->t * glm::length(ray.direction)));
 
     if (m.is_emissive()) {
-      const Rgb le = emitted_radiance(m, si.ng, wo_world);
+      const Rgb le = scene::emitted_radiance(m, si.ng, wo_world);
       if (!le.is_black()) {
         float weight = 1.0f;
         if (!specular_bounce && si.light >= 0) {
           const float light_pdf_v =
-              light_choice_pmf(scene, prev_query, uint32_t(si.light)) * light_pdf(scene, lights[si.light], prev, -wo_world, si);
-          weight = power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
+              light_choice_pmf(scene, prev_query, uint32_t(si.light)) * scene::light_pdf(scene, lights[si.light], prev, -wo_world, si);
+          weight = util::power_heuristic(1.0f, bsdf_pdf_prev, 1.0f, light_pdf_v);
         }
         radiance += beta * le * weight;
       }
@@ -68,7 +68,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
 
     // Continue the path by sampling the BSDF.
     const float u_lobe = ctx.sampler.uniform();
-    const std::optional<BsdfSample> bs = bsdf_sample(m, wo, u_lobe, ctx.sampler.uniform2());
+    const std::optional<scene::BsdfSample> bs = scene::bsdf_sample(m, wo, u_lobe, ctx.sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
     const Vec3 wi_world = frame.to_world(bs->wi);
     // A shading normal may send a reflected ray through the geometric surface: end such paths.
@@ -79,7 +79,7 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
     bsdf_pdf_prev = bs->pdf;
     prev = si;
     prev_query = light_query(si, m, wo_above);
-    ray = spawn_ray(si, wi_world);
+    ray = scene::spawn_ray(si, wi_world);
 
     // Russian roulette on the throughput.
     if (depth + 1 >= settings.rr_depth) {
@@ -91,4 +91,4 @@ Rgb path_radiance(const Scene& scene, const Ray& camera_ray, SampleContext& ctx,
   return radiance;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

@@ -4,7 +4,7 @@
 
 #include "raytrace_core/render/render.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
 /// Path tracer parameters.
 struct PathSettings {
@@ -13,10 +13,11 @@ struct PathSettings {
   /// When set, stands in for the material of the first surface hit, emission included: with a
   /// white, unlit Lambertian stand-in the estimate is E/π, E the irradiance there, whatever the
   /// surface really is (the radiosity checks). The rest of the path sees the real materials.
-  const Material* first_surface = nullptr;
+  const scene::Material* first_surface = nullptr;
 };
 
 /// Radiance along `ray` estimated by one path.
-Rgb path_radiance(const Scene& scene, const Ray& ray, SampleContext& ctx, const PathSettings& settings);
+Rgb path_radiance(const scene::Scene& scene, const scene::Ray& ray, SampleContext& ctx,
+                  const PathSettings& settings);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

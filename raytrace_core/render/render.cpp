@@ -11,7 +11,7 @@
 #include "raytrace_core/util/processes.h"
 #include "raytrace_core/util/progress.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 namespace {
 
 struct Tile {
@@ -27,22 +27,23 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 
 }  // namespace
 
-Ray camera_ray(const Camera& camera, const RenderSettings& settings, int x, int y, Sampler& sampler) {
+scene::Ray camera_ray(const scene::Camera& camera, const RenderSettings& settings, int x, int y,
+                      Sampler& sampler) {
   const Vec2 offset = settings.filter.sample(sampler.uniform2());
   const Vec2 film_pos((float(x) + 0.5f + offset.x) / float(settings.width), (float(y) + 0.5f + offset.y) / float(settings.height));
   const Vec2 lens = camera.has_lens() ? sampler.uniform2() : Vec2(0.5f);
-  Ray ray = camera.generate_ray(film_pos, lens, float(settings.width) / float(settings.height));
+  scene::Ray ray = camera.generate_ray(film_pos, lens, float(settings.width) / float(settings.height));
   ray.spread = camera.pixel_spread(settings.height);
   return ray;
 }
 
-Film render_image(const Scene& scene, const Camera& camera, const RenderSettings& settings,
+Film render_image(const scene::Scene& scene, const scene::Camera& camera, const RenderSettings& settings,
                   const RadianceFunction& radiance, RenderStats* stats) {
   if (!scene.committed()) throw std::logic_error("render_image: the scene was not committed");
   if (settings.width <= 0 || settings.height <= 0) throw InputError("image size must be positive");
   if (settings.time_limit <= 0.0 && settings.spp <= 0) throw InputError("samples per pixel must be positive");
   if (settings.tile_size <= 0) throw InputError("tile size must be positive");
-  const ThreadLimit limit(settings.threads);
+  const util::ThreadLimit limit(settings.threads);
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
@@ -53,16 +54,16 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
 
   const bool timed = settings.time_limit > 0.0;
   // Under several processes each renders the tiles it owns, and rank 0 shows the progress.
-  const Processes& group = processes();
+  const util::Processes& group = util::processes();
   std::vector<size_t> owned;
   for (size_t ti = 0; ti < tiles.size(); ++ti)
     if (group.owns(ti)) owned.push_back(ti);
-  Progress progress(timed ? "render (time budget)" : "render", timed ? 0 : pixels * settings.spp, "samples",
-                    settings.progress && group.rank() == 0);
+  util::Progress progress(timed ? "render (time budget)" : "render", timed ? 0 : pixels * settings.spp,
+                          "samples", settings.progress && group.rank() == 0);
 
   // One pass renders samples [first, first + count) of every pixel.
   auto run_pass = [&](int first, int count) {
-    parallel_for(owned.size(), [&](size_t k) {
+    util::parallel_for(owned.size(), [&](size_t k) {
       const Tile& tile = tiles[owned[k]];
       uint64_t tile_rays = 0, tile_bad = 0;
       for (int y = tile.y0; y < tile.y1; ++y) {
@@ -116,7 +117,7 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
         for (int x = t.x0; x < t.x1; ++x) f(size_t(y) * settings.width + x);
     };
     for (size_t ti : owned) for_pixels(ti, [&](size_t i) { sums[ti].push_back(film.accumulated(i)); });
-    join_chunks(sums);
+    util::join_chunks(sums);
     for (size_t ti = 0; ti < tiles.size(); ++ti) {
       size_t k = 0;
       for_pixels(ti, [&](size_t i) { film.set_accumulated(i, sums[ti][k++]); });
@@ -134,4 +135,4 @@ Film render_image(const Scene& scene, const Camera& camera, const RenderSettings
   return film;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

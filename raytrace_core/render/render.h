@@ -10,7 +10,7 @@
 #include "raytrace_core/render/sampler.h"
 #include "raytrace_core/scene/scene.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
 /// How to render an image.
 struct RenderSettings {
@@ -42,16 +42,17 @@ struct SampleContext {
 };
 
 /// Radiance arriving at the camera along a primary ray (W·sr⁻¹·m⁻²).
-using RadianceFunction = std::function<Rgb(const Ray& ray, SampleContext& ctx)>;
+using RadianceFunction = std::function<Rgb(const scene::Ray& ray, SampleContext& ctx)>;
 
 /// The camera ray of a sample of pixel (x, y): its position in the pixel drawn by the settings'
 /// filter, then a point on the lens when the camera has one, both from `sampler`'s camera
 /// dimensions; its spread set for texture filtering. render_image and SPPM's camera pass use it.
-Ray camera_ray(const Camera& camera, const RenderSettings& settings, int x, int y, Sampler& sampler);
+scene::Ray camera_ray(const scene::Camera& camera, const RenderSettings& settings, int x, int y,
+                      Sampler& sampler);
 
 /// Renders with the given radiance function. Sample s of pixel (x, y) draws from
 /// Sampler::for_pixel_sample(sampler, seed, y·width + x, s) only, so the result is independent of threads and tiles.
-Film render_image(const Scene& scene, const Camera& camera, const RenderSettings& settings,
+Film render_image(const scene::Scene& scene, const scene::Camera& camera, const RenderSettings& settings,
                   const RadianceFunction& radiance, RenderStats* stats = nullptr);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

@@ -20,7 +20,7 @@
 #include "raytrace_core/util/rng.h"
 #include "raytrace_core/util/sobol.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
 enum class SamplerKind : uint8_t { independent, sobol };
 
@@ -36,16 +36,16 @@ class Sampler {
   static constexpr uint32_t kSobolBounces = 3;       ///< vertices that get Sobol dimensions
 
   /// Independent values from `rng`.
-  explicit Sampler(Rng rng) : rng_(rng) {}
+  explicit Sampler(util::Rng rng) : rng_(rng) {}
 
   /// Sample `index` of pixel `pixel` under the global `seed`. The independent kind and the
   /// fallback past the Sobol dimensions use Rng::for_item(seed, pixel, index).
   static Sampler for_pixel_sample(SamplerKind kind, uint64_t seed, uint64_t pixel, uint64_t index) {
-    Sampler s(Rng::for_item(seed, pixel, index));
+    Sampler s(util::Rng::for_item(seed, pixel, index));
     if (kind == SamplerKind::sobol && index <= UINT32_MAX) {
       s.sobol_ = true;
-      s.reversed_index_ = sobol::reverse_bits(uint32_t(index));
-      s.pixel_seed_ = mix64(seed ^ mix64(pixel ^ 0x5bd1e9955bd1e995ull));
+      s.reversed_index_ = util::sobol::reverse_bits(uint32_t(index));
+      s.pixel_seed_ = util::mix64(seed ^ util::mix64(pixel ^ 0x5bd1e9955bd1e995ull));
     }
     return s;
   }
@@ -62,7 +62,7 @@ class Sampler {
   Vec2 uniform2() { return use_sobol() ? sobol_2d() : rng_.uniform2(); }
 
   /// The independent stream (used past the Sobol dimensions).
-  Rng& rng() { return rng_; }
+  util::Rng& rng() { return rng_; }
 
   /// `count` sub-samples taken at one point of the path, such as a final gather's rays.
   class SubSamples {
@@ -72,10 +72,10 @@ class Sampler {
     /// rays of all of a pixel's samples are stratified together, and for a power-of-two count
     /// each sample's own rays form a net too.
     Sampler operator[](uint32_t j) const {
-      Sampler s(Rng(mix64(key_ + j), key_));
+      Sampler s(util::Rng(util::mix64(key_ + j), key_));
       if (sobol_) {
         s.sobol_ = true;
-        s.reversed_index_ = sobol::reverse_bits(first_ + j);
+        s.reversed_index_ = util::sobol::reverse_bits(first_ + j);
         s.pixel_seed_ = key_;
         s.bounce_end_ = kBounceDimensions;
       }
@@ -91,13 +91,13 @@ class Sampler {
   /// A set of `count` sub-samples; uses up one dimension of this sampler.
   SubSamples split(uint32_t count) {
     SubSamples set;
-    const uint32_t index = sobol::reverse_bits(reversed_index_);
+    const uint32_t index = util::sobol::reverse_bits(reversed_index_);
     if (use_sobol() && count > 0 && index <= (UINT32_MAX - count) / count) {
       set.sobol_ = true;
       set.key_ = dimension_seed();
       set.first_ = index * count;
     } else {
-      set.key_ = mix64(uint64_t(rng_.next_u32()) << 32 | rng_.next_u32());
+      set.key_ = util::mix64(uint64_t(rng_.next_u32()) << 32 | rng_.next_u32());
       if (sobol_) ++dimension_;
     }
     return set;
@@ -110,13 +110,13 @@ class Sampler {
   float sobol_1d();
   Vec2 sobol_2d();
   /// Seeds of the current dimension, which the call then uses up.
-  uint64_t dimension_seed() { return mix64(pixel_seed_ + 0x9e3779b97f4a7c15ull * (dimension_++ + 1)); }
+  uint64_t dimension_seed() { return util::mix64(pixel_seed_ + 0x9e3779b97f4a7c15ull * (dimension_++ + 1)); }
   /// The point index, Owen-scrambled as a base-2 integer (Burley's shuffle), from its reversal.
-  uint32_t shuffled_index(uint32_t seed) const { return sobol::reverse_bits(sobol::laine_karras(reversed_index_, seed)); }
+  uint32_t shuffled_index(uint32_t seed) const { return util::sobol::reverse_bits(util::sobol::laine_karras(reversed_index_, seed)); }
   /// owen_scramble(dimension0(i)): dimension 0 is the reversal of i, which the scramble undoes.
-  static uint32_t scrambled_dimension0(uint32_t i, uint32_t seed) { return sobol::reverse_bits(sobol::laine_karras(i, seed)); }
+  static uint32_t scrambled_dimension0(uint32_t i, uint32_t seed) { return util::sobol::reverse_bits(util::sobol::laine_karras(i, seed)); }
 
-  Rng rng_;
+  util::Rng rng_;
   bool sobol_ = false;
   uint32_t reversed_index_ = 0;  ///< the sample's index, bits reversed
   uint64_t pixel_seed_ = 0;
@@ -124,4 +124,4 @@ class Sampler {
   uint32_t bounce_end_ = kCameraDimensions;  ///< the camera's dimensions until start_bounce
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

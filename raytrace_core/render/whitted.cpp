@@ -7,19 +7,19 @@
 #include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/render/direct_light.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 namespace {
 
-Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings, int depth) {
+Rgb trace(const scene::Scene& scene, const scene::Ray& ray, SampleContext& ctx, const WhittedSettings& settings, int depth) {
   ctx.sampler.start_bounce(depth);
   ++ctx.rays;
-  const std::optional<Hit> hit = scene.intersect(ray);
-  if (!hit) return escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
-  const SurfaceInteraction si = scene.surface(ray, *hit);
-  Material textured;
-  const Material& m = scene.shading_material(si, textured);
+  const std::optional<scene::Hit> hit = scene.intersect(ray);
+  if (!hit) return scene::escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
+  const scene::SurfaceInteraction si = scene.surface(ray, *hit);
+  scene::Material textured;
+  const scene::Material& m = scene.shading_material(si, textured);
   const Vec3 wo_world = -glm::normalize(ray.direction);
-  Rgb radiance = m.is_emissive() ? emitted_radiance(m, si.ng, wo_world) : Rgb(0.0f);
+  Rgb radiance = m.is_emissive() ? scene::emitted_radiance(m, si.ng, wo_world) : Rgb(0.0f);
   const Frame frame = Frame::from_normal(si.ns);
   const Vec3 wo = frame.to_local(wo_world);
   const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
@@ -36,10 +36,10 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
 
   auto follow = [&](const Vec3& wi_local, const Rgb& weight) {
     const Vec3 wi_world = frame.to_world(wi_local);
-    Rgb l = trace(scene, spawn_ray(si, wi_world), ctx, settings, depth + 1);
+    Rgb l = trace(scene, scene::spawn_ray(si, wi_world), ctx, settings, depth + 1);
     return weight * l;
   };
-  if (m.kind == MaterialKind::mirror) {
+  if (m.kind == scene::MaterialKind::mirror) {
     const Vec3 wi(-wo.x, -wo.y, wo.z);
     return radiance + follow(wi, m.specular);
   }
@@ -48,7 +48,7 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
   if (!si.front_face && !m.absorption.is_black()) absorb = exp(m.absorption * (-hit->t * glm::length(ray.direction)));
   const float eta = m.ior;
   const float cos_o = wo.z;
-  const float fr = fresnel_dielectric(cos_o, eta);
+  const float fr = scene::fresnel_dielectric(cos_o, eta);
   const Vec3 wr(-wo.x, -wo.y, wo.z);
   radiance += follow(wr, Rgb(fr));
   if (fr < 1.0f) {
@@ -63,8 +63,8 @@ Rgb trace(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedS
 
 }  // namespace
 
-Rgb whitted_radiance(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings) {
+Rgb whitted_radiance(const scene::Scene& scene, const scene::Ray& ray, SampleContext& ctx, const WhittedSettings& settings) {
   return trace(scene, ray, ctx, settings, 0);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

@@ -5,7 +5,7 @@
 
 #include "raytrace_core/render/render.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 
 /// Whitted parameters.
 struct WhittedSettings {
@@ -14,6 +14,7 @@ struct WhittedSettings {
 };
 
 /// Radiance along `ray` by Whitted's method (area lights sampled with `area_light_samples` points).
-Rgb whitted_radiance(const Scene& scene, const Ray& ray, SampleContext& ctx, const WhittedSettings& settings);
+Rgb whitted_radiance(const scene::Scene& scene, const scene::Ray& ray, SampleContext& ctx,
+                     const WhittedSettings& settings);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

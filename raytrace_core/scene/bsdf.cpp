@@ -21,7 +21,7 @@
 #include "raytrace_core/scene/rough_dielectric.h"
 #include "raytrace_core/util/sampling.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 // Above this the Phong lobe is narrower than float directions can resolve (width ~ sqrt(2/n)
@@ -62,7 +62,7 @@ float glossy_pdf_front(const Material& m, const Vec3& wo, const Vec3& wi) {
   if (ps < 0.0f) return 0.0f;
   const float n = phong_exponent(m);
   const float lobe_pdf = (n + 1.0f) * kInv2Pi * phong_cos_power(wo, wi, n);
-  return ps * lobe_pdf + (1.0f - ps) * cosine_hemisphere_pdf(wi.z);
+  return ps * lobe_pdf + (1.0f - ps) * util::cosine_hemisphere_pdf(wi.z);
 }
 
 // Direction with density (n + 1)/2π cos^n α around the mirror direction of wo, α ≤ π/2.
@@ -127,7 +127,7 @@ float metallic_roughness_pdf_front(const Material& m, const Vec3& wo, const Vec3
     // Reflection maps h to wi with Jacobian 1 / (4 wo·h).
     if (cos_oh > 0.0f) specular_pdf = ggx_of_roughness(m.roughness).visible_d(wo, h) / (4.0f * cos_oh);
   }
-  return ps * specular_pdf + (1.0f - ps) * cosine_hemisphere_pdf(wi.z);
+  return ps * specular_pdf + (1.0f - ps) * util::cosine_hemisphere_pdf(wi.z);
 }
 
 std::optional<BsdfSample> sample_reflective(const Material& m, Vec3 wo, float u_lobe, Vec2 u) {
@@ -137,22 +137,22 @@ std::optional<BsdfSample> sample_reflective(const Material& m, Vec3 wo, float u_
 
   Vec3 wi;
   if (m.kind == MaterialKind::diffuse) {
-    wi = sample_cosine_hemisphere(u);
+    wi = util::sample_cosine_hemisphere(u);
   } else if (m.kind == MaterialKind::metallic_roughness) {
     const float ps = metallic_roughness_specular_probability(m, wo);
     if (ps < 0.0f) return std::nullopt;
-    wi = u_lobe < ps ? reflect_about(wo, ggx_of_roughness(m.roughness).sample_visible(wo, u)) : sample_cosine_hemisphere(u);
+    wi = u_lobe < ps ? reflect_about(wo, ggx_of_roughness(m.roughness).sample_visible(wo, u)) : util::sample_cosine_hemisphere(u);
   } else {
     const float ps = specular_lobe_probability(m);
     if (ps < 0.0f) return std::nullopt;
-    wi = u_lobe < ps ? sample_phong_lobe(wo, phong_exponent(m), u) : sample_cosine_hemisphere(u);
+    wi = u_lobe < ps ? sample_phong_lobe(wo, phong_exponent(m), u) : util::sample_cosine_hemisphere(u);
   }
   if (!(wi.z > 0.0f)) return std::nullopt;  // under the surface, or on the horizon (pdf 0)
 
   BsdfSample s;
   if (m.kind == MaterialKind::diffuse) {
     s.f = m.albedo * kInvPi;
-    s.pdf = cosine_hemisphere_pdf(wi.z);
+    s.pdf = util::cosine_hemisphere_pdf(wi.z);
   } else if (m.kind == MaterialKind::metallic_roughness) {
     s.f = metallic_roughness_eval_front(m, wo, wi);
     s.pdf = metallic_roughness_pdf_front(m, wo, wi);
@@ -251,7 +251,7 @@ float bsdf_pdf(const Material& m, const Vec3& wo, const Vec3& wi) {
   if (!(wo.z * wi.z > 0.0f)) return 0.0f;
   switch (m.kind) {
     case MaterialKind::diffuse:
-      return cosine_hemisphere_pdf(std::fabs(wi.z));
+      return util::cosine_hemisphere_pdf(std::fabs(wi.z));
     case MaterialKind::glossy:
       return wo.z > 0.0f ? glossy_pdf_front(m, wo, wi) : glossy_pdf_front(m, flip_z(wo), flip_z(wi));
     case MaterialKind::metallic_roughness:
@@ -312,4 +312,4 @@ float fresnel_dielectric(float cos_i, float eta) {
   return std::clamp(0.5f * (r_parallel * r_parallel + r_perpendicular * r_perpendicular), 0.0f, 1.0f);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

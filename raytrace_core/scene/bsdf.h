@@ -15,7 +15,7 @@
 #include "raytrace_core/scene/material.h"
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// Whether a path carries radiance (camera paths) or importance (light paths, photons). Only
 /// refraction differs: radiance is scaled by 1/η² across the interface, importance is not.
@@ -54,4 +54,4 @@ Rgb diffuse_reflectance(const Material& m);
 /// outside; eta is the inside IOR over the outside IOR.
 float fresnel_dielectric(float cos_i, float eta);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

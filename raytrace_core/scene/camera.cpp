@@ -8,7 +8,7 @@
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/sampling.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 void Camera::validate() const {
   if (!is_finite(look_from) || !is_finite(look_at) || !is_finite(up))
@@ -46,7 +46,7 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float aspect) const {
   if (aperture_radius <= 0.0f) return {look_from, glm::normalize(d), kInfinity};
   const float focus = focus_distance > 0.0f ? focus_distance : glm::length(look_at - look_from);
   const Vec3 target = look_from + focus * d;  // the point on the plane of focus
-  const Vec2 disk = aperture_radius * sample_uniform_disk(lens);
+  const Vec2 disk = aperture_radius * util::sample_uniform_disk(lens);
   const Vec3 origin = look_from + disk.x * u + disk.y * v;
   return {origin, glm::normalize(target - origin), kInfinity};
 }
@@ -80,4 +80,4 @@ Camera default_camera(const Bounds3& bounds, float aspect) {
   return c;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

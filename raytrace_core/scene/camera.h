@@ -6,7 +6,7 @@
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/scene/ray.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// A perspective camera. With aperture_radius = 0 it is a pinhole; otherwise a thin lens focused
 /// at focus_distance (0 means at the distance to look_at). An orthographic camera sends parallel
@@ -48,4 +48,4 @@ struct NamedCamera {
 /// width, whichever binds, with an 8 % margin.
 Camera default_camera(const Bounds3& bounds, float aspect);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -9,7 +9,7 @@
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/image_io.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Rgb> texels, float scale, float rotate_degrees)
     : width_(width), height_(height), texels_(std::move(texels)), rotate_degrees_(rotate_degrees) {
@@ -40,12 +40,12 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Rgb> texels, f
     row_weights[size_t(row)] = float(row_sum * omega);
     columns_.emplace_back(column_weights);
   }
-  rows_ = Distribution1D(row_weights);
+  rows_ = util::Distribution1D(row_weights);
   for (int c = 0; c < 3; ++c) mean_[c] = float(mean[c] / (4.0 * std::numbers::pi));
 }
 
 std::shared_ptr<const EnvironmentMap> EnvironmentMap::load(const std::string& path, float scale, float rotate_degrees) {
-  Image image = read_image(path);
+  util::Image image = util::read_image(path);
   try {
     return std::make_shared<const EnvironmentMap>(image.width, image.height, std::move(image.pixels), scale,
                                                   rotate_degrees);
@@ -77,7 +77,7 @@ EnvironmentMap::Sample EnvironmentMap::sample(Vec2 u) const {
   if (rows_.size() == 0) return s;
   float u_theta = 0.0f, u_phi = 0.0f;
   const uint32_t row = rows_.sample(u.x, u_theta);
-  const Distribution1D& columns = columns_[row];
+  const util::Distribution1D& columns = columns_[row];
   const uint32_t col = columns.sample(u.y, u_phi);
   // Uniform in solid angle inside the cell: cos θ uniform between its rows' cosines, φ uniform.
   const double cos0 = std::cos(std::numbers::pi * row / height_), cos1 = std::cos(std::numbers::pi * (row + 1) / height_);
@@ -98,4 +98,4 @@ float EnvironmentMap::pdf(const Vec3& w) const {
   return rows_.pmf(row) * columns_[row].pmf(col) / cell_solid_angle(int(row));
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -22,7 +22,7 @@
 #include "raytrace_core/util/rgb.h"
 #include "raytrace_core/util/sampling.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 class EnvironmentMap {
  public:
@@ -64,9 +64,9 @@ class EnvironmentMap {
   int width_ = 0, height_ = 0;
   std::vector<Rgb> texels_;
   float rotate_degrees_ = 0.0f, cos_rotation_ = 1.0f, sin_rotation_ = 0.0f;
-  Distribution1D rows_;                 ///< row marginals
-  std::vector<Distribution1D> columns_; ///< per row, its texels
+  util::Distribution1D rows_;                 ///< row marginals
+  std::vector<util::Distribution1D> columns_; ///< per row, its texels
   Rgb mean_{0.0f};
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -15,7 +15,7 @@
 #include "raytrace_core/util/spherical_triangle.h"
 #include "raytrace_core/scene/scene.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 /// Area density converted to solid angle as seen from ref: pdf_A · d² / |cos θ_light|.
@@ -56,7 +56,7 @@ float spot_falloff(const Light& l, const Vec3& w_from_light) {
 /// (Light::cos_angle) drawn uniformly.
 Vec3 directional_travel(const Light& light, Vec2 u) {
   if (!(light.cos_angle < 1.0f)) return light.direction;
-  return Frame::from_normal(light.direction).to_world(sample_uniform_cone(u, light.cos_angle));
+  return Frame::from_normal(light.direction).to_world(util::sample_uniform_cone(u, light.cos_angle));
 }
 
 /// The scene's bounding box seen along a direction: the convex outline of its corners projected
@@ -105,7 +105,7 @@ Vec2 sample_outline(const BoxOutline& o, Vec2 u) {
     const float area = 0.5f * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
     if (target < area || i + 2 == o.count) {
       const float ux = std::clamp(area > 0.0f ? target / area : 0.0f, 0.0f, kOneMinusEpsilon);
-      const Vec2 bary = sample_uniform_triangle(Vec2(ux, u.y));
+      const Vec2 bary = util::sample_uniform_triangle(Vec2(ux, u.y));
       return a + (b - a) * bary.x + (c - a) * bary.y;
     }
     target -= area;
@@ -140,7 +140,7 @@ std::array<DVec3, 3> light_corners(const Scene& scene, const Light& light) {
 /// corner's distance over the nearest point's.
 bool density_spreads(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   constexpr float kSpread = 2.0f;  // largest ratio of densities left to area sampling
-  const Vec2 nb = closest_point_on_triangle(p, a, b, c);
+  const Vec2 nb = util::closest_point_on_triangle(p, a, b, c);
   const Vec3 nearest = (1.0f - nb.x - nb.y) * a + nb.x * b + nb.y * c;
   const float r_near2 = glm::dot(nearest - p, nearest - p);
   const float r_far2 = std::max({glm::dot(a - p, a - p), glm::dot(b - p, b - p), glm::dot(c - p, c - p)});
@@ -151,13 +151,15 @@ bool density_spreads(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
 /// The spherical triangle a triangle light spans from p, when it is sampled by the solid angle
 /// it subtends there; nothing when it is sampled by area. sample_light and light_pdf both
 /// decide through here, from p and the triangle alone.
-std::optional<SphericalTriangle> solid_angle_sampling(const Scene& scene, const Light& light, const Vec3& p) {
+std::optional<util::SphericalTriangle> solid_angle_sampling(const Scene& scene, const Light& light,
+                                                            const Vec3& p) {
   const TriangleMesh& mesh = scene.meshes[light.geom_id];
   const uint32_t* i = &mesh.indices[3 * size_t(light.prim_id)];
   const Vec3 &a = mesh.positions[i[0]], &b = mesh.positions[i[1]], &c = mesh.positions[i[2]];
   if (!density_spreads(p, a, b, c)) return std::nullopt;
-  std::optional<SphericalTriangle> t = SphericalTriangle::from(DVec3(p), DVec3(a), DVec3(b), DVec3(c));
-  if (t && !samples_by_solid_angle(t->solid_angle())) t.reset();
+  std::optional<util::SphericalTriangle> t =
+      util::SphericalTriangle::from(DVec3(p), DVec3(a), DVec3(b), DVec3(c));
+  if (t && !util::samples_by_solid_angle(t->solid_angle())) t.reset();
   return t;
 }
 
@@ -181,7 +183,7 @@ Vec2 barycentrics_along(const std::array<DVec3, 3>& c, const DVec3& p, const DVe
 }  // namespace
 
 double triangle_light_solid_angle(const Scene& scene, const Light& light, const Vec3& p) {
-  const std::optional<SphericalTriangle> t = solid_angle_sampling(scene, light, p);
+  const std::optional<util::SphericalTriangle> t = solid_angle_sampling(scene, light, p);
   return t ? t->solid_angle() : 0.0;
 }
 
@@ -194,19 +196,19 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
       SurfaceInteraction q;
       float pdf = 0.0f;
       if (light.kind == LightKind::area_triangle) {
-        if (const std::optional<SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p)) {
+        if (const std::optional<util::SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p)) {
           // A direction uniform over the solid angle, and the point where it meets the light.
           const DVec3 w = st->sample(u);
           q = scene.triangle_point(light.geom_id, light.prim_id, barycentrics_along(light_corners(scene, light), DVec3(ref.p), w));
           pdf = float(1.0 / st->solid_angle());
         } else {
-          q = scene.triangle_point(light.geom_id, light.prim_id, sample_uniform_triangle(u));
+          q = scene.triangle_point(light.geom_id, light.prim_id, util::sample_uniform_triangle(u));
           pdf = area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, q);
         }
       } else {
         const Sphere& s = scene.spheres[light.prim_id];
         if (inside_sphere(s, ref.p)) {
-          q = scene.sphere_point(light.prim_id, sample_uniform_sphere(u));
+          q = scene.sphere_point(light.prim_id, util::sample_uniform_sphere(u));
           pdf = area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, q);
         } else {
           // Uniform direction in the subtended cone, then the nearer intersection with the sphere.
@@ -269,13 +271,13 @@ LightSample sample_light(const Scene& scene, const Light& light, const SurfacePo
         ls.pdf = s.pdf;
         ls.radiance = light.radiance * s.radiance;
       } else if (receiving != Vec3(0.0f)) {  // cosine-distributed over the receiving side
-        ls.wi = Frame::from_normal(receiving).to_world(sample_cosine_hemisphere(u));
-        ls.pdf = cosine_hemisphere_pdf(glm::dot(ls.wi, receiving));
+        ls.wi = Frame::from_normal(receiving).to_world(util::sample_cosine_hemisphere(u));
+        ls.pdf = util::cosine_hemisphere_pdf(glm::dot(ls.wi, receiving));
         if (!(ls.pdf > 0.0f)) return ls;  // on the horizon, within rounding
         ls.radiance = light.radiance;
       } else {
-        ls.wi = sample_uniform_sphere(u);
-        ls.pdf = uniform_sphere_pdf();
+        ls.wi = util::sample_uniform_sphere(u);
+        ls.pdf = util::uniform_sphere_pdf();
         ls.radiance = light.radiance;
       }
       ls.shadow_ray = spawn_shadow_ray_to_infinity(ref, ls.wi);
@@ -288,7 +290,7 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
                 const SurfacePoint& on_light, const Vec3& receiving) {
   switch (light.kind) {
     case LightKind::area_triangle:
-      if (const std::optional<SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p))
+      if (const std::optional<util::SphericalTriangle> st = solid_angle_sampling(scene, light, ref.p))
         return float(1.0 / st->solid_angle());
       return area_to_solid_angle(1.0f / scene.primitive_area(light.geom_id, light.prim_id), ref.p, on_light);
     case LightKind::area_sphere: {
@@ -299,7 +301,8 @@ float light_pdf(const Scene& scene, const Light& light, const SurfacePoint& ref,
     }
     case LightKind::environment:
       if (light.map) return light.map->pdf(wi);
-      return receiving != Vec3(0.0f) ? cosine_hemisphere_pdf(glm::dot(wi, receiving)) : uniform_sphere_pdf();
+      return receiving != Vec3(0.0f) ? util::cosine_hemisphere_pdf(glm::dot(wi, receiving))
+                                     : util::uniform_sphere_pdf();
     case LightKind::point:
     case LightKind::spot:
     case LightKind::directional: return 0.0f;
@@ -314,8 +317,8 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
     case LightKind::area_sphere: {
       const SurfaceInteraction q =
           light.kind == LightKind::area_triangle
-              ? scene.triangle_point(light.geom_id, light.prim_id, sample_uniform_triangle(u_position))
-              : scene.sphere_point(light.prim_id, sample_uniform_sphere(u_position));
+              ? scene.triangle_point(light.geom_id, light.prim_id, util::sample_uniform_triangle(u_position))
+              : scene.sphere_point(light.prim_id, util::sample_uniform_sphere(u_position));
       const Material& m = scene.primitive_material(light.geom_id, light.prim_id);
       Vec3 n = q.ng;
       float sides = 1.0f;
@@ -329,7 +332,7 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
           u_direction.x = std::min(kOneMinusEpsilon, 2.0f * u_direction.x - 1.0f);
         }
       }
-      const Vec3 w = Frame::from_normal(n).to_world(sample_cosine_hemisphere(u_direction));
+      const Vec3 w = Frame::from_normal(n).to_world(util::sample_cosine_hemisphere(u_direction));
       // Le cos / (1/A · cos/π · 1/sides) = Le π A · sides.
       es.power = scene.emission_at(m, q.uv) * (sides * kPi * scene.primitive_area(light.geom_id, light.prim_id));
       SurfacePoint from = q;
@@ -342,11 +345,12 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
     case LightKind::spot: {
       Vec3 w;
       if (light.kind == LightKind::point) {
-        w = sample_uniform_sphere(u_direction);
+        w = util::sample_uniform_sphere(u_direction);
         es.power = light.intensity * (4.0f * kPi);
       } else {
-        w = Frame::from_normal(light.direction).to_world(sample_uniform_cone(u_direction, light.cos_outer));
-        es.power = light.intensity * (spot_falloff(light, w) / uniform_cone_pdf(light.cos_outer));
+        w = Frame::from_normal(light.direction)
+                .to_world(util::sample_uniform_cone(u_direction, light.cos_outer));
+        es.power = light.intensity * (spot_falloff(light, w) / util::uniform_cone_pdf(light.cos_outer));
       }
       es.ray = Ray{light.position, w};
       es.normal = w;
@@ -364,8 +368,8 @@ EmissionSample sample_emission(const Scene& scene, const Light& light, Vec2 u_po
         w = -s.wi;
         radiance_over_pdf = light.radiance * s.radiance / s.pdf;
       } else if (light.kind == LightKind::environment) {
-        w = -sample_uniform_sphere(u_direction);
-        radiance_over_pdf = light.radiance / uniform_sphere_pdf();
+        w = -util::sample_uniform_sphere(u_direction);
+        radiance_over_pdf = light.radiance / util::uniform_sphere_pdf();
       }
       const Bounds3& b = scene.bounds();
       const Vec3 center = 0.5f * (b.lo + b.hi);
@@ -437,4 +441,4 @@ Rgb light_power(const Scene& scene, const Light& light) {
   return Rgb(0.0f);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

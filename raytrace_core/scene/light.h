@@ -11,7 +11,7 @@
 #include "raytrace_core/scene/ray.h"
 #include "raytrace_core/util/rgb.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 class Scene;
 
@@ -127,4 +127,4 @@ Rgb escaped_radiance(std::span<const Light> lights, const Vec3& w);
 /// Radiance emitted by a surface of material m towards direction w leaving it (front = ng side).
 Rgb emitted_radiance(const Material& m, const Vec3& ng, const Vec3& w);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

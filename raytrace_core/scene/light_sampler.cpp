@@ -8,7 +8,7 @@
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/scene/scene.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 namespace {
 
@@ -237,7 +237,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Light> lights, st
     tree_power += p;
     order.push_back(i);
   }
-  distant_ = Distribution1D(distant_power);
+  distant_ = util::Distribution1D(distant_power);
   tree_share_ = all_power > 0.0 ? float(tree_power / all_power) : 0.0f;
   if (distant_.size() == 0) tree_share_ = order.empty() ? 0.0f : 1.0f;
   if (!order.empty()) {
@@ -418,4 +418,4 @@ float LightSampler::pmf(const LightQuery& query, uint32_t light) const {
   return pmf;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

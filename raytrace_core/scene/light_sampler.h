@@ -16,7 +16,7 @@
 #include "raytrace_core/scene/light.h"
 #include "raytrace_core/util/sampling.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// Where light is sought: a point and the side of its surface that receives light.
 struct LightQuery {
@@ -102,9 +102,9 @@ class LightSampler {
   float cluster_pmf(const Node& cluster, uint32_t leaf) const;
 
   LightSampling mode_ = LightSampling::bvh;
-  Distribution1D power_;           // every light by power: the distant lights' choice, and mode power
+  util::Distribution1D power_;           // every light by power: the distant lights' choice, and mode power
   float tree_share_ = 0.0f;        // probability of descending the tree (its lights' share of power)
-  Distribution1D distant_;         // the directional and environment lights, by power
+  util::Distribution1D distant_;         // the directional and environment lights, by power
   std::vector<uint32_t> distant_index_;  // light index of each entry of distant_
   std::vector<Node> nodes_;
   std::vector<double> prefix_;     // summed power of the leaves before each, in depth-first order
@@ -115,4 +115,4 @@ class LightSampler {
   int depth_ = 0;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

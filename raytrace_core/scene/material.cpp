@@ -7,7 +7,7 @@
 
 #include "raytrace_core/scene/microfacet.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 Material Material::make_diffuse(std::string name, Rgb albedo) {
   Material m;
@@ -67,4 +67,4 @@ Material Material::make_metallic_roughness(std::string name, Rgb base_colour, fl
   return m;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -8,7 +8,7 @@
 #include "raytrace_core/util/rgb.h"
 #include "raytrace_core/scene/texture.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// The scattering model of a material.
 enum class MaterialKind : uint8_t {
@@ -114,4 +114,4 @@ struct Material {
                                           float ior = 1.5f);
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -2,7 +2,7 @@
 
 #include "raytrace_core/scene/microfacet.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 GgxDistribution::GgxDistribution(float alpha)
     : alpha_(alpha >= kMinGgxAlpha ? std::min(alpha, 1.0f) : (alpha < kMinGgxAlpha ? kMinGgxAlpha : 1.0f)) {}
@@ -52,4 +52,4 @@ Vec3 GgxDistribution::sample_visible(const Vec3& wo, Vec2 u) const {
   return glm::normalize(Vec3(alpha_ * n_h.x, alpha_ * n_h.y, std::max(1e-6f, n_h.z)));
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -19,7 +19,7 @@
 
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// Smallest α the distribution is evaluated with. Below it D's peak (1/πα²) overflows what a
 /// float path weight can carry usefully; a glTF roughness of 0.03 (α = 1e-3) is already a mirror
@@ -68,4 +68,4 @@ inline float schlick_weight(float cos_theta) {
   return m2 * m2 * m;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -4,7 +4,7 @@
 
 #include "raytrace_core/scene/scene.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 namespace {
 
@@ -79,4 +79,4 @@ Vec3 height_normal(float dh_ds, float dh_dup, float scale) {
   return glm::normalize(Vec3(-scale * dh_ds, -scale * dh_dup, 1.0f));
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -16,7 +16,7 @@
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/scene/texture.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 struct TriangleMesh;
 
@@ -38,4 +38,4 @@ Vec3 decode_normal_texel(const Rgb& texel, float scale);
 /// range over each texel width make a 45° slope.
 Vec3 height_normal(float dh_ds, float dh_dup, float scale);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 namespace {
 
@@ -49,4 +49,4 @@ Ray spawn_shadow_ray(const SurfacePoint& from, const Vec3& to) {
   return {origin, to - origin, 1.0f - kShadowEpsilon};
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -10,7 +10,7 @@
 
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// A ray origin + t·direction for t in (0, tmax]. The direction need not be normalised.
 struct Ray {
@@ -50,4 +50,4 @@ inline Ray spawn_shadow_ray_to_infinity(const SurfacePoint& from, const Vec3& di
   return spawn_ray(from, direction);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

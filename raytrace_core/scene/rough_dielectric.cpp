@@ -13,7 +13,7 @@
 
 #include "raytrace_core/scene/microfacet.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 bool valid_ior(float eta) { return eta > 0.0f && std::isfinite(eta); }
@@ -130,4 +130,4 @@ std::optional<BsdfSample> rough_dielectric_sample(const Material& m, const Vec3&
   return s;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

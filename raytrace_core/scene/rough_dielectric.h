@@ -26,7 +26,7 @@
 
 #include "raytrace_core/scene/bsdf.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// f(wo, wi) of a rough dielectric (m.kind == dielectric, roughness above the smooth limit).
 Rgb rough_dielectric_eval(const Material& m, const Vec3& wo, const Vec3& wi, TransportMode mode);
@@ -38,4 +38,4 @@ float rough_dielectric_pdf(const Material& m, const Vec3& wo, const Vec3& wi);
 std::optional<BsdfSample> rough_dielectric_sample(const Material& m, const Vec3& wo, float u_lobe, Vec2 u,
                                                   TransportMode mode);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -20,7 +20,7 @@
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/scene/normal_map.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 std::string embree_error_message(RTCError code) {
@@ -484,7 +484,7 @@ void Scene::commit() {
   committed_ = true;  // light_power needs bounds and geometry queries
   std::vector<float> power(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) power[i] = light_power(*this, lights_[i]).average();
-  light_distribution_ = Distribution1D(power);
+  light_distribution_ = util::Distribution1D(power);
   light_sampler_ = LightSampler(*this, lights_, power);
 }
 
@@ -545,7 +545,7 @@ bool nearest_triangle_callback(RTCPointQueryFunctionArguments* args) {
   const Vec3 normal = glm::cross(b - a, c - a);
   const float length = glm::length(normal);
   if (!(length > 0.0f) || !(glm::dot(normal, q->n) > q->min_cosine * length)) return false;
-  const Vec2 uv = closest_point_on_triangle(q->p, a, b, c);
+  const Vec2 uv = util::closest_point_on_triangle(q->p, a, b, c);
   const Vec3 x = (1.0f - uv.x - uv.y) * a + uv.x * b + uv.y * c;
   const float d2 = glm::dot(x - q->p, x - q->p);
   if (d2 > q->best_distance2 || (d2 == q->best_distance2 && args->primID > q->best.prim_id)) return false;
@@ -805,4 +805,4 @@ Camera Scene::effective_camera(float aspect) const {
 
 void* Scene::embree_scene() const { return impl_->scene; }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -22,7 +22,7 @@
 #include "raytrace_core/scene/ray.h"
 #include "raytrace_core/util/sampling.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// Where a mesh came from in the model file it was read from, so that results computed on the
 /// scene (baked colours) can be written back onto that file's own vertices.
@@ -151,7 +151,7 @@ class Scene {
   /// visit every emitting triangle to find them.
   std::span<const uint32_t> environment_lights() const { return environment_lights_; }
   /// Light chosen with probability proportional to its power: where photons start.
-  const Distribution1D& light_distribution() const { return light_distribution_; }
+  const util::Distribution1D& light_distribution() const { return light_distribution_; }
   /// Light chosen for a point to be lit (next-event estimation), and its probability for MIS.
   const LightSampler& light_sampler() const { return light_sampler_; }
   /// How light_sampler() chooses: by the light BVH (default) or by power alone. Set before rendering.
@@ -203,7 +203,7 @@ class Scene {
   std::unique_ptr<Impl> impl_;
   std::vector<Light> lights_;
   std::vector<uint32_t> environment_lights_;
-  Distribution1D light_distribution_;
+  util::Distribution1D light_distribution_;
   LightSampler light_sampler_;
   Bounds3 bounds_;
   bool committed_ = false;
@@ -212,4 +212,4 @@ class Scene {
   std::unique_ptr<TextureSet> texture_set_;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -18,7 +18,7 @@
 
 #include "raytrace_core/util/error.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 struct Perez {
@@ -86,4 +86,4 @@ std::shared_ptr<const EnvironmentMap> preetham_sky(const Vec3& to_sun, float tur
   return std::make_shared<const EnvironmentMap>(width, height, std::move(texels));
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

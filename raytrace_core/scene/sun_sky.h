@@ -13,7 +13,7 @@
 #include "raytrace_core/scene/environment_map.h"
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// Unit direction towards a point at `elevation_degrees` above the horizon and azimuth
 /// `azimuth_degrees` (see above).
@@ -28,4 +28,4 @@ inline constexpr float kSunAngularRadiusDegrees = 0.2665f;
 /// the ground belongs to the scene. Throws InputError for a turbidity outside [1.7, 10].
 std::shared_ptr<const EnvironmentMap> preetham_sky(const Vec3& to_sun, float turbidity, int width = 512);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -12,7 +12,7 @@
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/sampling.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 namespace fs = std::filesystem;
 
@@ -187,7 +187,7 @@ Texel TextureSet::triangle_mean(int32_t image, Vec2 a, Vec2 b, Vec2 c) const {
   for (int i = 0; i < kSide; ++i)
     for (int j = 0; j < kSide; ++j) {
       // The centres of kSide² strata, mapped onto the triangle by area.
-      const Vec2 w = sample_uniform_triangle({(i + 0.5f) / kSide, (j + 0.5f) / kSide});
+      const Vec2 w = util::sample_uniform_triangle({(i + 0.5f) / kSide, (j + 0.5f) / kSide});
       const Texel t = lookup(image, (1.0f - w.x - w.y) * a + w.x * b + w.y * c, dx, dy);
       sum += t.rgb;
       alpha += t.alpha;
@@ -196,4 +196,4 @@ Texel TextureSet::triangle_mean(int32_t image, Vec2 a, Vec2 b, Vec2 c) const {
   return Texel{sum * inv, alpha * inv};
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

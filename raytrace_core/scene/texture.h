@@ -23,7 +23,7 @@
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/util/rgb.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 
 /// What happens outside [0, 1] along one texture axis (glTF's sampler wrap modes).
 enum class TextureWrap : uint8_t { repeat, clamp, mirror };
@@ -92,4 +92,4 @@ class TextureSet {
 /// $XDG_CACHE_HOME/gilt/textures, else ~/.cache/gilt/textures, else the system's temporary folder.
 std::string texture_cache_folder();
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

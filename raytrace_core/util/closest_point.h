@@ -4,7 +4,7 @@
 
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Barycentrics (b1, b2) of the second and third vertex of the point of triangle (a, b, c)
 /// nearest to p; the point is (1 − b1 − b2)·a + b1·b + b2·c. Degenerate triangles give a
@@ -33,4 +33,4 @@ inline Vec2 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& 
   return Vec2(vb / sum, vc / sum);              // interior
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

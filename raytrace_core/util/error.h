@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Bad user input (a file, a flag, a number). The message names the file and, where known, the
 /// line or field, e.g. "scene.obj:12: face refers to vertex 40 of 12".
@@ -20,4 +20,7 @@ class Interrupted : public std::runtime_error {
   Interrupted() : std::runtime_error("interrupted") {}
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util
+
+// The parent namespace re-exports these names (rc::Vec3, rc::Rgb, rc::InputError ...).
+#include "raytrace_core/util/vocabulary.h"

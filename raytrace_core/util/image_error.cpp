@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 ImageError image_error(std::span<const Rgb> image, std::span<const Rgb> reference) {
   return image_error(image, reference, {});
@@ -64,4 +64,4 @@ std::vector<Rgb> reference_variance(std::span<const Rgb> a, std::span<const Rgb>
   return v;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

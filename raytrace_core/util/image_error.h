@@ -7,7 +7,7 @@
 
 #include "raytrace_core/util/rgb.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Errors of an image against a reference of the same size, over pixels and channels.
 ///
@@ -58,4 +58,4 @@ inline double mean_relative_error(std::span<const Rgb> image, std::span<const Rg
   return image_error(image, reference).mean_relative;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -31,7 +31,7 @@
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/staged_file.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 namespace fs = std::filesystem;
 
@@ -206,4 +206,4 @@ Image read_image(const std::string& path) {
   return image;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -7,7 +7,7 @@
 
 #include "raytrace_core/util/rgb.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// A linear RGB float image, row-major from the top-left.
 struct Image {
@@ -28,4 +28,4 @@ void write_image(const std::string& path, const Image& image, float exposure = 0
 /// Throws InputError naming the file when it cannot be read.
 Image read_image(const std::string& path);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -7,7 +7,7 @@
 
 #include <glm/glm.hpp>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 using Vec2 = glm::vec2;
 using Vec3 = glm::vec3;
@@ -66,4 +66,7 @@ struct Bounds3 {
   float radius() const { return empty() ? 0.0f : 0.5f * glm::length(diagonal()); }
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util
+
+// The parent namespace re-exports these names (rc::Vec3, rc::Rgb, rc::InputError ...).
+#include "raytrace_core/util/vocabulary.h"

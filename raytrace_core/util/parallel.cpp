@@ -17,7 +17,7 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Holds the TBB control object that caps the parallelism while it lives.
 struct ThreadLimitImpl {
@@ -76,4 +76,4 @@ bool stop_requested() noexcept { return stop_flag.load(std::memory_order_relaxed
 
 int hardware_threads() { return tbb::info::default_concurrency(); }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

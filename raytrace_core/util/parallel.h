@@ -5,7 +5,7 @@
 #include <functional>
 #include <memory>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Caps the worker threads for its lifetime (0 = all hardware threads). Results never depend on
 /// the count: work items are seeded by index, not by thread.
@@ -40,4 +40,4 @@ bool stop_requested() noexcept;
 /// Number of hardware threads available.
 int hardware_threads();
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

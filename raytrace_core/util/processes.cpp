@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 std::shared_ptr<const Processes>& installed() {
@@ -31,4 +31,4 @@ void set_processes(std::shared_ptr<const Processes> processes) {
   installed() = processes ? std::move(processes) : std::make_shared<const Processes>();
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -20,7 +20,7 @@
 
 #include "raytrace_core/util/parallel.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// The processes of a run and the collective operations the libraries use. Every process must
 /// call each operation, in the same order.
@@ -159,4 +159,4 @@ void distributed_chunks(std::vector<std::vector<T>>& chunks, const std::function
   join_chunks(chunks);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

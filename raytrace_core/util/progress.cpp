@@ -15,7 +15,7 @@
 #include <string>
 #include <utility>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 namespace {
 
@@ -127,4 +127,4 @@ void Progress::draw(bool final_draw) {
   std::fflush(stderr);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -8,7 +8,7 @@
 #include <mutex>
 #include <string>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Thread-safe progress reporting for `total` units of work.
 class Progress {
@@ -37,4 +37,4 @@ class Progress {
   std::mutex draw_mutex_;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Linear Rec.709 RGB triple: radiance (W·sr⁻¹·m⁻²), reflectance, power (W) or any other
 /// spectral quantity. Never a position or direction.
@@ -53,4 +53,7 @@ inline Rgb clamp(const Rgb& c, float lo, float hi) {
   return {std::clamp(c.r, lo, hi), std::clamp(c.g, lo, hi), std::clamp(c.b, lo, hi)};
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util
+
+// The parent namespace re-exports these names (rc::Vec3, rc::Rgb, rc::InputError ...).
+#include "raytrace_core/util/vocabulary.h"

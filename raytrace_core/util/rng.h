@@ -7,7 +7,7 @@
 
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// SplitMix64 finaliser: a bijective 64-bit hash used to derive independent seeds.
 constexpr uint64_t mix64(uint64_t x) {
@@ -54,4 +54,4 @@ class Rng {
   uint64_t state_ = 0, inc_ = 0;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

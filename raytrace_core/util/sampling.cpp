@@ -8,7 +8,7 @@
 
 #include <algorithm>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 Vec2 sample_uniform_disk(Vec2 u) {
   // Map to [-1, 1]², then send each concentric square to the circle of the same "radius"; the
@@ -108,4 +108,4 @@ uint32_t Distribution1D::sample(float u, float& remapped) const {
   return i;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -7,7 +7,7 @@
 
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Point on the unit disk, Shirley–Chiu concentric map (area-preserving, low distortion).
 Vec2 sample_uniform_disk(Vec2 u);
@@ -61,4 +61,4 @@ class Distribution1D {
   float total_ = 0.0f;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

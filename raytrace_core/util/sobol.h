@@ -9,7 +9,7 @@
 
 #include <cstdint>
 
-namespace gilt::raytrace_core::sobol {
+namespace gilt::raytrace_core::util::sobol {
 
 /// The bits of x in reverse order (a byte swap, then the bits within each byte).
 constexpr uint32_t reverse_bits(uint32_t x) {
@@ -66,4 +66,4 @@ constexpr uint32_t dimension1(uint32_t index) {
 /// 24 digits: exact in a float, and never rounded up to 1.
 inline float to_unit_float(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
 
-}  // namespace gilt::raytrace_core::sobol
+}  // namespace gilt::raytrace_core::util::sobol

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 /// The component of `v` orthogonal to unit `w`, normalised (zero when v is along w).
@@ -67,4 +67,4 @@ DVec3 SphericalTriangle::sample(Vec2 u) const {
   return glm::normalize(w);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -9,7 +9,7 @@
 
 #include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// The triangle (a, b, c) as seen from a point: its corners as unit directions, and what Arvo's
 /// construction needs of the spherical triangle they span. Computed in double: the construction
@@ -42,4 +42,4 @@ double triangle_solid_angle(const DVec3& a, const DVec3& b, const DVec3& c);
 /// The same test decides for sampling and for the MIS density, so the two always match.
 inline bool samples_by_solid_angle(double omega) { return omega > 1e-4 && omega < 6.2; }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -13,7 +13,7 @@
 
 #include "raytrace_core/util/error.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace fs = std::filesystem;
 namespace {
 
@@ -71,4 +71,4 @@ void StagedFile::fail(int error, bool remove_temporary) {
   throw InputError("cannot write '" + destination_.string() + "': " + std::generic_category().message(error));
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string_view>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 
 /// Bytes staged in a hidden temporary beside `destination` (same folder, same extension). The
 /// destination is untouched until commit(); an uncommitted temporary is removed on destruction.
@@ -26,4 +26,4 @@ class StagedFile {
   std::filesystem::path destination_, temporary_;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

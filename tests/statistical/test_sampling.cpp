@@ -13,7 +13,7 @@
 #include "raytrace_core/util/sampling.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 using test::chi2_directions;
@@ -230,4 +230,4 @@ TEST(Distribution1D, NegativeAndNanWeightsCountAsZero) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -21,7 +21,7 @@
 
 #include "raytrace_core/util/error.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 namespace fs = std::filesystem;
@@ -286,4 +286,4 @@ TEST_F(ImageIoTest, ReadsTheFirstThreeOfFourChannels) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

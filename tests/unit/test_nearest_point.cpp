@@ -25,11 +25,11 @@ Vec3 at(const Vec3& a, const Vec3& b, const Vec3& c, Vec2 uv) { return (1.0f - u
 // point of the triangle, so brute force overestimates the true distance d by at most h; the
 // closed form must never be farther than the grid's best, and never nearer than d − h.
 TEST(NearestPoint, ClosestPointOnTriangleMatchesAGrid) {
-  rc::Rng rng(3);
+  rc::util::Rng rng(3);
   for (int trial = 0; trial < 300; ++trial) {
     auto random_point = [&] { return Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0f - 2.0f; };
     const Vec3 a = random_point(), b = random_point(), c = random_point(), p = random_point() * 2.0f;
-    const Vec2 uv = rc::closest_point_on_triangle(p, a, b, c);
+    const Vec2 uv = rc::util::closest_point_on_triangle(p, a, b, c);
     ASSERT_GE(uv.x, -1e-6f);
     ASSERT_GE(uv.y, -1e-6f);
     ASSERT_LE(uv.x + uv.y, 1.0f + 1e-5f);
@@ -49,10 +49,10 @@ TEST(NearestPoint, ClosestPointOnTriangleMatchesAGrid) {
 // facing test; the two must agree on the distance (to float rounding) and, but for exact ties,
 // on the triangle.
 TEST(NearestPoint, SceneQueryMatchesALinearScan) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
-  rc::Rng rng(5);
-  rc::TriangleMesh mesh;
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+  rc::util::Rng rng(5);
+  rc::scene::TriangleMesh mesh;
   for (int t = 0; t < 400; ++t) {
     const Vec3 c(rng.uniform() * 10 - 5, rng.uniform() * 10 - 5, rng.uniform() * 10 - 5);
     for (int k = 0; k < 3; ++k) {
@@ -63,11 +63,11 @@ TEST(NearestPoint, SceneQueryMatchesALinearScan) {
   scene.meshes.push_back(mesh);
   scene.spheres.push_back({Vec3(0.0f), 1.0f, 0});  // other geometry is never returned
   scene.commit();
-  const rc::TriangleMesh& m = scene.meshes[0];
+  const rc::scene::TriangleMesh& m = scene.meshes[0];
   int found = 0;
   for (int i = 0; i < 3000; ++i) {
     const Vec3 p(rng.uniform() * 12 - 6, rng.uniform() * 12 - 6, rng.uniform() * 12 - 6);
-    const Vec3 n = rc::sample_uniform_sphere(rng.uniform2());
+    const Vec3 n = rc::util::sample_uniform_sphere(rng.uniform2());
     const float radius = 0.2f + 2.0f * rng.uniform();
     const float min_cosine = i % 3 == 0 ? -2.0f : 0.5f;  // every third query accepts any facing
     float best = radius;
@@ -77,7 +77,7 @@ TEST(NearestPoint, SceneQueryMatchesALinearScan) {
                  &c = m.positions[m.indices[3 * t + 2]];
       const Vec3 normal = glm::normalize(glm::cross(b - a, c - a));
       if (!(glm::dot(normal, n) > min_cosine)) continue;
-      const float d = glm::length(at(a, b, c, rc::closest_point_on_triangle(p, a, b, c)) - p);
+      const float d = glm::length(at(a, b, c, rc::util::closest_point_on_triangle(p, a, b, c)) - p);
       if (d < best) best = d, best_t = int(t);
     }
     const auto hit = scene.nearest_triangle(0, p, radius, n, min_cosine);

@@ -10,7 +10,7 @@
 #include "raytrace_core/util/rng.h"
 #include "raytrace_core/util/spherical_triangle.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 /// The spherical excess α + β + γ − π of the triangle spanned by the directions a, b, c (Girard's
@@ -61,4 +61,4 @@ TEST(SphericalTriangle, SolidAngleAndSamplesAgreeWithTheTriangle) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util
