@@ -14,11 +14,11 @@
 
 #include "api/methods.h"
 #include "photonmap/photon_map.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/io/staged_file.h"
-#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/util/staged_file.h"
+#include "raytrace_core/render/path_tracer.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;
@@ -40,20 +40,20 @@ struct Hasher {
 
 /// A key for the loaded scene's content (geometry, materials, lights), the camera and the
 /// reference's settings: a second compare of the same thing reuses the reference.
-std::string reference_key(const rc::Scene& scene, const rc::Camera& camera, const CompareSettings& o,
-                          const std::string& method) {
+std::string reference_key(const rc::scene::Scene& scene, const rc::scene::Camera& camera,
+                          const CompareSettings& o, const std::string& method) {
   Hasher k;
   const std::string version = "gilt-reference-5";  // 4: halves drawn with the Sobol sampler; 5: the light BVH
   k.bytes(version.data(), version.size());
   k.bytes(method.data(), method.size());
-  for (const rc::TriangleMesh& m : scene.meshes) k.vector(m.positions), k.vector(m.indices), k.vector(m.normals), k.value(m.material);
-  for (const rc::Sphere& s : scene.spheres) k.value(s);
-  for (const rc::Material& m : scene.materials) {
+  for (const rc::scene::TriangleMesh& m : scene.meshes) k.vector(m.positions), k.vector(m.indices), k.vector(m.normals), k.value(m.material);
+  for (const rc::scene::Sphere& s : scene.spheres) k.value(s);
+  for (const rc::scene::Material& m : scene.materials) {
     k.value(m.kind), k.value(m.albedo), k.value(m.emission), k.value(m.specular), k.value(m.exponent), k.value(m.ior);
     k.value(m.absorption), k.value(m.two_sided_emission), k.value(m.metallic), k.value(m.roughness);
     k.value(m.transmission_tint), k.value(m.thin_walled);
   }
-  for (const rc::Light& l : scene.punctual_lights) {
+  for (const rc::scene::Light& l : scene.punctual_lights) {
     k.value(l.kind), k.value(l.position), k.value(l.direction), k.value(l.intensity), k.value(l.irradiance);
     k.value(l.radiance), k.value(l.cos_inner), k.value(l.cos_outer);
     if (l.map) k.value(l.map->width()), k.value(l.map->rotate_degrees()), k.vector(l.map->texels());
@@ -84,10 +84,11 @@ struct Reference {
   double noise = 0.0;
 };
 
-Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const CompareSettings& o) {
+Reference make_reference(const rc::scene::Scene& scene, const rc::scene::Camera& camera,
+                         const CompareSettings& o) {
   Reference ref;
   if (!o.reference_file.empty()) {
-    const rc::Image image = rc::read_image(o.reference_file);
+    const rc::util::Image image = rc::util::read_image(o.reference_file);
     if (image.width != o.width || image.height != o.height)
       throw rc::InputError("--reference " + o.reference_file + ": " + std::to_string(image.width) + "x" +
                            std::to_string(image.height) + " does not match the report's " + std::to_string(o.width) +
@@ -114,7 +115,8 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   const fs::path variance_exr = folder / ("reference-" + key + "-variance.exr");
   if (!folder.empty() && fs::exists(exr) && fs::exists(meta) && fs::exists(variance_exr)) {
     try {
-      const rc::Image image = rc::read_image(exr.string()), variance = rc::read_image(variance_exr.string());
+      const rc::util::Image image = rc::util::read_image(exr.string()),
+                            variance = rc::util::read_image(variance_exr.string());
       const nlohmann::json j = nlohmann::json::parse(std::ifstream(meta));
       if (image.width == o.width && image.height == o.height && variance.width == o.width &&
           variance.height == o.height) {
@@ -130,33 +132,33 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
   }
   // Two independent halves: their difference measures the reference's own noise (for SPPM its
   // noise alone: the blur of its shrinking radius is the same in both halves).
-  rc::RenderSettings s;
+  rc::render::RenderSettings s;
   s.width = o.width, s.height = o.height, s.threads = o.threads, s.progress = o.progress;
   s.time_limit = o.reference_time / 2.0;
-  const rc::PathSettings path;
-  auto half = [&](uint64_t seed, rc::RenderStats& stats) {
+  const rc::render::PathSettings path;
+  auto half = [&](uint64_t seed, rc::render::RenderStats& stats) {
     s.seed = seed;
     if (method == "sppm") {
       MethodResult result = run_method(scene, camera, method, s, MethodOptions{});
       stats = result.stats;
       return result.film.pixels();
     }
-    return rc::render_image(scene, camera, s,
-                            [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); },
+    return rc::render::render_image(scene, camera, s,
+                            [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); },
                             &stats)
         .pixels();
   };
   if (o.progress) std::fprintf(stderr, "gilt compare: %s reference, %.0f s\n", method.c_str(), o.reference_time);
-  rc::RenderStats sa, sb;
+  rc::render::RenderStats sa, sb;
   const std::vector<rc::Rgb> a = half(o.seed ^ 0x5eed0001ull, sa), b = half(o.seed ^ 0x5eed0002ull, sb);
   const float wa = float(sa.spp) / float(sa.spp + sb.spp);
   ref.pixels.resize(a.size());
   for (size_t i = 0; i < a.size(); ++i) ref.pixels[i] = a[i] * wa + b[i] * (1.0f - wa);
   // Each half carries about √2 times the noise of the mean: halve their mutual error.
-  ref.noise = 0.5 * rc::mean_relative_error(a, b);
+  ref.noise = 0.5 * rc::util::mean_relative_error(a, b);
   // Its variance per pixel, when both halves got samples (a budget too short for one leaves the
   // noise unknown, and the errors uncorrected).
-  if (wa > 0.0f && wa < 1.0f) ref.variance = rc::reference_variance(a, b, wa);
+  if (wa > 0.0f && wa < 1.0f) ref.variance = rc::util::reference_variance(a, b, wa);
   ref.description = (method == "sppm" ? "SPPM, " + std::to_string(sa.spp + sb.spp) + " iterations in "
                                        : "path tracer, " + std::to_string(sa.spp + sb.spp) + " spp in ") +
                     std::to_string(int(std::lround(sa.seconds + sb.seconds))) + " s" + why;
@@ -164,9 +166,10 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
     std::error_code ec;
     fs::create_directories(folder, ec);
     try {
-      rc::write_image(exr.string(), rc::Image{o.width, o.height, ref.pixels});
-      if (!ref.variance.empty()) rc::write_image(variance_exr.string(), rc::Image{o.width, o.height, ref.variance});
-      rc::StagedFile m(meta, nlohmann::json{{"noise", ref.noise}, {"description", ref.description}}.dump());
+      rc::util::write_image(exr.string(), rc::util::Image{o.width, o.height, ref.pixels});
+      if (!ref.variance.empty()) rc::util::write_image(variance_exr.string(), rc::util::Image{o.width, o.height, ref.variance});
+      rc::util::StagedFile m(meta,
+                             nlohmann::json{{"noise", ref.noise}, {"description", ref.description}}.dump());
       m.commit();
     } catch (const std::exception& e) {
       std::cerr << "gilt: warning: could not cache the reference in " << folder.string() << ": " << e.what() << "\n";
@@ -176,7 +179,7 @@ Reference make_reference(const rc::Scene& scene, const rc::Camera& camera, const
 }
 
 void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const Reference& ref) {
-  const rc::ImageError error = rc::image_error(image, ref.pixels, ref.variance);
+  const rc::util::ImageError error = rc::util::image_error(image, ref.pixels, ref.variance);
   e.rmse = error.rmse, e.relmse = error.relmse, e.mae = error.mae, e.mre = error.mean_relative;
   e.mean_ratio = error.mean_ratio;
   e.relmse_stderr = error.relmse_stderr;
@@ -186,30 +189,31 @@ void fill_errors(ReportEntry& e, const std::vector<rc::Rgb>& image, const Refere
 /// Radiosity against the path tracer in object space: at up to 64 element centroids (where the
 /// Gouraud value is the element's mean), outgoing radiance Le + ρE/π with E from 1,024
 /// cosine-distributed path-traced samples, mean |L_radiosity − L_path| / (L_path + 0.01).
-double object_space_error(const rc::Scene& scene, const radiosity::solver::Solution& sol, uint64_t seed) {
+double object_space_error(const rc::scene::Scene& scene, const radiosity::solver::Solution& sol,
+                          uint64_t seed) {
   const size_t ne = sol.mesh.element_count();
   if (ne == 0) return 0.0;
   const size_t stride = std::max<size_t>(1, ne / 64);
-  const rc::PathSettings path;
+  const rc::render::PathSettings path;
   double sum = 0.0;
   size_t count = 0;
   for (size_t e = 0; e < ne; e += stride) {
     const auto& el = sol.mesh.elements[e];
     const rc::Vec3 p = (sol.mesh.positions[el[0]] + sol.mesh.positions[el[1]] + sol.mesh.positions[el[2]]) / 3.0f;
     const rc::Vec3 n = sol.mesh.element_normal[e];
-    rc::SurfacePoint at;
+    rc::scene::SurfacePoint at;
     at.p = p;
-    at.p_error = rc::error_gamma(16) * rc::abs(p);
+    at.p_error = rc::scene::error_gamma(16) * rc::abs(p);
     at.ng = n;
     const rc::Frame frame = rc::Frame::from_normal(n);
     rc::Rgb incoming(0.0f);
     constexpr int kSamples = 1024;
     for (int i = 0; i < kSamples; ++i) {
-      rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(seed, e, uint64_t(i))), 0};
-      const rc::Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(ctx.sampler.uniform2()));
-      incoming += rc::path_radiance(scene, rc::spawn_ray(at, w), ctx, path);
+      rc::render::SampleContext ctx{rc::render::Sampler(rc::util::Rng::for_item(seed, e, uint64_t(i))), 0};
+      const rc::Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(ctx.sampler.uniform2()));
+      incoming += rc::render::path_radiance(scene, rc::scene::spawn_ray(at, w), ctx, path);
     }
-    const rc::Material& m = scene.materials[sol.mesh.element_material[e]];
+    const rc::scene::Material& m = scene.materials[sol.mesh.element_material[e]];
     const rc::Rgb reference = m.emission + m.albedo * incoming / float(kSamples);  // ρ/π · π · mean L
     const rc::Rgb solved = sol.element_radiosity[e] * rc::kInvPi;
     for (int c = 0; c < 3; ++c) sum += std::abs(solved[c] - reference[c]) / (reference[c] + 0.01);
@@ -233,7 +237,7 @@ void write_error_png(const fs::path& file, const std::vector<rc::Rgb>& image, co
     error_colour(e / 3.0, rgb);
     colours[i] = rc::Rgb(linear(rgb[0]), linear(rgb[1]), linear(rgb[2]));
   }
-  rc::write_image(file.string(), rc::Image{w, h, colours});
+  rc::util::write_image(file.string(), rc::util::Image{w, h, colours});
 }
 
 std::string budget_name(double b) {
@@ -245,7 +249,7 @@ std::string budget_name(double b) {
 /// Restores the scene's light sampling when the comparison ends, however it ends.
 class LightSamplingScope {
  public:
-  LightSamplingScope(rc::Scene& scene, rc::LightSampling mode)
+  LightSamplingScope(rc::scene::Scene& scene, rc::scene::LightSampling mode)
       : scene_(scene), saved_(scene.light_sampler().mode()) {
     scene_.set_light_sampling(mode);
   }
@@ -254,8 +258,8 @@ class LightSamplingScope {
   LightSamplingScope& operator=(const LightSamplingScope&) = delete;
 
  private:
-  rc::Scene& scene_;
-  rc::LightSampling saved_;
+  rc::scene::Scene& scene_;
+  rc::scene::LightSampling saved_;
 };
 
 /// A time budget gilt accepts: more than nothing, at most a day.
@@ -301,8 +305,8 @@ void check_settings(const CompareSettings& o) {
     if (!std::isfinite(o.reference_time) || !(o.reference_time >= 0.1) || o.reference_time > 1e6)
       throw rc::InputError("--reference-time: from 0.1 to 1e6 seconds");
   }
-  rc::parse_sampler(o.sampler);
-  rc::parse_light_sampling(o.light_sampler);
+  rc::render::parse_sampler(o.sampler);
+  rc::scene::parse_light_sampling(o.light_sampler);
   if (!std::isfinite(o.exposure)) throw rc::InputError("--exposure: must be a finite number");
   if (o.threads < 0) throw rc::InputError("--threads: 0 (all) or more");
   if (!o.output.empty()) {
@@ -314,13 +318,13 @@ void check_settings(const CompareSettings& o) {
   }
 }
 
-Report compare_methods(rc::Scene& scene, const CompareSettings& given,
+Report compare_methods(rc::scene::Scene& scene, const CompareSettings& given,
                        const std::function<void(const ReportEntry&)>& each) {
   CompareSettings o = given;
   check_settings(o);
   std::sort(o.budgets.begin(), o.budgets.end());
   o.budgets.erase(std::unique(o.budgets.begin(), o.budgets.end()), o.budgets.end());
-  const rc::Camera camera = scene.effective_camera(float(o.width) / float(std::max(o.height, 1)));
+  const rc::scene::Camera camera = scene.effective_camera(float(o.width) / float(std::max(o.height, 1)));
   const Reference ref = make_reference(scene, camera, o);
 
   const fs::path& folder = o.output;
@@ -331,11 +335,12 @@ Report compare_methods(rc::Scene& scene, const CompareSettings& given,
   report.width = o.width, report.height = o.height, report.exposure = o.exposure;
   report.sampler = o.sampler;
   report.light_sampler = o.light_sampler;
-  const LightSamplingScope sampling(scene, rc::parse_light_sampling(o.light_sampler));  // after the reference
+  const LightSamplingScope sampling(scene,
+                                    rc::scene::parse_light_sampling(o.light_sampler));  // after the reference
   report.reference = ref.description;
   report.reference_noise_mre = ref.noise;
   if (!ref.variance.empty()) {
-    const rc::ImageError floor = rc::image_error(ref.pixels, ref.pixels, ref.variance);
+    const rc::util::ImageError floor = rc::util::image_error(ref.pixels, ref.pixels, ref.variance);
     report.reference_relmse_floor = floor.relmse_floor;
     report.reference_mse_floor = floor.mse_floor;
   }
@@ -343,13 +348,14 @@ Report compare_methods(rc::Scene& scene, const CompareSettings& given,
   report.budgets = o.budgets;
   if (files) {
     report.reference_png = "images/reference.png";
-    rc::write_image((folder / "images/reference.exr").string(), rc::Image{o.width, o.height, ref.pixels});
-    rc::write_image((folder / report.reference_png).string(), rc::Image{o.width, o.height, ref.pixels}, o.exposure);
+    rc::util::write_image((folder / "images/reference.exr").string(),
+                          rc::util::Image{o.width, o.height, ref.pixels});
+    rc::util::write_image((folder / report.reference_png).string(), rc::util::Image{o.width, o.height, ref.pixels}, o.exposure);
   }
 
-  rc::RenderSettings settings;
+  rc::render::RenderSettings settings;
   settings.width = o.width, settings.height = o.height, settings.seed = o.seed, settings.threads = o.threads;
-  settings.sampler = rc::parse_sampler(o.sampler);
+  settings.sampler = rc::render::parse_sampler(o.sampler);
   // Each method's run reports its own stages (the budgets run minutes in all).
   settings.progress = o.progress;
   for (double budget : o.budgets) {
@@ -375,8 +381,9 @@ Report compare_methods(rc::Scene& scene, const CompareSettings& given,
       if (files) {
         const std::string stem = "images/" + m + "_" + budget_name(budget);
         e.image_exr = stem + ".exr", e.image_png = stem + ".png", e.error_png = stem + "_error.png";
-        rc::write_image((folder / e.image_exr).string(), rc::Image{o.width, o.height, pixels});
-        rc::write_image((folder / e.image_png).string(), rc::Image{o.width, o.height, pixels}, o.exposure);
+        rc::util::write_image((folder / e.image_exr).string(), rc::util::Image{o.width, o.height, pixels});
+        rc::util::write_image((folder / e.image_png).string(), rc::util::Image{o.width, o.height, pixels},
+                              o.exposure);
         write_error_png(folder / e.error_png, pixels, ref.pixels, o.width, o.height);
       }
       report.entries.push_back(e);

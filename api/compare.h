@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "api/report.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::api {
 
@@ -48,7 +48,7 @@ void check_settings(const CompareSettings& settings);
 /// Runs the comparison. The settings are checked before any rendering. `each` is called after every
 /// entry, in the report's order. The scene's light sampling is set to `light_sampler` for the
 /// methods and restored before returning.
-Report compare_methods(raytrace_core::Scene& scene, const CompareSettings& settings,
+Report compare_methods(raytrace_core::scene::Scene& scene, const CompareSettings& settings,
                        const std::function<void(const ReportEntry&)>& each = {});
 
 }  // namespace gilt::api

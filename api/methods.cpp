@@ -6,10 +6,10 @@
 
 #include "radiosity/solver/budget.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/whitted.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/whitted.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;
@@ -23,7 +23,8 @@ void PhotonOptions::apply(MethodOptions& mo) const {
   mo.sppm.alpha = alpha;
 }
 
-std::pair<int, int> image_size(const rc::Scene& scene, std::optional<int> width, std::optional<int> height) {
+std::pair<int, int> image_size(const rc::scene::Scene& scene, std::optional<int> width,
+                               std::optional<int> height) {
   for (const std::optional<int>& v : {width, height})
     if (v && (*v < 1 || *v > 65536)) throw rc::InputError("image width and height: from 1 to 65536 pixels");
   const double aspect = double(scene.render.width) / double(std::max(scene.render.height, 1));
@@ -32,16 +33,17 @@ std::pair<int, int> image_size(const rc::Scene& scene, std::optional<int> width,
   return {std::clamp(w, 1, 65536), std::clamp(h, 1, 65536)};
 }
 
-MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const std::string& method,
-                        const rc::RenderSettings& base, const MethodOptions& options) {
+MethodResult run_method(const rc::scene::Scene& scene, const rc::scene::Camera& camera,
+                        const std::string& method, const rc::render::RenderSettings& base,
+                        const MethodOptions& options) {
   if (std::find(kMethods.begin(), kMethods.end(), method) == kMethods.end())
     throw rc::InputError("--method " + method + ": expected path, whitted, radiosity, photon or sppm");
   if (base.width <= 0 || base.height <= 0) throw rc::InputError("image size must be positive");
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  rc::RenderSettings settings = base;
+  rc::render::RenderSettings settings = base;
   MethodResult result;
-  rc::RadianceFunction radiance;
+  rc::render::RadianceFunction radiance;
   std::optional<radiosity::bake::RadiosityView> view;
   std::optional<photonmap::PhotonMapper> mapper;
   // What is left of a time budget after the preparation: at least one pass gets rendered.
@@ -50,7 +52,7 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
   // A scene that emits nothing is black whatever the method: the image is made at once rather
   // than after the samples or the time budget have been spent tracing it.
   if (scene.lights().empty()) {
-    result.film = rc::Film(base.width, base.height);
+    result.film = rc::render::Film(base.width, base.height);
     result.notes.push_back("nothing traced: without lights the image is black in every method");
     return result;
   }
@@ -74,12 +76,14 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
     if (base.time_limit > 0.0) pm.photons.global_seconds = 0.1 * base.time_limit;
     if (options.max_depth > 0) pm.max_depth = pm.photons.max_depth = options.max_depth;
     {
-      const rc::ThreadLimit limit(settings.threads);
+      const rc::util::ThreadLimit limit(settings.threads);
       mapper.emplace(scene, pm);
     }
     result.photon = mapper->stats();
     result.notes = mapper->stats().skipped;
-    radiance = [&mapper](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper->radiance(ray, ctx); };
+    radiance = [&mapper](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+      return mapper->radiance(ray, ctx);
+    };
     if (base.time_limit > 0.0) settings.time_limit = remaining();
   } else if (method == "radiosity") {
     radiosity::solver::SolverSettings solver = radiosity::bake::solver_settings_for(options.radiosity_view, options.solver);
@@ -93,18 +97,20 @@ MethodResult run_method(const rc::Scene& scene, const rc::Camera& camera, const 
     result.notes = result.solution->mesh_report.warnings;
     if (!fit.note.empty()) result.notes.push_back(fit.note);
     view.emplace(scene, *result.solution, options.radiosity_view);
-    radiance = [&view](const rc::Ray& ray, rc::SampleContext& ctx) { return view->radiance(ray, ctx); };
+    radiance = [&view](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+      return view->radiance(ray, ctx);
+    };
     if (base.time_limit > 0.0) settings.time_limit = remaining();
   } else if (method == "path") {
-    rc::PathSettings ps;
+    rc::render::PathSettings ps;
     if (options.max_depth > 0) ps.max_depth = options.max_depth;
-    radiance = [&scene, ps](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, ps); };
+    radiance = [&scene, ps](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, ps); };
   } else {
-    rc::WhittedSettings ws;
+    rc::render::WhittedSettings ws;
     if (options.max_depth > 0) ws.max_depth = options.max_depth;
-    radiance = [&scene, ws](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::whitted_radiance(scene, ray, ctx, ws); };
+    radiance = [&scene, ws](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::whitted_radiance(scene, ray, ctx, ws); };
   }
-  result.film = rc::render_image(scene, camera, settings, radiance, &result.stats);
+  result.film = rc::render::render_image(scene, camera, settings, radiance, &result.stats);
   result.stats.seconds = elapsed();
   return result;
 }

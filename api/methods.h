@@ -12,9 +12,9 @@
 #include "photonmap/sppm.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/camera.h"
-#include "raytrace_core/film.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/scene/camera.h"
+#include "raytrace_core/render/film.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::api {
 
@@ -47,8 +47,8 @@ struct PhotonOptions {
 
 /// What one run produced.
 struct MethodResult {
-  raytrace_core::Film film;
-  raytrace_core::RenderStats stats;  ///< seconds: the whole run, preparation included
+  raytrace_core::render::Film film;
+  raytrace_core::render::RenderStats stats;  ///< seconds: the whole run, preparation included
   std::optional<radiosity::solver::Solution> solution;
   std::optional<photonmap::PhotonMapperStats> photon;
   std::optional<photonmap::SppmStats> sppm;
@@ -58,14 +58,14 @@ struct MethodResult {
 /// The image size for a requested width and height: both given, as given; one, the other from the
 /// aspect ratio of the scene's render size (its camera's, if it has one); neither, the scene's.
 /// Throws InputError for a size outside 1–65,536.
-std::pair<int, int> image_size(const raytrace_core::Scene& scene, std::optional<int> width, std::optional<int> height);
+std::pair<int, int> image_size(const raytrace_core::scene::Scene& scene, std::optional<int> width, std::optional<int> height);
 
 /// Renders with `method` ("path", "whitted", "radiosity", "photon" or "sppm"). With a time
 /// limit, a radiosity solve may use 70 % of it (a partial solution is shown with its ambient
 /// term) and photon tracing runs first; the image takes what is left, at least one pass. A scene
 /// without lights gives its black image at once, with a note. Throws InputError for an unknown
-/// method, Interrupted when raytrace_core::request_stop() stops it.
-MethodResult run_method(const raytrace_core::Scene& scene, const raytrace_core::Camera& camera, const std::string& method,
-                        const raytrace_core::RenderSettings& settings, const MethodOptions& options);
+/// method, Interrupted when raytrace_core::util::request_stop() stops it.
+MethodResult run_method(const raytrace_core::scene::Scene& scene, const raytrace_core::scene::Camera& camera, const std::string& method,
+                        const raytrace_core::render::RenderSettings& settings, const MethodOptions& options);
 
 }  // namespace gilt::api

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::api {
 namespace {
@@ -42,7 +42,7 @@ std::string escape(const std::string& s) {
 }
 
 void write_file(const std::filesystem::path& path, const std::string& text) {
-  raytrace_core::StagedFile file(path, text);
+  raytrace_core::util::StagedFile file(path, text);
   file.commit();
 }
 

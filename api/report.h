@@ -22,7 +22,7 @@ struct ReportEntry {
   uint64_t photons = 0;        ///< photon paths traced (photon, sppm)
   uint64_t shots = 0;          ///< radiosity shots
   /// √mean (I − R)² over pixels and channels, and mean (I − R)² / (R² + 0.01), each less the
-  /// reference's own noise when it is known (raytrace_core/io/image_error.h): estimates of the
+  /// reference's own noise when it is known (raytrace_core/util/image_error.h): estimates of the
   /// error against the exact image. relmse may then come out below 0 by about relmse_stderr.
   double rmse = 0.0;
   double relmse = 0.0;

@@ -2,25 +2,25 @@
 
 #include <algorithm>
 
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
 
 namespace gilt::api {
 namespace rc = gilt::raytrace_core;
 
-nlohmann::json run_statistics(const rc::Scene& scene, const std::string& method, const rc::RenderSettings& settings,
+nlohmann::json run_statistics(const rc::scene::Scene& scene, const std::string& method, const rc::render::RenderSettings& settings,
                               const MethodResult& result) {
-  const rc::RenderStats& stats = result.stats;
+  const rc::render::RenderStats& stats = result.stats;
   const double secs = std::max(stats.seconds, 1e-9);
   nlohmann::json j = {{"method", method},
                       {"width", settings.width},
                       {"height", settings.height},
                       {"spp", stats.spp},
                       {"seed", settings.seed},
-                      {"sampler", rc::sampler_name(settings.sampler)},
-                      {"light_sampler", rc::light_sampling_name(scene.light_sampler().mode())},
-                      {"threads", settings.threads > 0 ? settings.threads : rc::hardware_threads()},
-                      {"ranks", rc::processes().count()},
+                      {"sampler", rc::render::sampler_name(settings.sampler)},
+                      {"light_sampler", rc::scene::light_sampling_name(scene.light_sampler().mode())},
+                      {"threads", settings.threads > 0 ? settings.threads : rc::util::hardware_threads()},
+                      {"ranks", rc::util::processes().count()},
                       {"triangles", scene.triangle_count()},
                       {"spheres", scene.spheres.size()},
                       {"lights", scene.lights().size()},
@@ -65,7 +65,7 @@ nlohmann::json solution_statistics(const radiosity::solver::Solution& sol, const
                       {"iterate_seconds", l.iterate_seconds}});
   nlohmann::json mesh_stages = nlohmann::json::object();
   for (const auto& [stage, seconds] : sol.mesh_report.stage_seconds) mesh_stages[stage] = seconds;
-  return {{"ranks", rc::processes().count()},
+  return {{"ranks", rc::util::processes().count()},
           {"elements", sol.mesh.element_count()},
           {"meshed_elements", sol.mesh_report.elements},
           {"vertices", sol.mesh.vertex_count()},
@@ -109,7 +109,7 @@ nlohmann::json solution_statistics(const radiosity::solver::Solution& sol, const
             {"iterations", sol.iterate_seconds},
             {"final_gather", sol.gather_seconds},
             {"shooting", sol.shoot_seconds}}},
-          {"threads", settings.threads > 0 ? settings.threads : rc::hardware_threads()}};
+          {"threads", settings.threads > 0 ? settings.threads : rc::util::hardware_threads()}};
 }
 
 }  // namespace gilt::api

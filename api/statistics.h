@@ -8,16 +8,17 @@
 
 #include "api/methods.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::api {
 
 /// A run's statistics: method, size, spp, seed, samplers, threads, the scene's size, rays,
 /// samples, their rates, seconds, notes, and the method's own pass ("radiosity", "photon" or
 /// "sppm").
-nlohmann::json run_statistics(const raytrace_core::Scene& scene, const std::string& method,
-                              const raytrace_core::RenderSettings& settings, const MethodResult& result);
+nlohmann::json run_statistics(const raytrace_core::scene::Scene& scene, const std::string& method,
+                              const raytrace_core::render::RenderSettings& settings,
+                              const MethodResult& result);
 
 /// A radiosity solve's statistics: the mesh (elements, vertices, what meshing repaired or
 /// removed), the solver and why it was chosen, its work (shots, links, form factors, shadow

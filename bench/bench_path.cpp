@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -32,24 +32,25 @@ constexpr int kSpp = 4;  // samples per pixel in each timed render
 }
 
 /// One render of the scene with `threads` worker threads, no progress bar.
-rc::Film render(const rc::Scene& scene, const rc::Camera& camera, int threads, rc::RenderStats* stats) {
-  rc::RenderSettings settings;
+rc::render::Film render(const rc::scene::Scene& scene, const rc::scene::Camera& camera, int threads,
+                        rc::render::RenderStats* stats) {
+  rc::render::RenderSettings settings;
   settings.width = kImageSize;
   settings.height = kImageSize;
   settings.spp = kSpp;
   settings.threads = threads;
   settings.progress = false;
-  const rc::PathSettings path;
-  return rc::render_image(
+  const rc::render::PathSettings path;
+  return rc::render::render_image(
       scene, camera, settings,
-      [&scene, &path](const rc::Ray& ray, rc::SampleContext& ctx) {
-        return rc::path_radiance(scene, ray, ctx, path);
+      [&scene, &path](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+        return rc::render::path_radiance(scene, ray, ctx, path);
       },
       stats);
 }
 
 /// Mean luminance of the image, in W·sr⁻¹·m⁻².
-double mean_luminance(const rc::Film& film) {
+double mean_luminance(const rc::render::Film& film) {
   double sum = 0.0;
   for (const rc::Rgb& p : film.pixels()) sum += p.luminance();
   return sum / (double(film.width()) * film.height());
@@ -57,10 +58,10 @@ double mean_luminance(const rc::Film& film) {
 
 /// Renders once with one and once with two threads and stops the program unless the images are
 /// finite, identical to the bit, and of a plausible brightness. Returns the mean luminance.
-double check_render(const rc::Scene& scene, const rc::Camera& camera) {
-  rc::RenderStats one_stats, two_stats;
-  const rc::Film one = render(scene, camera, 1, &one_stats);
-  const rc::Film two = render(scene, camera, 2, &two_stats);
+double check_render(const rc::scene::Scene& scene, const rc::scene::Camera& camera) {
+  rc::render::RenderStats one_stats, two_stats;
+  const rc::render::Film one = render(scene, camera, 1, &one_stats);
+  const rc::render::Film two = render(scene, camera, 2, &two_stats);
   if (one_stats.non_finite != 0 || two_stats.non_finite != 0 || one.non_finite_count() != 0)
     fail("the path tracer returned NaN or infinite samples");
   if (one_stats.rays != two_stats.rays) fail("one and two threads traced different numbers of rays");
@@ -77,12 +78,13 @@ double check_render(const rc::Scene& scene, const rc::Camera& camera) {
   return mean;
 }
 
-void BM_PathTracer_Cornell(benchmark::State& state, const rc::Scene& scene, const rc::Camera& camera) {
+void BM_PathTracer_Cornell(benchmark::State& state, const rc::scene::Scene& scene,
+                           const rc::scene::Camera& camera) {
   const int threads = int(state.range(0));
   uint64_t samples = 0, rays = 0;
   for (auto _ : state) {
-    rc::RenderStats stats;
-    rc::Film film = render(scene, camera, threads, &stats);
+    rc::render::RenderStats stats;
+    rc::render::Film film = render(scene, camera, threads, &stats);
     benchmark::DoNotOptimize(film);
     samples += stats.samples;
     rays += stats.rays;
@@ -98,8 +100,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return EXIT_FAILURE;
 
-  const rc::Scene scene = rc::load_scene("cornell");
-  const rc::Camera camera = scene.effective_camera();
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
+  const rc::scene::Camera camera = scene.effective_camera();
   const double mean = check_render(scene, camera);
   std::fprintf(
       stderr, "bench_path: cornell at %d x %d, %d spp: mean luminance %.4f, identical with 1 and 2 threads\n",

@@ -27,11 +27,11 @@
 
 #include "photonmap/photon_mapper.h"
 #include "photonmap/sppm.h"
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -52,8 +52,8 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 constexpr int kSize = 64;
 constexpr double kBudgets[] = {1, 2, 4, 8};
 
-rc::RenderSettings settings(int spp, uint64_t seed, double time_limit = 0.0) {
-  rc::RenderSettings s;
+rc::render::RenderSettings settings(int spp, uint64_t seed, double time_limit = 0.0) {
+  rc::render::RenderSettings s;
   s.width = s.height = kSize;
   s.spp = spp;
   s.seed = seed;
@@ -62,33 +62,33 @@ rc::RenderSettings settings(int spp, uint64_t seed, double time_limit = 0.0) {
   return s;
 }
 
-std::vector<rc::Rgb> path_half(const rc::Scene& scene, int spp, uint64_t seed, const fs::path& dir, bool fresh) {
+std::vector<rc::Rgb> path_half(const rc::scene::Scene& scene, int spp, uint64_t seed, const fs::path& dir, bool fresh) {
   const fs::path file = dir / ("reference_" + scene.name + "_" + std::to_string(kSize) + "x" + std::to_string(kSize) +
                                "_" + std::to_string(spp) + "spp_seed" + std::to_string(seed) + ".exr");
   if (!fresh && fs::exists(file)) {
-    const rc::Image image = rc::read_image(file.string());
+    const rc::util::Image image = rc::util::read_image(file.string());
     if (image.width == kSize && image.height == kSize) return image.pixels;
   }
-  const rc::PathSettings path;
-  rc::RenderStats stats;
-  const rc::Film film = rc::render_image(
+  const rc::render::PathSettings path;
+  rc::render::RenderStats stats;
+  const rc::render::Film film = rc::render::render_image(
       scene, scene.effective_camera(), settings(spp, seed),
-      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); }, &stats);
+      [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); }, &stats);
   if (stats.non_finite != 0) fail("the reference has non-finite samples");
-  rc::write_image(file.string(), rc::Image{kSize, kSize, film.pixels()});
+  rc::util::write_image(file.string(), rc::util::Image{kSize, kSize, film.pixels()});
   return film.pixels();
 }
 
 void run_trace() {
-  const rc::Scene scene = rc::load_scene("cornell-caustics");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
   // Correctness first: every emission sample of this scene's lights carries the light's power.
-  for (const rc::Light& light : scene.lights()) {
+  for (const rc::scene::Light& light : scene.lights()) {
     rc::Rgb sum(0.0f);
     for (int i = 0; i < 1000; ++i) {
-      rc::Rng rng = rc::Rng::for_item(1, uint64_t(i), 0);
-      sum += rc::sample_emission(scene, light, rng.uniform2(), rng.uniform2()).power;
+      rc::util::Rng rng = rc::util::Rng::for_item(1, uint64_t(i), 0);
+      sum += rc::scene::sample_emission(scene, light, rng.uniform2(), rng.uniform2()).power;
     }
-    const rc::Rgb expected = rc::light_power(scene, light);
+    const rc::Rgb expected = rc::scene::light_power(scene, light);
     if (std::abs(sum.average() / 1000.0f - expected.average()) > 1e-3f * expected.average())
       fail("emitted power does not add up to the light's power");
   }
@@ -113,8 +113,8 @@ void run_trace() {
 /// the same photons, alternating, five times; medians of the render times. The images must be
 /// identical, since both indexes return exactly the brute-force neighbours.
 void run_index() {
-  const rc::Scene scene = rc::load_scene("cornell-caustics");
-  const rc::Camera camera = scene.effective_camera();
+  const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
+  const rc::scene::Camera camera = scene.effective_camera();
   std::vector<double> times[2][2];
   std::vector<rc::Rgb> images[2][2];
   for (int r = 0; r < 5; ++r)
@@ -125,8 +125,8 @@ void run_index() {
       s.index = index;
       const pm::PhotonMapper mapper(scene, s);
       auto start = std::chrono::steady_clock::now();
-      images[kind][0] = rc::render_image(scene, camera, settings(2, 3),
-                                         [&](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper.radiance(ray, ctx); })
+      images[kind][0] = rc::render::render_image(scene, camera, settings(2, 3),
+                                         [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return mapper.radiance(ray, ctx); })
                             .pixels();
       times[kind][0].push_back(seconds_since(start));
       pm::SppmSettings sp;
@@ -159,38 +159,41 @@ struct Point {
 };
 
 void run_race(const fs::path& out_dir, int half_spp, bool fresh) {
-  const rc::Scene scene = rc::load_scene("cornell-caustics");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
   const auto ref_start = std::chrono::steady_clock::now();
   const std::vector<rc::Rgb> a = path_half(scene, half_spp, 1001, out_dir, fresh);
   const std::vector<rc::Rgb> b = path_half(scene, half_spp, 1002, out_dir, fresh);
   std::vector<rc::Rgb> reference(a.size());
   for (size_t i = 0; i < a.size(); ++i) reference[i] = (a[i] + b[i]) * 0.5f;
-  const double noise = 0.5 * rc::mean_relative_error(a, b);
+  const double noise = 0.5 * rc::util::mean_relative_error(a, b);
   std::printf("reference: path tracer, 2 x %d spp at %dx%d (%.1f s, cached when fast); its noise: %.2f %%\n", half_spp,
               kSize, kSize, seconds_since(ref_start), 100 * noise);
 
-  const rc::Camera camera = scene.effective_camera();
+  const rc::scene::Camera camera = scene.effective_camera();
   std::vector<Point> points;
   std::printf("\n  method  budget s  actual s   spp   error %%\n");
   for (double budget : kBudgets) {
     for (const char* method : {"path", "photon", "sppm"}) {
       const auto start = std::chrono::steady_clock::now();
-      rc::Film film;
+      rc::render::Film film;
       int spp = 0;
       const std::string m = method;
       if (m == "path") {
-        const rc::PathSettings path;
-        rc::RenderStats stats;
-        film = rc::render_image(
+        const rc::render::PathSettings path;
+        rc::render::RenderStats stats;
+        film = rc::render::render_image(
             scene, camera, settings(1, 7, budget),
-            [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); }, &stats);
+            [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); }, &stats);
         spp = stats.spp;
       } else if (m == "photon") {
         const pm::PhotonMapper mapper(scene, pm::PhotonMapperSettings{});
-        rc::RenderStats stats;
-        film = rc::render_image(
+        rc::render::RenderStats stats;
+        film = rc::render::render_image(
             scene, camera, settings(1, 7, std::max(0.05, budget - seconds_since(start))),
-            [&](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper.radiance(ray, ctx); }, &stats);
+            [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+              return mapper.radiance(ray, ctx);
+            },
+            &stats);
         spp = stats.spp;
       } else {
         pm::SppmStats stats;
@@ -199,7 +202,7 @@ void run_race(const fs::path& out_dir, int half_spp, bool fresh) {
       }
       const double seconds = seconds_since(start);
       if (film.non_finite_count() != 0) fail(m + " produced non-finite pixels");
-      const Point p{m, budget, seconds, rc::mean_relative_error(film.pixels(), reference), spp};
+      const Point p{m, budget, seconds, rc::util::mean_relative_error(film.pixels(), reference), spp};
       points.push_back(p);
       std::printf("  %-6s  %8.0f  %8.2f  %4d  %8.2f\n", method, budget, seconds, spp, 100 * p.error);
       std::fflush(stdout);

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "photonmap/photon_index.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -50,8 +50,8 @@ constexpr uint64_t kSeed = 2025;
 /// Area-weighted random points on the scene's triangles (the light excluded).
 class SurfaceSampler {
  public:
-  explicit SurfaceSampler(const rc::Scene& scene) {
-    for (const rc::TriangleMesh& mesh : scene.meshes) {
+  explicit SurfaceSampler(const rc::scene::Scene& scene) {
+    for (const rc::scene::TriangleMesh& mesh : scene.meshes) {
       if (mesh.name == "light") continue;
       for (size_t t = 0; t < mesh.triangle_count(); ++t) {
         const Vec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
@@ -63,7 +63,7 @@ class SurfaceSampler {
       }
     }
   }
-  Vec3 sample(rc::Rng& rng) const {
+  Vec3 sample(rc::util::Rng& rng) const {
     const double u = rng.uniform() * total_;
     const size_t t =
         std::min<size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin(), triangles_.size() - 1);
@@ -91,11 +91,11 @@ struct Workload {
 };
 
 Workload make_workload() {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   const SurfaceSampler sampler(scene);
   Workload w;
   w.surface_area = sampler.area();
-  rc::Rng rng(kSeed);
+  rc::util::Rng rng(kSeed);
   const auto caustic = static_cast<size_t>(kCausticFraction * double(kPhotons));
   w.photons.reserve(kPhotons);
   for (size_t i = 0; i < kPhotons - caustic; ++i) w.photons.push_back(sampler.sample(rng));
@@ -105,7 +105,7 @@ Workload make_workload() {
     const float phi = 2.0f * rc::kPi * rng.uniform();
     w.photons.push_back({400.0f + r * std::cos(phi), 0.0f, 150.0f + r * std::sin(phi)});
   }
-  rc::Rng query_rng(kSeed + 1);
+  rc::util::Rng query_rng(kSeed + 1);
   for (size_t i = 0; i < kQueries; ++i) w.queries.push_back(sampler.sample(query_rng));
   return w;
 }

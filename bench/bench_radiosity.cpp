@@ -48,12 +48,12 @@
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/util/rng.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -103,8 +103,8 @@ const char* label_of(Pixels pixels) {
   return pixels == Pixels::filtered ? "filtered pixels" : "pixel centres";
 }
 
-rc::RenderSettings render_settings(Pixels pixels, int spp, uint64_t seed) {
-  rc::RenderSettings s;
+rc::render::RenderSettings render_settings(Pixels pixels, int spp, uint64_t seed) {
+  rc::render::RenderSettings s;
   s.width = s.height = kImageSize;
   s.spp = spp;
   s.seed = seed;
@@ -128,30 +128,32 @@ struct Reference {
 /// One half of the reference, from the cache in `dir` when it holds one made with the same
 /// settings, else rendered now and cached. The cache is keyed by the settings, not by the code:
 /// after changing the path tracer, run with --fresh-reference.
-std::vector<rc::Rgb> reference_half(const rc::Scene& scene, Pixels pixels, int spp, uint64_t seed,
+std::vector<rc::Rgb> reference_half(const rc::scene::Scene& scene, Pixels pixels, int spp, uint64_t seed,
                                     const fs::path& dir, bool fresh, bool& cached) {
   const fs::path file = dir / ("reference_" + scene.name + "_" + name_of(pixels) + "_" +
                                std::to_string(kImageSize) + "x" + std::to_string(kImageSize) + "_" +
                                std::to_string(spp) + "spp_seed" + std::to_string(seed) + ".exr");
   if (!fresh && fs::exists(file)) {
-    const rc::Image image = rc::read_image(file.string());
+    const rc::util::Image image = rc::util::read_image(file.string());
     if (image.width == kImageSize && image.height == kImageSize && all_finite(image.pixels))
       return image.pixels;
   }
-  const rc::PathSettings path;
-  rc::RenderStats stats;
-  const rc::Film film = rc::render_image(
+  const rc::render::PathSettings path;
+  rc::render::RenderStats stats;
+  const rc::render::Film film = rc::render::render_image(
       scene, scene.effective_camera(), render_settings(pixels, spp, seed),
-      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); },
+      [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+        return rc::render::path_radiance(scene, ray, ctx, path);
+      },
       &stats);
   if (stats.non_finite != 0 || film.non_finite_count() != 0)
     fail("the path-traced reference has non-finite samples");
-  rc::write_image(file.string(), rc::Image{kImageSize, kImageSize, film.pixels()});
+  rc::util::write_image(file.string(), rc::util::Image{kImageSize, kImageSize, film.pixels()});
   cached = false;
   return film.pixels();
 }
 
-Reference make_reference(const rc::Scene& scene, Pixels pixels, int half_spp, const fs::path& dir,
+Reference make_reference(const rc::scene::Scene& scene, Pixels pixels, int half_spp, const fs::path& dir,
                          bool fresh) {
   const auto start = std::chrono::steady_clock::now();
   Reference ref;
@@ -180,12 +182,13 @@ Reference make_reference(const rc::Scene& scene, Pixels pixels, int half_spp, co
 }
 
 /// A radiosity render of a solution with the reference's camera, size and first seed.
-std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, const rad::bake::RadiosityView& view, Pixels pixels,
+std::vector<rc::Rgb> radiosity_render(const rc::scene::Scene& scene, const rad::bake::RadiosityView& view, Pixels pixels,
                                       int spp) {
-  rc::RenderStats stats;
-  const rc::Film film = rc::render_image(
+  rc::render::RenderStats stats;
+  const rc::render::Film film = rc::render::render_image(
       scene, scene.effective_camera(), render_settings(pixels, spp, kSeeds[0]),
-      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); }, &stats);
+      [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return view.radiance(ray, ctx); },
+      &stats);
   if (stats.non_finite != 0 || film.non_finite_count() != 0) fail("a radiosity render has non-finite pixels");
   return film.pixels();
 }
@@ -199,7 +202,7 @@ void write_error_image(const fs::path& file, const std::vector<rc::Rgb>& image, 
     for (int k = 0; k < 3; ++k) e += std::abs(image[i][k] - reference[i][k]) / (reference[i][k] + 0.01f);
     error[i] = rc::Rgb(e / 3.0f * 10.0f);
   }
-  rc::write_image(file.string(), rc::Image{kImageSize, kImageSize, error});
+  rc::util::write_image(file.string(), rc::util::Image{kImageSize, kImageSize, error});
 }
 
 /// Timed repeats of each sweep point (--repeats=N); the median time is reported.
@@ -307,7 +310,7 @@ void report_time_to_target(const std::vector<SweepPoint>& points, Measure m, dou
 }
 
 void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   const bool two_pass = g_view == rad::bake::ViewMode::two_pass;
   std::printf("\n== Error against time on cornell, %d x %d: solver tolerance %g, %s view ==\n", kImageSize,
               kImageSize, kTolerance, two_pass ? "two-pass" : "mesh");
@@ -319,7 +322,7 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
   const rad::solver::Solution warm = rad::solver::solve(scene, solver_settings(1000));
   const rad::bake::RadiosityView warm_view(scene, warm, rad::bake::ViewMode::mesh);
   const double display_noise =
-      rc::mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
+      rc::util::mean_relative_error(radiosity_render(scene, warm_view, Pixels::filtered, kRadiositySpp),
                           radiosity_render(scene, warm_view, Pixels::filtered, kDisplaySpp));
   std::printf(
       "display noise of a %d-spp filtered radiosity render: %.3f %% (1000 elements, against %d spp)\n",
@@ -394,8 +397,8 @@ void run_sweep(const fs::path& out_dir, int half_spp, bool fresh_reference) {
       image = radiosity_render(scene, *view, Pixels::filtered, g_view_spp);
     else
       centres = radiosity_render(scene, *view, Pixels::centres, 1);
-    p.error[kFiltered] = rc::mean_relative_error(image, refs[int(Pixels::filtered)].image);
-    p.error[kCentres] = rc::mean_relative_error(centres, refs[int(Pixels::centres)].image);
+    p.error[kFiltered] = rc::util::mean_relative_error(image, refs[int(Pixels::filtered)].image);
+    p.error[kCentres] = rc::util::mean_relative_error(centres, refs[int(Pixels::centres)].image);
     write_error_image(out_dir / (std::string(two_pass ? "radiosity_two_pass_error_" : "radiosity_error_") +
                                  std::to_string(requested) + ".png"),
                       centres,
@@ -448,7 +451,7 @@ struct Configuration {
   DVec3 p, n, a, b, c;
 };
 
-DVec3 uniform_in_cube(rc::Rng& rng) { return DVec3(rng.uniform(), rng.uniform(), rng.uniform()); }
+DVec3 uniform_in_cube(rc::util::Rng& rng) { return DVec3(rng.uniform(), rng.uniform(), rng.uniform()); }
 
 /// Random triangles in the unit cube, each seen by a random point in front of it (the solver
 /// only asks for those) whose normal is uniform on the sphere: some sources lie wholly in front
@@ -457,7 +460,7 @@ std::vector<Configuration> random_configurations() {
   std::vector<Configuration> configs;
   configs.reserve(kConfigurations);
   for (size_t i = 0; configs.size() < kConfigurations; ++i) {
-    rc::Rng rng = rc::Rng::for_item(7, i, 0);
+    rc::util::Rng rng = rc::util::Rng::for_item(7, i, 0);
     Configuration c{uniform_in_cube(rng), DVec3(0.0), uniform_in_cube(rng), uniform_in_cube(rng),
                     uniform_in_cube(rng)};
     const DVec3 normal = glm::cross(c.b - c.a, c.c - c.a);
@@ -475,14 +478,14 @@ std::vector<Configuration> random_configurations() {
 /// Vertex–element pairs of the cornell mesh at 1000 elements, the vertex in front of the element,
 /// as the solver meets them.
 std::vector<Configuration> cornell_configurations() {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   rad::mesh::MeshSettings settings;
   settings.elements = 1000;
   const rad::mesh::RadiosityMesh mesh = rad::mesh::build_mesh(scene, settings);
   std::vector<Configuration> configs;
   configs.reserve(kConfigurations);
   for (size_t i = 0; configs.size() < kConfigurations; ++i) {
-    rc::Rng rng = rc::Rng::for_item(8, i, 0);
+    rc::util::Rng rng = rc::util::Rng::for_item(8, i, 0);
     const size_t v = std::min(mesh.vertex_count() - 1, size_t(rng.uniform() * float(mesh.vertex_count())));
     const size_t e = std::min(mesh.element_count() - 1, size_t(rng.uniform() * float(mesh.element_count())));
     const auto& el = mesh.elements[e];
@@ -557,7 +560,7 @@ constexpr int kScalingElements[] = {1000, 10000, 100000};
 constexpr double kShootingBudget = 20.0;  // seconds of shooting per size
 
 void run_scaling(const fs::path& out_dir) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   std::printf(
       "\n== Solve cost against element count on cornell: tolerance %g, at most about %.0f s of shooting ==\n",
       kTolerance, kShootingBudget);
@@ -638,7 +641,7 @@ double peak_gib() {
 }
 
 void run_hierarchical(const fs::path& out_dir, int largest) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   std::printf("\n== Hierarchical solve against element count on cornell (tolerance %g, no subdivision) ==\n",
               kTolerance);
   std::printf("  %9s %8s %8s %9s %10s %5s %9s %8s %8s %8s %9s\n", "requested", "elements", "vertices", "nodes",
@@ -730,7 +733,7 @@ int main(int argc, char** argv) {
   fs::create_directories(out_dir);
 
   const auto start = std::chrono::steady_clock::now();
-  std::printf("bench_radiosity: %d hardware threads, all used (threads = 0)\n", rc::hardware_threads());
+  std::printf("bench_radiosity: %d hardware threads, all used (threads = 0)\n", rc::util::hardware_threads());
   if (form_factors) run_form_factors();
   if (sweep) run_sweep(out_dir, half_spp, fresh_reference);
   if (scaling) run_scaling(out_dir);

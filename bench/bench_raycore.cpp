@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 using rc::Vec3;
@@ -54,7 +54,7 @@ float terrain_height(float x, float z) {
 }
 
 /// Appends quad a b c d as triangles (a, b, c) and (a, c, d): counter-clockwise seen from its front.
-void add_quad(rc::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+void add_quad(rc::scene::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const auto base = static_cast<uint32_t>(mesh.positions.size());
   mesh.positions.insert(mesh.positions.end(), {a, b, c, d});
   mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
@@ -62,15 +62,15 @@ void add_quad(rc::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& 
 
 /// A closed room whose floor is a terrain of about a million triangles, lit by a quad light on
 /// one wall. Mesh 0: walls, 1: terrain, 2: light.
-rc::Scene make_scene() {
-  rc::Scene scene;
+rc::scene::Scene make_scene() {
+  rc::scene::Scene scene;
   scene.name = "bench-terrain-room";
-  scene.materials = {rc::Material::make_diffuse("wall", rc::Rgb(0.7f)),
-                     rc::Material::make_diffuse("ground", rc::Rgb(0.5f)),
-                     rc::Material::make_emitter("light", rc::Rgb(10.0f))};
+  scene.materials = {rc::scene::Material::make_diffuse("wall", rc::Rgb(0.7f)),
+                     rc::scene::Material::make_diffuse("ground", rc::Rgb(0.5f)),
+                     rc::scene::Material::make_emitter("light", rc::Rgb(10.0f))};
 
   // Walls facing inwards; the eight corners are shared, so the box is watertight.
-  rc::TriangleMesh& walls = scene.meshes.emplace_back();
+  rc::scene::TriangleMesh& walls = scene.meshes.emplace_back();
   walls.name = "walls";
   walls.material = 0;
   auto corner = [](int i) {
@@ -83,7 +83,7 @@ rc::Scene make_scene() {
   add_quad(walls, corner(0), corner(4), corner(6), corner(2));  // x = −1, normal +x
   add_quad(walls, corner(1), corner(3), corner(7), corner(5));  // x = +1, normal −x
 
-  rc::TriangleMesh& terrain = scene.meshes.emplace_back();
+  rc::scene::TriangleMesh& terrain = scene.meshes.emplace_back();
   terrain.name = "terrain";
   terrain.material = 1;
   constexpr int n = kTerrainQuads;
@@ -104,7 +104,7 @@ rc::Scene make_scene() {
     }
   }
 
-  rc::TriangleMesh& light = scene.meshes.emplace_back();
+  rc::scene::TriangleMesh& light = scene.meshes.emplace_back();
   light.name = "light";
   light.material = 2;
   const float x = kLightX, s = kLightHalfWidth;
@@ -112,7 +112,7 @@ rc::Scene make_scene() {
   add_quad(light, Vec3(x, kLightLow, s), Vec3(x, kLightLow, -s), Vec3(x, kLightHigh, -s),
            Vec3(x, kLightHigh, s));
 
-  rc::Camera camera;
+  rc::scene::Camera camera;
   camera.look_from = Vec3(0.0f, 1.0f, 0.95f);
   camera.look_at = Vec3(0.0f, -0.05f, -0.4f);
   camera.vfov_degrees = 65.0f;
@@ -125,7 +125,7 @@ rc::Scene make_scene() {
 
 // --- Raw Embree, with the structures filled field by field as Scene::intersect / occluded do. ---
 
-RTCRayHit raw_intersect(RTCScene scene, const rc::Ray& ray) {
+RTCRayHit raw_intersect(RTCScene scene, const rc::scene::Ray& ray) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
@@ -147,7 +147,7 @@ RTCRayHit raw_intersect(RTCScene scene, const rc::Ray& ray) {
   return rh;
 }
 
-bool raw_occluded(RTCScene scene, const rc::Ray& ray) {
+bool raw_occluded(RTCScene scene, const rc::scene::Ray& ray) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay r;
@@ -167,25 +167,25 @@ bool raw_occluded(RTCScene scene, const rc::Ray& ray) {
   return r.tfar < 0.0f;
 }
 
-RTCScene embree_of(const rc::Scene& scene) { return static_cast<RTCScene>(scene.embree_scene()); }
+RTCScene embree_of(const rc::scene::Scene& scene) { return static_cast<RTCScene>(scene.embree_scene()); }
 
 // --- The ray sets, generated once from fixed seeds. ---
 
 struct RaySets {
-  std::vector<rc::Ray> primary, shadow, diffuse;
+  std::vector<rc::scene::Ray> primary, shadow, diffuse;
 };
 
 /// Index of the random stream of each ray kind, so the three sets draw independent numbers.
 enum class Stream : uint64_t { primary, shadow, diffuse };
 
-RaySets make_rays(const rc::Scene& scene) {
+RaySets make_rays(const rc::scene::Scene& scene) {
   RaySets sets;
-  const rc::Camera camera = scene.effective_camera();
+  const rc::scene::Camera camera = scene.effective_camera();
   sets.primary.reserve(size_t(kImageSize) * kImageSize);
   for (int y = 0; y < kImageSize; ++y) {
     for (int x = 0; x < kImageSize; ++x) {
       const uint64_t pixel = uint64_t(y) * kImageSize + x;
-      rc::Rng rng = rc::Rng::for_item(kSeed, pixel, uint64_t(Stream::primary));
+      rc::util::Rng rng = rc::util::Rng::for_item(kSeed, pixel, uint64_t(Stream::primary));
       const rc::Vec2 jitter = rng.uniform2();
       const rc::Vec2 film((x + jitter.x) / kImageSize, (y + jitter.y) / kImageSize);
       sets.primary.push_back(camera.generate_ray(film, rc::Vec2(0.5f), 1.0f));
@@ -194,22 +194,23 @@ RaySets make_rays(const rc::Scene& scene) {
 
   // Shadow and bounce rays leave every primary hit except those on the light itself.
   for (size_t i = 0; i < sets.primary.size(); ++i) {
-    const rc::Ray& ray = sets.primary[i];
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const rc::scene::Ray& ray = sets.primary[i];
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     if (!hit) fail("primary ray " + std::to_string(i) + " left the closed room");
     if (hit->geom_id == kLightMesh) continue;
-    const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+    const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
 
-    rc::Rng shadow_rng = rc::Rng::for_item(kSeed, i, uint64_t(Stream::shadow));
+    rc::util::Rng shadow_rng = rc::util::Rng::for_item(kSeed, i, uint64_t(Stream::shadow));
     const uint32_t light_triangle = shadow_rng.uniform() < 0.5f ? 0 : 1;  // the two halves have equal area
-    const rc::SurfaceInteraction on_light =
-        scene.triangle_point(kLightMesh, light_triangle, rc::sample_uniform_triangle(shadow_rng.uniform2()));
-    sets.shadow.push_back(rc::spawn_shadow_ray(si, on_light));
+    const rc::scene::SurfaceInteraction on_light = scene.triangle_point(
+        kLightMesh, light_triangle, rc::util::sample_uniform_triangle(shadow_rng.uniform2()));
+    sets.shadow.push_back(rc::scene::spawn_shadow_ray(si, on_light));
 
-    rc::Rng bounce_rng = rc::Rng::for_item(kSeed, i, uint64_t(Stream::diffuse));
+    rc::util::Rng bounce_rng = rc::util::Rng::for_item(kSeed, i, uint64_t(Stream::diffuse));
     const Vec3 n = glm::dot(ray.direction, si.ng) < 0.0f ? si.ng : -si.ng;  // the side the ray came from
-    const Vec3 wi = rc::Frame::from_normal(n).to_world(rc::sample_cosine_hemisphere(bounce_rng.uniform2()));
-    sets.diffuse.push_back(rc::spawn_ray(si, wi));
+    const Vec3 wi =
+        rc::Frame::from_normal(n).to_world(rc::util::sample_cosine_hemisphere(bounce_rng.uniform2()));
+    sets.diffuse.push_back(rc::scene::spawn_ray(si, wi));
   }
   return sets;
 }
@@ -223,13 +224,14 @@ struct SetSummary {
 
 /// Traces every ray through the core and through raw Embree, both queries each, and stops the
 /// program at the first disagreement.
-SetSummary check_agreement(const char* kind, const rc::Scene& scene, const std::vector<rc::Ray>& rays) {
+SetSummary check_agreement(const char* kind, const rc::scene::Scene& scene,
+                           const std::vector<rc::scene::Ray>& rays) {
   const RTCScene raw_scene = embree_of(scene);
   SetSummary summary;
   summary.rays = rays.size();
   for (size_t i = 0; i < rays.size(); ++i) {
     const std::string where = std::string(kind) + " ray " + std::to_string(i) + ": ";
-    const std::optional<rc::Hit> core = scene.intersect(rays[i]);
+    const std::optional<rc::scene::Hit> core = scene.intersect(rays[i]);
     const RTCRayHit raw = raw_intersect(raw_scene, rays[i]);
     const bool raw_hit = raw.hit.geomID != RTC_INVALID_GEOMETRY_ID;
     if (core.has_value() != raw_hit)
@@ -258,7 +260,7 @@ SetSummary check_agreement(const char* kind, const rc::Scene& scene, const std::
 /// Checks that the scene behaves as built: every primary and bounce ray stays inside the closed
 /// room, no bounce ray hits the planar triangle it leaves, no shadow ray is stopped by the light
 /// it aims at, and the shadow rays are neither all blocked nor all free.
-void check_scene_sanity(const rc::Scene& scene, const RaySets& sets, const SetSummary& primary,
+void check_scene_sanity(const rc::scene::Scene& scene, const RaySets& sets, const SetSummary& primary,
                         const SetSummary& shadow, const SetSummary& diffuse) {
   if (primary.hits != primary.rays) fail("some primary rays missed the closed room");
   if (diffuse.hits != diffuse.rays)
@@ -266,16 +268,16 @@ void check_scene_sanity(const rc::Scene& scene, const RaySets& sets, const SetSu
   if (shadow.occluded == 0 || shadow.occluded == shadow.rays)
     fail("the shadow rays are all blocked or all free: the scene does not test what it should");
   for (size_t i = 0; i < sets.shadow.size(); ++i) {
-    const std::optional<rc::Hit> blocker = scene.intersect(sets.shadow[i]);
+    const std::optional<rc::scene::Hit> blocker = scene.intersect(sets.shadow[i]);
     if (blocker && blocker->geom_id == kLightMesh)
       fail("shadow ray " + std::to_string(i) + " is blocked by the light it aims at");
   }
   // Bounce ray k starts on the surface hit by the k-th primary ray that did not land on the light.
   size_t k = 0;
-  for (const rc::Ray& ray : sets.primary) {
-    const rc::Hit from = *scene.intersect(ray);
+  for (const rc::scene::Ray& ray : sets.primary) {
+    const rc::scene::Hit from = *scene.intersect(ray);
     if (from.geom_id == kLightMesh) continue;
-    const rc::Hit to = *scene.intersect(sets.diffuse[k]);
+    const rc::scene::Hit to = *scene.intersect(sets.diffuse[k]);
     if (to.geom_id == from.geom_id && to.prim_id == from.prim_id)
       fail("bounce ray " + std::to_string(k) + " hit the triangle it leaves");
     ++k;
@@ -288,9 +290,9 @@ constexpr size_t kChunk = 1024;  // rays per task of the multi-threaded loops
 
 /// Traces every ray once per iteration, one after the other on this thread.
 template <class Query>
-void trace(benchmark::State& state, const std::vector<rc::Ray>& rays, Query query) {
+void trace(benchmark::State& state, const std::vector<rc::scene::Ray>& rays, Query query) {
   for (auto _ : state)
-    for (const rc::Ray& ray : rays) query(ray);
+    for (const rc::scene::Ray& ray : rays) query(ray);
   // Rays per second, shown as "rays=…M/s".
   state.counters["rays"] =
       benchmark::Counter(double(state.iterations()) * double(rays.size()), benchmark::Counter::kIsRate);
@@ -299,11 +301,12 @@ void trace(benchmark::State& state, const std::vector<rc::Ray>& rays, Query quer
 /// Traces every ray once per iteration in chunks spread over at most `threads` threads by
 /// gilt's parallel_for, as the renderers do.
 template <class Query>
-void trace_parallel(benchmark::State& state, const std::vector<rc::Ray>& rays, Query query, int threads) {
-  const rc::ThreadLimit limit(threads);
+void trace_parallel(benchmark::State& state, const std::vector<rc::scene::Ray>& rays, Query query,
+                    int threads) {
+  const rc::util::ThreadLimit limit(threads);
   const size_t chunks = (rays.size() + kChunk - 1) / kChunk;
   for (auto _ : state) {
-    rc::parallel_for(chunks, [&rays, &query](size_t c) {
+    rc::util::parallel_for(chunks, [&rays, &query](size_t c) {
       const size_t end = std::min(rays.size(), (c + 1) * kChunk);
       for (size_t i = c * kChunk; i < end; ++i) query(rays[i]);
     });
@@ -312,28 +315,28 @@ void trace_parallel(benchmark::State& state, const std::vector<rc::Ray>& rays, Q
       benchmark::Counter(double(state.iterations()) * double(rays.size()), benchmark::Counter::kIsRate);
 }
 
-void register_benchmarks(const rc::Scene& scene, const RaySets& sets) {
+void register_benchmarks(const rc::scene::Scene& scene, const RaySets& sets) {
   const RTCScene raw = embree_of(scene);
-  auto core_closest = [&scene](const rc::Ray& ray) {
-    std::optional<rc::Hit> hit = scene.intersect(ray);
+  auto core_closest = [&scene](const rc::scene::Ray& ray) {
+    std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     benchmark::DoNotOptimize(hit);
   };
-  auto raw_closest = [raw](const rc::Ray& ray) {
+  auto raw_closest = [raw](const rc::scene::Ray& ray) {
     RTCRayHit rh = raw_intersect(raw, ray);
     benchmark::DoNotOptimize(rh);
   };
-  auto core_any = [&scene](const rc::Ray& ray) {
+  auto core_any = [&scene](const rc::scene::Ray& ray) {
     bool blocked = scene.occluded(ray);
     benchmark::DoNotOptimize(blocked);
   };
-  auto raw_any = [raw](const rc::Ray& ray) {
+  auto raw_any = [raw](const rc::scene::Ray& ray) {
     bool blocked = raw_occluded(raw, ray);
     benchmark::DoNotOptimize(blocked);
   };
 
   // Single-thread loops are timed in CPU time, which other load on the machine disturbs least;
   // the two-thread ones ("…/threads:2/real_time") in wall time.
-  auto add = [](const char* name, const std::vector<rc::Ray>& rays, auto query, int threads) {
+  auto add = [](const char* name, const std::vector<rc::scene::Ray>& rays, auto query, int threads) {
     if (threads == 1) {
       benchmark::RegisterBenchmark(name, [&rays, query](benchmark::State& state) {
         trace(state, rays, query);
@@ -364,7 +367,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return EXIT_FAILURE;
 
-  const rc::Scene scene = make_scene();
+  const rc::scene::Scene scene = make_scene();
   const RaySets sets = make_rays(scene);
   const SetSummary primary = check_agreement("primary", scene, sets.primary);
   const SetSummary shadow = check_agreement("shadow", scene, sets.shadow);

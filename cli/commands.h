@@ -32,7 +32,7 @@ std::function<void()> add_info_command(CLI::App& app);
 void add_solver_options(CLI::App& cmd, radiosity::solver::SolverSettings& settings);
 
 /// Registers --env, --env-scale and --env-rotate (light given on the command line) on a subcommand.
-void add_lighting_options(CLI::App& cmd, raytrace_core::ExtraLighting& lighting);
+void add_lighting_options(CLI::App& cmd, raytrace_core::io::ExtraLighting& lighting);
 
 /// Registers --camera N|NAME (one of the scene file's cameras) on a subcommand.
 inline void add_camera_option(CLI::App& cmd, std::string& camera) {

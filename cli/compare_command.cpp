@@ -9,7 +9,7 @@
 
 #include "api/compare.h"
 #include "cli/commands.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {
@@ -19,7 +19,7 @@ namespace {
 
 struct CompareOptions {
   std::string scene, output;
-  rc::ExtraLighting lighting;
+  rc::io::ExtraLighting lighting;
   std::string methods = "path,photon,sppm,radiosity,whitted";
   std::string budgets = "1,2,4,8,16";
   std::string reference;
@@ -47,8 +47,8 @@ void run_compare(const CompareOptions& o) {
   s.scene_name = o.scene;
   api::check_settings(s);  // before the scene is loaded
 
-  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
-  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
+  rc::scene::Scene scene = rc::io::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::io::select_camera(scene, o.camera);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: every image will be black\n";
   if (!o.quiet) std::printf("  method     budget s  actual s  relMSE      mean rel. error  mean / reference\n");

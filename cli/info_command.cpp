@@ -21,30 +21,30 @@ namespace {
 
 struct InfoOptions {
   std::string scene;
-  rc::ExtraLighting lighting;
+  rc::io::ExtraLighting lighting;
   std::string camera;  ///< --camera N|NAME; empty: the scene's own
   bool json = false;
 };
 
-const char* light_kind_name(rc::LightKind k) {
+const char* light_kind_name(rc::scene::LightKind k) {
   switch (k) {
-    case rc::LightKind::area_triangle: return "area triangles";
-    case rc::LightKind::area_sphere: return "area spheres";
-    case rc::LightKind::point: return "point";
-    case rc::LightKind::spot: return "spot";
-    case rc::LightKind::directional: return "directional";
-    case rc::LightKind::environment: return "environment";
+    case rc::scene::LightKind::area_triangle: return "area triangles";
+    case rc::scene::LightKind::area_sphere: return "area spheres";
+    case rc::scene::LightKind::point: return "point";
+    case rc::scene::LightKind::spot: return "spot";
+    case rc::scene::LightKind::directional: return "directional";
+    case rc::scene::LightKind::environment: return "environment";
   }
   return "?";
 }
 
-const char* material_kind_name(rc::MaterialKind k) {
+const char* material_kind_name(rc::scene::MaterialKind k) {
   switch (k) {
-    case rc::MaterialKind::diffuse: return "diffuse";
-    case rc::MaterialKind::glossy: return "glossy";
-    case rc::MaterialKind::mirror: return "mirror";
-    case rc::MaterialKind::dielectric: return "dielectric";
-    case rc::MaterialKind::metallic_roughness: return "metallic-roughness";
+    case rc::scene::MaterialKind::diffuse: return "diffuse";
+    case rc::scene::MaterialKind::glossy: return "glossy";
+    case rc::scene::MaterialKind::mirror: return "mirror";
+    case rc::scene::MaterialKind::dielectric: return "dielectric";
+    case rc::scene::MaterialKind::metallic_roughness: return "metallic-roughness";
   }
   return "?";
 }
@@ -61,11 +61,11 @@ struct MethodPlan {
   std::vector<std::string> runs, skipped;
 };
 
-std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
+std::vector<MethodPlan> plan_methods(const rc::scene::Scene& scene) {
   std::vector<MethodPlan> plans;
   const bool lit = !scene.lights().empty();
-  // How a shadow ray's light is chosen (raytrace_core/light_sampler.h).
-  const rc::LightSampler& sampler = scene.light_sampler();
+  // How a shadow ray's light is chosen (raytrace_core/scene/light_sampler.h).
+  const rc::scene::LightSampler& sampler = scene.light_sampler();
   const std::string choice =
       sampler.node_count() > 1
           ? "chosen by a light BVH (" + std::to_string(sampler.node_count()) + " nodes, depth " +
@@ -128,17 +128,17 @@ std::vector<MethodPlan> plan_methods(const rc::Scene& scene) {
 }
 
 /// Whether `named` is the camera the scene renders with (the file's first, or --camera's choice).
-bool is_view(const rc::Scene& scene, const rc::NamedCamera& named) {
+bool is_view(const rc::scene::Scene& scene, const rc::scene::NamedCamera& named) {
   if (!scene.camera) return false;
-  const rc::Camera& a = *scene.camera;
-  const rc::Camera& b = named.camera;
+  const rc::scene::Camera& a = *scene.camera;
+  const rc::scene::Camera& b = named.camera;
   return a.look_from == b.look_from && a.look_at == b.look_at && a.up == b.up && a.vfov_degrees == b.vfov_degrees &&
          a.aperture_radius == b.aperture_radius && a.focus_distance == b.focus_distance &&
          a.orthographic == b.orthographic && a.ortho_height == b.ortho_height;
 }
 
 /// One camera as info describes it: "perspective, 39.6° vertical" or "orthographic, 4 high".
-std::string camera_text(const rc::Camera& c) {
+std::string camera_text(const rc::scene::Camera& c) {
   char text[96];
   if (c.orthographic) std::snprintf(text, sizeof text, "orthographic, %g high", double(c.ortho_height));
   else std::snprintf(text, sizeof text, "perspective, %g degrees vertical", double(c.vfov_degrees));
@@ -156,27 +156,27 @@ struct SceneSummary {
 
 /// Reads the scene's lights, materials, meshes and spheres; writes the summary's counts and
 /// memory estimate.
-void count_geometry(const rc::Scene& scene, SceneSummary& s) {
-  for (const rc::Light& l : scene.lights()) ++s.lights[light_kind_name(l.kind)];
-  for (const rc::Material& m : scene.materials) ++s.materials[material_kind_name(m.kind)];
-  for (const rc::Material& m : scene.materials) s.emissive += m.is_emissive();
+void count_geometry(const rc::scene::Scene& scene, SceneSummary& s) {
+  for (const rc::scene::Light& l : scene.lights()) ++s.lights[light_kind_name(l.kind)];
+  for (const rc::scene::Material& m : scene.materials) ++s.materials[material_kind_name(m.kind)];
+  for (const rc::scene::Material& m : scene.materials) s.emissive += m.is_emissive();
   // Memory: the scene's arrays plus Embree's BVH, estimated at 96 bytes per primitive (nodes
   // and primitive references; an order-of-magnitude figure, not a measurement).
-  for (const rc::TriangleMesh& m : scene.meshes) {
+  for (const rc::scene::TriangleMesh& m : scene.meshes) {
     s.vertices += m.positions.size();
     s.bytes += m.positions.size() * sizeof(rc::Vec3) + m.normals.size() * sizeof(rc::Vec3) +
                m.uvs.size() * sizeof(rc::Vec2) + m.tangents.size() * sizeof(glm::vec4) + m.indices.size() * sizeof(uint32_t);
   }
   const size_t bvh = scene.triangle_count() * 96 + scene.spheres.size() * 96;
-  s.bytes += bvh + scene.spheres.size() * sizeof(rc::Sphere);
+  s.bytes += bvh + scene.spheres.size() * sizeof(rc::scene::Sphere);
 }
 
 /// Reads the scene's materials and texture set; writes the summary's texture counts and their
 /// memory: the images the materials read, at the linear half-float copies' size with their MIP
 /// levels (4/3 of the finest).
-void count_textures(const rc::Scene& scene, SceneSummary& s) {
+void count_textures(const rc::scene::Scene& scene, SceneSummary& s) {
   s.textured = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
-                                    [](const rc::Material& m) { return m.is_textured(); }));
+                                    [](const rc::scene::Material& m) { return m.is_textured(); }));
   s.texels = scene.texture_set() ? scene.texture_set()->texel_count() : 0;
   s.texture_bytes = s.texels * 2 * 4 / 3;
 }
@@ -184,9 +184,9 @@ void count_textures(const rc::Scene& scene, SceneSummary& s) {
 /// Reads the scene's materials and the summary; adds to each method's plan what it does with
 /// metallic-roughness materials, rough glass, albedo textures and normal maps; writes
 /// s.normal_mapped.
-void add_material_notes(const rc::Scene& scene, SceneSummary& s, std::vector<MethodPlan>& plans) {
+void add_material_notes(const rc::scene::Scene& scene, SceneSummary& s, std::vector<MethodPlan>& plans) {
   // What each method does with glTF's metallic-roughness materials.
-  const bool metallic_roughness = s.materials.count(material_kind_name(rc::MaterialKind::metallic_roughness)) > 0;
+  const bool metallic_roughness = s.materials.count(material_kind_name(rc::scene::MaterialKind::metallic_roughness)) > 0;
   if (metallic_roughness)
     for (MethodPlan& p : plans) {
       if (p.method == "radiosity")
@@ -198,7 +198,7 @@ void add_material_notes(const rc::Scene& scene, SceneSummary& s, std::vector<Met
     }
   // And with rough glass.
   if (std::any_of(scene.materials.begin(), scene.materials.end(),
-                  [](const rc::Material& m) { return m.is_rough_dielectric(); }))
+                  [](const rc::scene::Material& m) { return m.is_rough_dielectric(); }))
     for (MethodPlan& p : plans) {
       if (p.method == "radiosity")
         p.runs.push_back("rough glass: not meshed; the view traces through it by sampling its GGX lobes");
@@ -218,8 +218,9 @@ void add_material_notes(const rc::Scene& scene, SceneSummary& s, std::vector<Met
       else
         p.runs.push_back("albedo textures: read at every hit (MIP-mapped, bilinear)");
     }
-  s.normal_mapped = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
-                                         [](const rc::Material& m) { return m.normal_texture.valid(); }));
+  s.normal_mapped =
+      size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
+                           [](const rc::scene::Material& m) { return m.normal_texture.valid(); }));
   if (s.normal_mapped > 0)
     for (MethodPlan& p : plans)
       p.runs.push_back(p.method == "radiosity"
@@ -228,7 +229,7 @@ void add_material_notes(const rc::Scene& scene, SceneSummary& s, std::vector<Met
 }
 
 /// --json. Reads the scene, the summary and the plans; writes one JSON object to stdout.
-void print_info_json(const InfoOptions& o, const rc::Scene& scene, const SceneSummary& s,
+void print_info_json(const InfoOptions& o, const rc::scene::Scene& scene, const SceneSummary& s,
                      const std::vector<MethodPlan>& plans) {
   const rc::Bounds3& b = scene.bounds();
   nlohmann::json j = {{"command", "info"},
@@ -246,7 +247,7 @@ void print_info_json(const InfoOptions& o, const rc::Scene& scene, const SceneSu
                                     {"texels", s.texels}, {"memory_estimate_bytes", s.texture_bytes}}},
                       {"memory_estimate_bytes", s.bytes}};
   j["cameras"] = nlohmann::json::array();
-  for (const rc::NamedCamera& c : scene.cameras)
+  for (const rc::scene::NamedCamera& c : scene.cameras)
     j["cameras"].push_back({{"name", c.name}, {"orthographic", c.camera.orthographic},
                             {"vfov_degrees", c.camera.vfov_degrees}, {"height", c.camera.ortho_height},
                             {"aspect", c.aspect}, {"view", is_view(scene, c)}});
@@ -256,7 +257,7 @@ void print_info_json(const InfoOptions& o, const rc::Scene& scene, const SceneSu
 }
 
 /// Reads the scene, the summary and the plans; prints them as text.
-void print_info_text(const InfoOptions& o, const rc::Scene& scene, const SceneSummary& s,
+void print_info_text(const InfoOptions& o, const rc::scene::Scene& scene, const SceneSummary& s,
                      const std::vector<MethodPlan>& plans) {
   const rc::Bounds3& b = scene.bounds();
   std::printf("gilt info: %s\n", o.scene.c_str());
@@ -289,8 +290,8 @@ void print_info_text(const InfoOptions& o, const rc::Scene& scene, const SceneSu
 
 /// `gilt info`: load the scene, count what it holds, plan each method, then print.
 void run_info(const InfoOptions& o) {
-  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
-  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
+  rc::scene::Scene scene = rc::io::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::io::select_camera(scene, o.camera);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   SceneSummary summary;
   count_geometry(scene, summary);

@@ -7,7 +7,7 @@
 
 namespace gilt::cli {
 
-void add_lighting_options(CLI::App& cmd, raytrace_core::ExtraLighting& lighting) {
+void add_lighting_options(CLI::App& cmd, raytrace_core::io::ExtraLighting& lighting) {
   cmd.add_option("--env", lighting.env_file,
                  "Light the scene with an environment image (.exr, .hdr; latitude-longitude, +y up), "
                  "replacing its own environment light")

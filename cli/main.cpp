@@ -12,15 +12,15 @@
 
 #include "cli/commands.h"
 #include "cli/mpi_processes.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace {
 
 /// The first Ctrl-C asks the run to stop at its next work item, so no output is half-written;
 /// a second one ends the process at once.
 extern "C" void on_interrupt(int) {
-  gilt::raytrace_core::request_stop();
+  gilt::raytrace_core::util::request_stop();
   std::signal(SIGINT, SIG_DFL);
 }
 

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/processes.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;
@@ -29,7 +29,7 @@ int as_count(size_t bytes) {
 }
 
 /// The ranks of MPI_COMM_WORLD.
-class MpiProcesses final : public rc::Processes {
+class MpiProcesses final : public rc::util::Processes {
  public:
   MpiProcesses(int rank, int count) : rank_(rank), count_(count) {}
   int rank() const override { return rank_; }
@@ -76,7 +76,7 @@ MpiSession::MpiSession(int& argc, char**& argv) {
   started_ = true;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
-  if (ranks_ > 1) rc::set_processes(std::make_shared<const MpiProcesses>(rank_, ranks_));
+  if (ranks_ > 1) rc::util::set_processes(std::make_shared<const MpiProcesses>(rank_, ranks_));
   if (rank_ > 0) {
     if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr))
       std::fputs("gilt: rank output not silenced\n", stderr);
@@ -85,7 +85,7 @@ MpiSession::MpiSession(int& argc, char**& argv) {
 
 MpiSession::~MpiSession() {
   if (!started_) return;
-  rc::set_processes(nullptr);
+  rc::util::set_processes(nullptr);
   MPI_Finalize();
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// gilt under `mpirun -np N`: MPI's ranks as raytrace_core::Processes. Built with -DGILT_MPI=ON.
+// gilt under `mpirun -np N`: MPI's ranks as raytrace_core::util::Processes. Built with -DGILT_MPI=ON.
 
 namespace gilt::cli {
 

@@ -16,9 +16,9 @@
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::cli {
@@ -32,7 +32,7 @@ struct RadiosityOptions {
   std::string scene, output, quantity = "radiance", onto = "elements", fit = "least-squares", check_points_file;
   radiosity::solver::SolverSettings solver;
   radiosity::bake::CheckSettings check;
-  rc::ExtraLighting lighting;
+  rc::io::ExtraLighting lighting;
   int check_points = 0;  ///< 0: no check
   int lightmap = 0;      ///< 0: no lightmap
   int bake_gather = 0;   ///< final-gather samples per baked point; 0: read the solution
@@ -112,9 +112,9 @@ void validate_radiosity_options(RadiosityOptions& o, RadiosityRun& run) {
 /// Reads o.scene, o.lighting, o.output, o.lightmap, run.lightmap and run.onto_input; writes
 /// run.start (the clock --time runs on) and returns the scene, its warnings printed and the
 /// output checked against it (a lightmap's layout before the solve, not after it).
-rc::Scene load_radiosity_scene(const RadiosityOptions& o, RadiosityRun& run) {
+rc::scene::Scene load_radiosity_scene(const RadiosityOptions& o, RadiosityRun& run) {
   run.start = std::chrono::steady_clock::now();
-  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
+  rc::scene::Scene scene = rc::io::load_scene(o.scene, o.lighting);
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (run.lightmap) {
     radiosity::bake::check_lightmap_output(o.output, scene);
@@ -128,7 +128,7 @@ rc::Scene load_radiosity_scene(const RadiosityOptions& o, RadiosityRun& run) {
 /// and run.start; writes o.solver.progress, o.solver.time_limit (what is left of --time for the
 /// solve), the time it keeps back for the export (o.solver.after_seconds and
 /// after_seconds_per_element), run.time_limit and run.gather (its deadline).
-void plan_radiosity_budget(const rc::Scene& scene, RadiosityOptions& o, RadiosityRun& run) {
+void plan_radiosity_budget(const rc::scene::Scene& scene, RadiosityOptions& o, RadiosityRun& run) {
   o.solver.progress = !o.quiet && !o.json;
   radiosity::bake::BakeGather& gather = run.gather;
   gather = radiosity::bake::BakeGather{o.bake_gather, o.solver.seed};
@@ -158,7 +158,7 @@ void plan_radiosity_budget(const rc::Scene& scene, RadiosityOptions& o, Radiosit
 
 /// Reads the scene and o.solver; writes run.budget_fit and returns the solution. Under a budget a
 /// mesh left to gilt is sized to fit it (radiosity/solver/budget.h).
-radiosity::solver::Solution solve_radiosity(const rc::Scene& scene, const RadiosityOptions& o, RadiosityRun& run) {
+radiosity::solver::Solution solve_radiosity(const rc::scene::Scene& scene, const RadiosityOptions& o, RadiosityRun& run) {
   return o.solver.time_limit > 0.0 ? radiosity::solver::solve_within(scene, o.solver, o.solver.time_limit, &run.budget_fit)
                                    : radiosity::solver::solve(scene, o.solver);
 }
@@ -172,7 +172,7 @@ void print_solve_warnings(const radiosity::solver::Solution& sol, const Radiosit
 /// Reads the scene, the solution, the options and run.ex, run.gather; writes run.fit and the
 /// output file, with run.atlas (--lightmap), run.onto (--onto input) or run.snap and the vertex
 /// gather (--onto elements).
-void export_radiosity(const rc::Scene& scene, const radiosity::solver::Solution& sol, const RadiosityOptions& o,
+void export_radiosity(const rc::scene::Scene& scene, const radiosity::solver::Solution& sol, const RadiosityOptions& o,
                       RadiosityRun& run) {
   const radiosity::bake::ExportSettings& ex = run.ex;
   run.fit = o.fit == "point" ? radiosity::bake::VertexFit::point : radiosity::bake::VertexFit::least_squares;
@@ -200,13 +200,13 @@ void export_radiosity(const rc::Scene& scene, const radiosity::solver::Solution&
 /// --check N. Reads the scene, the solution, the options and what the export left in run; writes
 /// o.check (points and seed), run.gather's deadline (none: the check gathers every point),
 /// run.check, run.surface_check or run.element_surface_check, and the --check-points file.
-void check_radiosity(const rc::Scene& scene, const radiosity::solver::Solution& sol, RadiosityOptions& o,
-                     RadiosityRun& run) {
+void check_radiosity(const rc::scene::Scene& scene, const radiosity::solver::Solution& sol,
+                     RadiosityOptions& o, RadiosityRun& run) {
   if (o.check_points <= 0) return;
   const radiosity::bake::ExportSettings& ex = run.ex;
   o.check.points = o.check_points;
   o.check.seed = o.solver.seed;
-  const rc::ThreadLimit limit(o.solver.threads);
+  const rc::util::ThreadLimit limit(o.solver.threads);
   // The check's own irradiance bake gathers every point, past any deadline.
   run.gather.deadline = std::chrono::steady_clock::time_point::max();
   if (run.lightmap) {
@@ -331,7 +331,7 @@ void report_radiosity_json(const radiosity::solver::Solution& sol, const Radiosi
 /// Reads the solution and o.solver; prints its mesh, solve, ladder, work and time lines.
 void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityOptions& o) {
   const double secs = std::max(sol.seconds, 1e-9);
-  const int threads = o.solver.threads > 0 ? o.solver.threads : rc::hardware_threads();
+  const int threads = o.solver.threads > 0 ? o.solver.threads : rc::util::hardware_threads();
   std::printf("gilt radiosity: %s, %d thread(s)\n", o.scene.c_str(), threads);
   std::printf("  mesh:    %zu elements (%zu as meshed), %zu vertices, target edge %.4g, %zu elements bisected at steep "
               "direct light\n",
@@ -481,11 +481,11 @@ void print_bake_report(const radiosity::solver::Solution& sol, const RadiosityOp
 void run_radiosity(RadiosityOptions& o) {
   RadiosityRun run;
   validate_radiosity_options(o, run);
-  const rc::Scene scene = load_radiosity_scene(o, run);
+  const rc::scene::Scene scene = load_radiosity_scene(o, run);
   plan_radiosity_budget(scene, o, run);
   const radiosity::solver::Solution sol = solve_radiosity(scene, o, run);
   // Under mpirun every rank took part in the solve; the bake, the export and the check are rank 0's.
-  if (rc::processes().rank() > 0) return;
+  if (rc::util::processes().rank() > 0) return;
   print_solve_warnings(sol, o, run);
   const auto export_start = std::chrono::steady_clock::now();
   export_radiosity(scene, sol, o, run);

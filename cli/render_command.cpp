@@ -16,14 +16,14 @@
 #include "api/statistics.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/whitted.h"
+#include "raytrace_core/render/whitted.h"
 
 namespace gilt::cli {
 namespace rc = gilt::raytrace_core;
@@ -33,7 +33,7 @@ namespace {
 
 struct RenderOptions {
   std::string scene;
-  rc::ExtraLighting lighting;
+  rc::io::ExtraLighting lighting;
   std::string output;
   std::string method = "path";
   std::optional<int> spp, width, height;
@@ -69,8 +69,8 @@ rc::Vec3 parse_vec3(const std::string& text, const std::string& flag) {
 
 /// The camera: the scene's (or a default view framed for an image of `aspect`), overridden by any
 /// camera flag.
-rc::Camera make_camera(const rc::Scene& scene, const RenderOptions& o, float aspect) {
-  rc::Camera c = scene.effective_camera(aspect);
+rc::scene::Camera make_camera(const rc::scene::Scene& scene, const RenderOptions& o, float aspect) {
+  rc::scene::Camera c = scene.effective_camera(aspect);
   if (!o.look_from.empty()) c.look_from = parse_vec3(o.look_from, "--lookfrom");
   if (!o.look_at.empty()) c.look_at = parse_vec3(o.look_at, "--lookat");
   if (!o.up.empty()) c.up = parse_vec3(o.up, "--up");
@@ -83,7 +83,7 @@ rc::Camera make_camera(const rc::Scene& scene, const RenderOptions& o, float asp
 
 /// Checks the output path before any work, so a long render cannot fail at its end.
 void check_output(const std::string& path) {
-  if (!rc::is_supported_image_path(path))
+  if (!rc::util::is_supported_image_path(path))
     throw rc::InputError("-o " + path + ": unsupported image type (use .exr, .hdr or .png)");
   const std::filesystem::path parent = std::filesystem::absolute(path).parent_path();
   if (!std::filesystem::is_directory(parent))
@@ -93,24 +93,24 @@ void check_output(const std::string& path) {
 
 void run_render(const RenderOptions& o) {
   check_output(o.output);
-  rc::Scene scene = rc::load_scene(o.scene, o.lighting);
-  if (!o.camera.empty()) rc::select_camera(scene, o.camera);
-  scene.set_light_sampling(rc::parse_light_sampling(o.light_sampler));
+  rc::scene::Scene scene = rc::io::load_scene(o.scene, o.lighting);
+  if (!o.camera.empty()) rc::io::select_camera(scene, o.camera);
+  scene.set_light_sampling(rc::scene::parse_light_sampling(o.light_sampler));
   for (const std::string& w : scene.warnings) std::cerr << "gilt: warning: " << w << "\n";
   if (scene.lights().empty()) std::cerr << "gilt: warning: the scene has no lights: the image will be black\n";
 
-  rc::RenderSettings settings;
+  rc::render::RenderSettings settings;
   // One of --width and --height alone keeps the scene's aspect ratio (its camera's, if it has one).
   std::tie(settings.width, settings.height) = api::image_size(scene, o.width, o.height);
   settings.spp = o.spp.value_or(scene.render.spp);
   settings.time_limit = o.time_limit;
   settings.seed = o.seed;
   settings.threads = o.threads;
-  settings.filter.kind = rc::Filter::parse(o.filter);
+  settings.filter.kind = rc::render::Filter::parse(o.filter);
   settings.filter.radius = o.filter_radius;
-  settings.sampler = rc::parse_sampler(o.sampler);
+  settings.sampler = rc::render::parse_sampler(o.sampler);
   settings.progress = !o.quiet && !o.json;
-  const rc::Camera camera = make_camera(scene, o, float(settings.width) / float(settings.height));
+  const rc::scene::Camera camera = make_camera(scene, o, float(settings.width) / float(settings.height));
 
   MethodOptions mo;
   mo.solver = o.solver;
@@ -118,19 +118,19 @@ void run_render(const RenderOptions& o) {
   o.photon.apply(mo);
   mo.max_depth = o.max_depth;
   const MethodResult result = api::run_method(scene, camera, o.method, settings, mo);
-  const rc::Film& film = result.film;
-  const rc::RenderStats& stats = result.stats;
+  const rc::render::Film& film = result.film;
+  const rc::render::RenderStats& stats = result.stats;
   const std::optional<radiosity::solver::Solution>& solution = result.solution;
   const std::optional<photonmap::PhotonMapperStats>& photon = result.photon;
   const std::optional<photonmap::SppmStats>& sppm_stats = result.sppm;
   for (const std::string& n : result.notes)
     if (!o.json) std::cerr << "gilt: " << n << "\n";
-  if (rc::processes().rank() == 0)  // under mpirun, rank 0 alone writes
-    rc::write_image(o.output, rc::Image{film.width(), film.height(), film.pixels()}, o.exposure);
+  if (rc::util::processes().rank() == 0)  // under mpirun, rank 0 alone writes
+    rc::util::write_image(o.output, rc::util::Image{film.width(), film.height(), film.pixels()}, o.exposure);
   if (stats.non_finite > 0)
     std::cerr << "gilt: warning: " << stats.non_finite << " sample(s) were NaN or infinite and were discarded\n";
 
-  const int threads = o.threads > 0 ? o.threads : rc::hardware_threads();
+  const int threads = o.threads > 0 ? o.threads : rc::util::hardware_threads();
   const double secs = std::max(stats.seconds, 1e-9);
   if (o.json) {
     nlohmann::json j = api::run_statistics(scene, o.method, settings, result);

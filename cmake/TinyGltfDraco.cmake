@@ -3,7 +3,7 @@
 # is replaced by a call to gilt's checked one (raytrace_core/io/gltf_draco.h, which says why).
 # Nothing else changes, so every other file keeps including <tiny_gltf.h> itself; only
 # raytrace_core/io/tinygltf_impl.cpp, which compiles tinygltf's implementation, includes the copy.
-# Run at build time by raytrace_core/CMakeLists.txt:
+# Run at build time by raytrace_core/io/CMakeLists.txt:
 #   cmake -DHEADER=/path/to/tiny_gltf.h -DOUTPUT=/path/to/tiny_gltf_draco.h -P TinyGltfDraco.cmake
 
 if(NOT HEADER OR NOT OUTPUT)
@@ -35,7 +35,7 @@ string(SUBSTRING "${source}" ${end} -1 tail)
 set(replacement [=[
 static bool ParseDracoExtension(Primitive *primitive, Model *model, std::string * /*err*/,
                                 const Value &dracoExtensionValue) {
-  ::gilt::raytrace_core::decode_draco_primitive(*primitive, *model, dracoExtensionValue);
+  ::gilt::raytrace_core::io::decode_draco_primitive(*primitive, *model, dracoExtensionValue);
   return true;
 }
 #endif

@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   const std::string scene_name = argc > 1 ? argv[1] : "cornell";
   const std::string output = argc > 2 ? argv[2] : "cornell_baked.ply";
   try {
-    const rc::Scene scene = rc::load_scene(scene_name);
+    const rc::scene::Scene scene = rc::io::load_scene(scene_name);
     rad::solver::SolverSettings settings;
     settings.mesh.elements = argc > 3 ? std::atoi(argv[3]) : 2000;
     settings.progress = false;

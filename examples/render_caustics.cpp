@@ -8,8 +8,8 @@
 #include <string>
 
 #include "photonmap/photon_mapper.h"
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {
@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   const std::string output = argc > 1 ? argv[1] : "caustics.exr";
   const int spp = argc > 2 ? std::atoi(argv[2]) : 8;
   try {
-    const rc::Scene scene = rc::load_scene("cornell-caustics");
+    const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
     pm::PhotonMapperSettings settings;
     settings.photons.caustic_photons = 500'000;  // a sharper caustic than the default
     const pm::PhotonMapper mapper(scene, settings);
@@ -28,14 +28,15 @@ int main(int argc, char** argv) {
                 stats.precompute_seconds);
     for (const std::string& s : stats.skipped) std::printf("skipped: %s\n", s.c_str());
 
-    rc::RenderSettings render;
+    rc::render::RenderSettings render;
     render.width = render.height = 256;
     render.spp = spp > 0 ? spp : 8;
-    rc::RenderStats rs;
-    const rc::Film film = rc::render_image(
+    rc::render::RenderStats rs;
+    const rc::render::Film film = rc::render::render_image(
         scene, scene.effective_camera(), render,
-        [&](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper.radiance(ray, ctx); }, &rs);
-    rc::write_image(output, {film.width(), film.height(), film.pixels()});
+        [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return mapper.radiance(ray, ctx); },
+        &rs);
+    rc::util::write_image(output, {film.width(), film.height(), film.pixels()});
     std::printf("%d spp in %.2f s -> %s\n", rs.spp, rs.seconds, output.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render_caustics: %s\n", e.what());

@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <string>
 
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 int main(int argc, char** argv) {
@@ -15,16 +15,16 @@ int main(int argc, char** argv) {
   const std::string output = argc > 1 ? argv[1] : "cornell.exr";
   const int spp = argc > 2 ? std::atoi(argv[2]) : 64;
   try {
-    const rc::Scene scene = rc::load_scene("cornell");
-    rc::RenderSettings settings;
+    const rc::scene::Scene scene = rc::io::load_scene("cornell");
+    rc::render::RenderSettings settings;
     settings.width = settings.height = 256;
     settings.spp = spp > 0 ? spp : 64;
-    const rc::PathSettings path;
-    rc::RenderStats stats;
-    const rc::Film film = rc::render_image(
+    const rc::render::PathSettings path;
+    rc::render::RenderStats stats;
+    const rc::render::Film film = rc::render::render_image(
         scene, scene.effective_camera(), settings,
-        [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); }, &stats);
-    rc::write_image(output, {film.width(), film.height(), film.pixels()});
+        [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); }, &stats);
+    rc::util::write_image(output, {film.width(), film.height(), film.pixels()});
     std::printf("%d spp in %.2f s, %.2f Mrays/s -> %s\n", stats.spp, stats.seconds, stats.rays / stats.seconds * 1e-6,
                 output.c_str());
   } catch (const std::exception& e) {

@@ -4,9 +4,9 @@
 #include <atomic>
 #include <cmath>
 
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 
 namespace gilt::photonmap {
@@ -43,7 +43,7 @@ double edge_wedge(glm::dvec2 u1, glm::dvec2 u2, double rho2) {
 
 }  // namespace
 
-SurfaceSides::SurfaceSides(const rc::Scene& scene) {
+SurfaceSides::SurfaceSides(const rc::scene::Scene& scene) {
   first_.resize(scene.meshes.size());
   uint64_t total = 0;
   for (size_t g = 0; g < scene.meshes.size(); ++g) {
@@ -53,9 +53,10 @@ SurfaceSides::SurfaceSides(const rc::Scene& scene) {
   counts_.assign(2 * total, 0);
 }
 
-void SurfaceSides::add(const rc::Scene& scene, uint32_t geom_id, uint32_t prim_id, const rc::Vec3& normal) {
+void SurfaceSides::add(const rc::scene::Scene& scene, uint32_t geom_id, uint32_t prim_id,
+                       const rc::Vec3& normal) {
   if (geom_id >= first_.size()) return;  // a sphere
-  const rc::TriangleMesh& mesh = scene.meshes[geom_id];
+  const rc::scene::TriangleMesh& mesh = scene.meshes[geom_id];
   const uint32_t* idx = &mesh.indices[3 * size_t(prim_id)];
   const rc::Vec3 &a = mesh.positions[idx[0]], &b = mesh.positions[idx[1]], &c = mesh.positions[idx[2]];
   const bool front = glm::dot(glm::cross(b - a, c - a), normal) >= 0.0f;
@@ -63,13 +64,13 @@ void SurfaceSides::add(const rc::Scene& scene, uint32_t geom_id, uint32_t prim_i
       .fetch_add(1, std::memory_order_relaxed);
 }
 
-SurfaceSides every_side(const rc::Scene& scene) {
+SurfaceSides every_side(const rc::scene::Scene& scene) {
   SurfaceSides sides(scene);
   std::fill(sides.counts().begin(), sides.counts().end(), 1);
   return sides;
 }
 
-SurfaceSides open_sides(const rc::Scene& scene, int rays) {
+SurfaceSides open_sides(const rc::scene::Scene& scene, int rays) {
   SurfaceSides sides(scene);
   std::vector<uint64_t>& reached = sides.counts();
   const size_t count = reached.size();
@@ -78,8 +79,8 @@ SurfaceSides open_sides(const rc::Scene& scene, int rays) {
   // sky. Winding does not enter: a ray reaches whichever side of a triangle faces it.
   std::vector<uint32_t> lands(count * size_t(rays), kNothing);
   for (uint32_t g = 0; g < scene.meshes.size(); ++g) {
-    const rc::TriangleMesh& mesh = scene.meshes[g];
-    rc::parallel_for(mesh.indices.size() / 3, [&](size_t t) {
+    const rc::scene::TriangleMesh& mesh = scene.meshes[g];
+    rc::util::parallel_for(mesh.indices.size() / 3, [&](size_t t) {
       const uint32_t* idx = &mesh.indices[3 * t];
       const rc::Vec3 &a = mesh.positions[idx[0]], &b = mesh.positions[idx[1]], &c = mesh.positions[idx[2]];
       const rc::Vec3 cross = glm::cross(b - a, c - a);
@@ -87,24 +88,24 @@ SurfaceSides open_sides(const rc::Scene& scene, int rays) {
       if (!(length > 0.0f) || !std::isfinite(length)) return;
       for (int side = 0; side < 2; ++side) {
         const size_t s = sides.side_index(g, uint32_t(t)) + size_t(side);
-        rc::SurfacePoint sp;
+        rc::scene::SurfacePoint sp;
         sp.ng = (side == 0 ? 1.0f : -1.0f) * cross / length;
         sp.p_error = rc::Vec3(1e-6f) * (glm::abs(a) + glm::abs(b) + glm::abs(c) + 1.0f);
         const rc::Frame frame = rc::Frame::from_normal(sp.ng);
         for (int i = 0; i < rays; ++i) {
-          rc::Rng rng = rc::Rng::for_item(0x5157u, s, uint64_t(i));
+          rc::util::Rng rng = rc::util::Rng::for_item(0x5157u, s, uint64_t(i));
           // A uniform point of the triangle (the folded square), kept off its edges.
           rc::Vec2 u = rng.uniform2();
           if (u.x + u.y > 1.0f) u = rc::Vec2(1.0f) - u;
           u = 0.05f + 0.9f * u;
           sp.p = a + u.x * (b - a) + u.y * (c - a);
-          const rc::Vec3 d = frame.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
-          const auto hit = scene.intersect(rc::spawn_ray(sp, d));
+          const rc::Vec3 d = frame.to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
+          const auto hit = scene.intersect(rc::scene::spawn_ray(sp, d));
           uint32_t& out = lands[s * size_t(rays) + size_t(i)];
           if (!hit) {
             out = kEscaped;
           } else if (hit->geom_id != scene.sphere_geom_id()) {
-            const rc::TriangleMesh& other = scene.meshes[hit->geom_id];
+            const rc::scene::TriangleMesh& other = scene.meshes[hit->geom_id];
             const uint32_t* j = &other.indices[3 * size_t(hit->prim_id)];
             const rc::Vec3 n = glm::cross(other.positions[j[1]] - other.positions[j[0]],
                                           other.positions[j[2]] - other.positions[j[0]]);
@@ -158,16 +159,16 @@ double kernel_integral(const rc::Vec3& a, const rc::Vec3& b, const rc::Vec3& c, 
   return std::fabs(sum) / double(r2);
 }
 
-double disk_coverage(const rc::Scene& scene, const SurfaceSides& sides, const rc::Vec3& p, const rc::Vec3& n,
-                     float r2, float min_cosine) {
+double disk_coverage(const rc::scene::Scene& scene, const SurfaceSides& sides, const rc::Vec3& p,
+                     const rc::Vec3& n, float r2, float min_cosine) {
   if (sides.empty() || !(r2 > 0.0f)) return 0.0;
   const float r = std::sqrt(r2);
-  for (const rc::Sphere& s : scene.spheres)
+  for (const rc::scene::Sphere& s : scene.spheres)
     if (!scene.materials[s.material].is_traced_through() && std::fabs(glm::length(s.center - p) - s.radius) < r)
       return -1.0;
   double sum = 0.0;
   scene.for_each_triangle_near(p, r, [&](uint32_t geom_id, uint32_t prim_id) {
-    const rc::TriangleMesh& mesh = scene.meshes[geom_id];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[geom_id];
     const uint32_t* idx = &mesh.indices[3 * size_t(prim_id)];
     const rc::Vec3 &a = mesh.positions[idx[0]], &b = mesh.positions[idx[1]], &c = mesh.positions[idx[2]];
     const rc::Vec3 cross = glm::cross(b - a, c - a);

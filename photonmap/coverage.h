@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::photonmap {
 
@@ -28,12 +28,12 @@ namespace rc = gilt::raytrace_core;
 class SurfaceSides {
  public:
   SurfaceSides() = default;
-  explicit SurfaceSides(const rc::Scene& scene);
+  explicit SurfaceSides(const rc::scene::Scene& scene);
 
   bool empty() const { return counts_.empty(); }
   /// Records one photon stored on triangle prim_id of mesh geom_id, on the side its normal (the
   /// stored photon normal, facing where the photon came from) lies. Thread-safe.
-  void add(const rc::Scene& scene, uint32_t geom_id, uint32_t prim_id, const rc::Vec3& normal);
+  void add(const rc::scene::Scene& scene, uint32_t geom_id, uint32_t prim_id, const rc::Vec3& normal);
   /// Whether any photon was stored on that side.
   bool holds(uint32_t geom_id, uint32_t prim_id, bool front) const {
     return counts_[2 * (size_t(first_[geom_id]) + prim_id) + (front ? 0 : 1)] > 0;
@@ -52,7 +52,7 @@ class SurfaceSides {
 /// photon mapper divides by. On Šibenik open_sides reaches 99.6 % of the sides, and this is the
 /// same to that; where it counts a side that faces into a closed solid, a disk reaching it is
 /// divided by too much and reads dark.
-SurfaceSides every_side(const rc::Scene& scene);
+SurfaceSides every_side(const rc::scene::Scene& scene);
 
 /// The triangle sides light from outside the scene can reach: a side that one of `rays`
 /// cosine-distributed rays, from points spread over it, sees the sky from, and any side that
@@ -61,15 +61,15 @@ SurfaceSides every_side(const rc::Scene& scene);
 /// solids are not reached. Unlike the sides a map's photons happened to reach, it does not
 /// leave out small triangles no photon hit by chance. A scene lit only from inside (a closed
 /// room with a lamp) reaches no side: give such scenes every side.
-SurfaceSides open_sides(const rc::Scene& scene, int rays = 8);
+SurfaceSides open_sides(const rc::scene::Scene& scene, int rays = 8);
 
 /// The kernel 2 / (π r²) · (1 − d² / r²) integrated over the triangle sides within distance
 /// √r2 of p that hold photons and face within `min_cosine` of the unit normal n: 1 for a full
 /// flat disk, less at an edge or in a corner, more where folded surface crowds the ball. Returns
 /// 0 when no such side reaches the ball, and -1 when a sphere that can hold photons does (the
 /// coverage is then unknown).
-double disk_coverage(const rc::Scene& scene, const SurfaceSides& sides, const rc::Vec3& p, const rc::Vec3& n,
-                     float r2, float min_cosine);
+double disk_coverage(const rc::scene::Scene& scene, const SurfaceSides& sides, const rc::Vec3& p,
+                     const rc::Vec3& n, float r2, float min_cosine);
 
 /// ∫ (1 − |y − p|² / r2)⁺ dA(y) over the triangle abc, in closed form (unnormalised: a full
 /// flat disk through p gives π r2 / 2).

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstdint>
 
-#include "raytrace_core/math.h"
-#include "raytrace_core/rgb.h"
+#include "raytrace_core/util/math.h"
+#include "raytrace_core/util/rgb.h"
 
 namespace gilt::photonmap {
 

@@ -10,7 +10,7 @@
 #include <span>
 #include <type_traits>
 
-#include "raytrace_core/math.h"
+#include "raytrace_core/util/math.h"
 
 namespace gilt::photonmap {
 

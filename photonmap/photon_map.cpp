@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <chrono>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/rng.h"
 
 namespace gilt::photonmap {
 namespace {
@@ -23,21 +23,22 @@ constexpr uint64_t kChunk = 4096;
 /// Emits photons first, …, first + count − 1 and keeps those `keep` accepts, in photon order,
 /// each with its power divided by `count`.
 template <class Keep>
-std::vector<Photon> trace_map(const rc::Scene& scene, uint64_t first, uint64_t count, uint64_t stream,
+std::vector<Photon> trace_map(const rc::scene::Scene& scene, uint64_t first, uint64_t count, uint64_t stream,
                               const PhotonSettings& settings, uint64_t& paths, Keep keep) {
   const auto& lights = scene.lights();
-  const rc::Distribution1D& choice = scene.light_distribution();
+  const rc::util::Distribution1D& choice = scene.light_distribution();
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   std::vector<std::vector<Photon>> stored(chunks);
   // Under several processes each traces the chunks it owns; they are joined in chunk order.
-  rc::distributed_chunks<Photon>(stored, [&](size_t c, std::vector<Photon>& out) {
+  rc::util::distributed_chunks<Photon>(stored, [&](size_t c, std::vector<Photon>& out) {
     for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
-      rc::Rng rng = rc::Rng::for_item(settings.seed, first + i, stream);
+      rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, first + i, stream);
       const uint32_t li = choice.sample(rng.uniform());
       const float pmf = choice.pmf(li);
       if (!(pmf > 0.0f)) continue;
       const rc::Vec2 u_position = rng.uniform2(), u_direction = rng.uniform2();
-      const rc::EmissionSample es = rc::sample_emission(scene, lights[li], u_position, u_direction);
+      const rc::scene::EmissionSample es =
+          rc::scene::sample_emission(scene, lights[li], u_position, u_direction);
       if (es.power.is_black()) continue;
       const rc::Rgb power = es.power / (pmf * float(count));
       trace_photon_path(scene, es.ray, power, rng, settings.max_depth,
@@ -87,7 +88,8 @@ float for_each_estimate_photon(const PhotonMap& map, const EstimateQuery& q, Est
 /// What an estimate over the disk of squared radius r2 is divided by: its coverage, held at 0.1
 /// and above (as SPPM holds its own), or 1 where it is unknown (a sphere in the ball) or where
 /// nothing was found.
-float coverage_divisor(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& q, float r2) {
+float coverage_divisor(const rc::scene::Scene& scene, const PhotonMap& map, const EstimateQuery& q,
+                       float r2) {
   if (!(r2 > 0.0f)) return 1.0f;
   const double c = disk_coverage(scene, map.sides, q.position, q.normal, r2, kSameSurfaceCosine);
   return c < 0.0 ? 1.0f : float(std::max(c, 0.1));
@@ -101,18 +103,19 @@ void PhotonMap::build_index(IndexKind kind) {
   index = PhotonIndex(positions, kind);
 }
 
-MapNeeds map_needs(const rc::Scene& scene) {
+MapNeeds map_needs(const rc::scene::Scene& scene) {
   MapNeeds needs;
   bool specular = false, reflective = false;
   auto visit = [&](uint32_t material) {
-    const rc::Material& m = scene.materials[material];
+    const rc::scene::Material& m = scene.materials[material];
     if (m.is_traced_through()) specular = true;
-    else if (rc::diffuse_reflectance(m).max_component() > 1e-4f || m.kind == rc::MaterialKind::glossy ||
-             m.kind == rc::MaterialKind::metallic_roughness)
+    else if (rc::scene::diffuse_reflectance(m).max_component() > 1e-4f ||
+             m.kind == rc::scene::MaterialKind::glossy ||
+             m.kind == rc::scene::MaterialKind::metallic_roughness)
       reflective = true;
   };
-  for (const rc::TriangleMesh& m : scene.meshes) visit(m.material);
-  for (const rc::Sphere& s : scene.spheres) visit(s.material);
+  for (const rc::scene::TriangleMesh& m : scene.meshes) visit(m.material);
+  for (const rc::scene::Sphere& s : scene.spheres) visit(s.material);
   if (scene.lights().empty()) {
     needs.caustic_reason = needs.global_reason = "no lights";
     return needs;
@@ -124,7 +127,7 @@ MapNeeds map_needs(const rc::Scene& scene) {
   return needs;
 }
 
-PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings) {
+PhotonMaps trace_photons(const rc::scene::Scene& scene, const PhotonSettings& settings) {
   if (!scene.committed()) throw std::logic_error("trace_photons: the scene was not committed");
   const auto start = std::chrono::steady_clock::now();
   PhotonMaps maps;
@@ -153,7 +156,7 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
       // clock decides for every process. A closed room stores most of its paths, and there more
       // photons cost the render its samples (cornell at 2 s: relMSE 7 times higher).
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const bool more_time = rc::processes().broadcast_value(seconds < settings.global_seconds) &&
+      const bool more_time = rc::util::processes().broadcast_value(seconds < settings.global_seconds) &&
                              2 * maps.global.photons.size() < maps.global.emitted && r + 1 < settings.global_time_rounds;
       const bool sparse = 2 * maps.global.photons.size() < round && r + 1 < settings.global_rounds;
       if (!sparse && !more_time) break;
@@ -177,8 +180,8 @@ PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings)
   return maps;
 }
 
-std::vector<Photon> trace_global_sites(const rc::Scene& scene, const PhotonSettings& settings, uint64_t paths,
-                                       uint64_t& traced) {
+std::vector<Photon> trace_global_sites(const rc::scene::Scene& scene, const PhotonSettings& settings,
+                                       uint64_t paths, uint64_t& traced) {
   if (!scene.committed()) throw std::logic_error("trace_global_sites: the scene was not committed");
   // Path numbers from 2^62 on, far from the maps' (which count from 0), on a stream of their own.
   return trace_map(scene, uint64_t(1) << 62, paths, 0xb100000000ull, settings, traced, keep_global);
@@ -186,17 +189,17 @@ std::vector<Photon> trace_global_sites(const rc::Scene& scene, const PhotonSetti
 
 namespace {
 
-rc::Rgb radiance_estimate(const rc::Scene* scene, const PhotonMap& map, const EstimateQuery& query,
-                          const rc::Material& material, const rc::Frame& shading, const rc::Vec3& wo_local,
-                          EstimateScratch& scratch) {
+rc::Rgb radiance_estimate(const rc::scene::Scene* scene, const PhotonMap& map, const EstimateQuery& query,
+                          const rc::scene::Material& material, const rc::Frame& shading,
+                          const rc::Vec3& wo_local, EstimateScratch& scratch) {
   rc::Rgb sum(0.0f);
-  const bool lambertian = material.kind == rc::MaterialKind::diffuse;
+  const bool lambertian = material.kind == rc::scene::MaterialKind::diffuse;
   const float r2 = for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) {
     if (lambertian) {
       sum += p.power * w;
     } else {
       const rc::Vec3 wi = shading.to_local(decode_direction(p.direction));
-      sum += rc::bsdf_eval(material, wo_local, wi) * p.power * w;
+      sum += rc::scene::bsdf_eval(material, wo_local, wi) * p.power * w;
     }
   });
   if (scene && !sum.is_black()) sum = sum / coverage_divisor(*scene, map, query, r2);
@@ -204,7 +207,7 @@ rc::Rgb radiance_estimate(const rc::Scene* scene, const PhotonMap& map, const Es
   return lambertian ? material.albedo * sum * rc::kInvPi : sum;
 }
 
-rc::Rgb irradiance_estimate(const rc::Scene* scene, const PhotonMap& map, const EstimateQuery& query,
+rc::Rgb irradiance_estimate(const rc::scene::Scene* scene, const PhotonMap& map, const EstimateQuery& query,
                             EstimateScratch& scratch) {
   rc::Rgb sum(0.0f);
   const float r2 = for_each_estimate_photon(map, query, scratch, [&](const Photon& p, float w) { sum += p.power * w; });
@@ -214,8 +217,9 @@ rc::Rgb irradiance_estimate(const rc::Scene* scene, const PhotonMap& map, const 
 
 }  // namespace
 
-rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, const rc::Material& material,
-                          const rc::Frame& shading, const rc::Vec3& wo_local, EstimateScratch& scratch) {
+rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query,
+                          const rc::scene::Material& material, const rc::Frame& shading,
+                          const rc::Vec3& wo_local, EstimateScratch& scratch) {
   return radiance_estimate(nullptr, map, query, material, shading, wo_local, scratch);
 }
 
@@ -223,13 +227,13 @@ rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, Es
   return irradiance_estimate(nullptr, map, query, scratch);
 }
 
-rc::Rgb estimate_radiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
-                          const rc::Material& material, const rc::Frame& shading, const rc::Vec3& wo_local,
-                          EstimateScratch& scratch) {
+rc::Rgb estimate_radiance(const rc::scene::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+                          const rc::scene::Material& material, const rc::Frame& shading,
+                          const rc::Vec3& wo_local, EstimateScratch& scratch) {
   return radiance_estimate(&scene, map, query, material, shading, wo_local, scratch);
 }
 
-rc::Rgb estimate_irradiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+rc::Rgb estimate_irradiance(const rc::scene::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
                             EstimateScratch& scratch) {
   return irradiance_estimate(&scene, map, query, scratch);
 }

@@ -14,9 +14,9 @@
 #include "photonmap/coverage.h"
 #include "photonmap/photon.h"
 #include "photonmap/photon_index.h"
-#include "raytrace_core/material.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/material.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::photonmap {
 
@@ -69,18 +69,18 @@ struct MapNeeds {
   bool caustic = false, global = false;
   std::string caustic_reason, global_reason;
 };
-MapNeeds map_needs(const rc::Scene& scene);
+MapNeeds map_needs(const rc::scene::Scene& scene);
 
 /// Traces the photons of both maps (in parallel; photon i of a map draws from its own random
 /// stream, so the maps are identical for any thread count) and builds their indexes.
-PhotonMaps trace_photons(const rc::Scene& scene, const PhotonSettings& settings);
+PhotonMaps trace_photons(const rc::scene::Scene& scene, const PhotonSettings& settings);
 
 /// Photons as the global map would store them (after at least one diffuse bounce) from `paths`
 /// further paths, on a random stream of their own, so that they are independent of the maps'
 /// photons; `traced` grows by the paths traced. The two-pass mapper precomputes irradiance at
 /// their positions (photon_mapper.h says why not at the map's own photons).
-std::vector<Photon> trace_global_sites(const rc::Scene& scene, const PhotonSettings& settings, uint64_t paths,
-                                       uint64_t& traced);
+std::vector<Photon> trace_global_sites(const rc::scene::Scene& scene, const PhotonSettings& settings,
+                                       uint64_t paths, uint64_t& traced);
 
 /// Scratch space for density estimates, one per thread: queries do not allocate.
 struct EstimateScratch {
@@ -109,8 +109,9 @@ struct EstimateQuery {
 /// within the maximum radius whose stored normal agrees with the query's (same side, within
 /// about 25°), each weighted by the BSDF and by Epanechnikov's kernel over the disk of the
 /// k-th photon's distance (or the maximum radius when fewer are found).
-rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query, const rc::Material& material,
-                          const rc::Frame& shading, const rc::Vec3& wo_local, EstimateScratch& scratch);
+rc::Rgb estimate_radiance(const PhotonMap& map, const EstimateQuery& query,
+                          const rc::scene::Material& material, const rc::Frame& shading,
+                          const rc::Vec3& wo_local, EstimateScratch& scratch);
 
 /// Irradiance (W·m⁻²) at the query from the same photons, with the same kernel.
 rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, EstimateScratch& scratch);
@@ -118,10 +119,10 @@ rc::Rgb estimate_irradiance(const PhotonMap& map, const EstimateQuery& query, Es
 /// The same two estimates divided by the share of their disk that the map's photon-holding
 /// surface covers (disk_coverage, held at 0.1 and above), which takes away their darkening at
 /// edges, in corners and on thin parts. `scene` is the one the map was traced in.
-rc::Rgb estimate_radiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
-                          const rc::Material& material, const rc::Frame& shading, const rc::Vec3& wo_local,
-                          EstimateScratch& scratch);
-rc::Rgb estimate_irradiance(const rc::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+rc::Rgb estimate_radiance(const rc::scene::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
+                          const rc::scene::Material& material, const rc::Frame& shading,
+                          const rc::Vec3& wo_local, EstimateScratch& scratch);
+rc::Rgb estimate_irradiance(const rc::scene::Scene& scene, const PhotonMap& map, const EstimateQuery& query,
                             EstimateScratch& scratch);
 
 /// The photon-tracing loop, shared by the two-pass mapper and SPPM: follows a photon path from
@@ -131,8 +132,8 @@ rc::Rgb estimate_irradiance(const rc::Scene& scene, const PhotonMap& map, const 
 /// which returns false to end the path. Russian roulette by the bounce's albedo keeps the power
 /// of surviving photons steady. Returns the number of rays traced.
 template <class Store>
-uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, rc::Rng& rng, int max_depth,
-                           Store&& store);
+uint64_t trace_photon_path(const rc::scene::Scene& scene, rc::scene::Ray ray, rc::Rgb power,
+                           rc::util::Rng& rng, int max_depth, Store&& store);
 
 }  // namespace gilt::photonmap
 

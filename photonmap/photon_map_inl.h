@@ -5,23 +5,23 @@
 #include <cmath>
 #include <type_traits>
 
-#include "raytrace_core/bsdf.h"
+#include "raytrace_core/scene/bsdf.h"
 
 namespace gilt::photonmap {
 
 template <class Store>
-uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, rc::Rng& rng, int max_depth,
-                           Store&& store) {
+uint64_t trace_photon_path(const rc::scene::Scene& scene, rc::scene::Ray ray, rc::Rgb power,
+                           rc::util::Rng& rng, int max_depth, Store&& store) {
   uint64_t rays = 0;
   bool specular_only = true;
   for (int depth = 0; depth < max_depth; ++depth) {
     ++rays;
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     if (!hit) break;
-    const rc::SurfaceInteraction si = scene.surface(ray, *hit);
-    rc::Material textured;
-    const rc::Material& m = scene.shading_material(si, textured);
-    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+    const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
+    rc::scene::Material textured;
+    const rc::scene::Material& m = scene.shading_material(si, textured);
+    if (m.kind == rc::scene::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
       power *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
     const rc::Vec3 wo_world = -glm::normalize(ray.direction);
     if (!m.is_traced_through()) {
@@ -31,7 +31,7 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
       p.direction = encode_direction(wo_world);
       p.normal = encode_direction(glm::dot(si.ng, wo_world) >= 0.0f ? si.ng : -si.ng);
       bool go_on;
-      if constexpr (std::is_invocable_v<Store, const Photon&, int, bool, const rc::Hit&>)
+      if constexpr (std::is_invocable_v<Store, const Photon&, int, bool, const rc::scene::Hit&>)
         go_on = store(p, depth, specular_only, *hit);
       else
         go_on = store(p, depth, specular_only);
@@ -39,8 +39,8 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
     }
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     const rc::Vec3 wo = frame.to_local(wo_world);
-    const std::optional<rc::BsdfSample> bs =
-        rc::bsdf_sample(m, wo, rng.uniform(), rng.uniform2(), rc::TransportMode::importance);
+    const std::optional<rc::scene::BsdfSample> bs =
+        rc::scene::bsdf_sample(m, wo, rng.uniform(), rng.uniform2(), rc::scene::TransportMode::importance);
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
     const rc::Vec3 wi_world = frame.to_world(bs->wi);
     // The sampled direction must leave on the side the BSDF meant (shading normals can disagree).
@@ -60,7 +60,7 @@ uint64_t trace_photon_path(const rc::Scene& scene, rc::Ray ray, rc::Rgb power, r
     const float survive = std::min(1.0f, scaled.max_component() / std::max(power.max_component(), 1e-30f));
     if (!(survive > 0.0f) || rng.uniform() >= survive) break;
     power = scaled / survive;
-    ray = rc::spawn_ray(si, wi_world);
+    ray = rc::scene::spawn_ray(si, wi_world);
   }
   return rays;
 }

@@ -7,23 +7,23 @@
 #include <cmath>
 
 #include "photonmap/coverage.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::photonmap {
 namespace {
 
 /// A point for spawning shadow rays at a photon position, whose rounding error is not tracked:
 /// the bound allows for γ(16)·|p|, as the radiosity solver does for mesh points.
-rc::SurfacePoint point_at(const rc::Vec3& p, const rc::Vec3& n) {
-  rc::SurfacePoint sp;
+rc::scene::SurfacePoint point_at(const rc::Vec3& p, const rc::Vec3& n) {
+  rc::scene::SurfacePoint sp;
   sp.p = p;
-  sp.p_error = rc::error_gamma(16) * rc::abs(p);
+  sp.p_error = rc::scene::error_gamma(16) * rc::abs(p);
   sp.ng = n;
   return sp;
 }
@@ -35,7 +35,7 @@ EstimateScratch& thread_scratch() {
 
 }  // namespace
 
-PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& settings)
+PhotonMapper::PhotonMapper(const rc::scene::Scene& scene, const PhotonMapperSettings& settings)
     : scene_(scene), settings_(settings) {
   if (!scene.committed()) throw std::logic_error("PhotonMapper: the scene was not committed");
   if (settings.k < 1) throw rc::InputError("--k must be at least 1");
@@ -82,10 +82,11 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
     const size_t count = sites.size();
     // Chunks of 1,024 points; under several processes each computes those it owns.
     std::vector<std::vector<IrradiancePoint>> chunks((count + 1023) / 1024);
-    rc::distributed_chunks<IrradiancePoint>(chunks, [&](size_t chunk, std::vector<IrradiancePoint>& out) {
+    rc::util::distributed_chunks<IrradiancePoint>(chunks, [&](size_t chunk,
+                                                              std::vector<IrradiancePoint>& out) {
       for (size_t i = chunk * 1024; i < std::min(count, chunk * 1024 + 1024); ++i) {
         const Photon& p = sites[i];
-        rc::Sampler sampler(rc::Rng::for_item(settings.photons.seed, i, 0xd000000000ull));
+        rc::render::Sampler sampler(rc::util::Rng::for_item(settings.photons.seed, i, 0xd000000000ull));
         out.push_back({p.position, p.normal,
                        compute_irradiance(p.position, decode_direction(p.normal), sampler, settings.direct_samples)});
       }
@@ -101,20 +102,21 @@ PhotonMapper::PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& s
   stats_.precompute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler,
-                                         int direct_samples) const {
+rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal,
+                                         rc::render::Sampler& sampler, int direct_samples) const {
   rc::Rgb e(0.0f);
   const auto& lights = scene_.lights();
-  const rc::LightSampler& choice = scene_.light_sampler();
+  const rc::scene::LightSampler& choice = scene_.light_sampler();
   if (choice.size() > 0) {
-    const rc::SurfacePoint at = point_at(p, normal);
-    const rc::LightQuery query{p, normal, false};
+    const rc::scene::SurfacePoint at = point_at(p, normal);
+    const rc::scene::LightQuery query{p, normal, false};
     for (int i = 0; i < direct_samples; ++i) {
-      const rc::LightChoice chosen = choice.sample(query, sampler.uniform());
+      const rc::scene::LightChoice chosen = choice.sample(query, sampler.uniform());
       const float pmf = chosen.pmf;
       const rc::Vec2 u_light = sampler.uniform2();
       if (!(pmf > 0.0f)) continue;
-      const rc::LightSample ls = rc::sample_light(scene_, lights[chosen.light], at, u_light, normal);
+      const rc::scene::LightSample ls =
+          rc::scene::sample_light(scene_, lights[chosen.light], at, u_light, normal);
       const float cos_theta = glm::dot(ls.wi, normal);
       if (!(ls.pdf > 0.0f) || !(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
       if (scene_.occluded(ls.shadow_ray)) continue;
@@ -127,7 +129,8 @@ rc::Rgb PhotonMapper::compute_irradiance(const rc::Vec3& p, const rc::Vec3& norm
   return e;
 }
 
-rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler) const {
+rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal,
+                                 rc::render::Sampler& sampler) const {
   if (!points_.empty()) {
     constexpr size_t kCandidates = 8;
     Neighbour near[kCandidates];
@@ -139,52 +142,53 @@ rc::Rgb PhotonMapper::irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::
   return compute_irradiance(p, normal, sampler, 4);
 }
 
-rc::Rgb PhotonMapper::radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+rc::Rgb PhotonMapper::radiance(const rc::scene::Ray& camera_ray, rc::render::SampleContext& ctx) const {
   rc::Rgb radiance(0.0f), beta(1.0f);
-  rc::Ray ray = camera_ray;
+  rc::scene::Ray ray = camera_ray;
   for (int depth = 0; depth < settings_.max_depth; ++depth) {
     ctx.sampler.start_bounce(depth);
     ++ctx.rays;
-    const std::optional<rc::Hit> hit = scene_.intersect(ray);
+    const std::optional<rc::scene::Hit> hit = scene_.intersect(ray);
     if (!hit) {
-      radiance += beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+      radiance += beta * rc::scene::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
       break;
     }
-    const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
-    rc::Material textured;
-    const rc::Material& m = scene_.shading_material(si, textured);
-    if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+    const rc::scene::SurfaceInteraction si = scene_.surface(ray, *hit);
+    rc::scene::Material textured;
+    const rc::scene::Material& m = scene_.shading_material(si, textured);
+    if (m.kind == rc::scene::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
       beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
     const rc::Vec3 wo_world = -glm::normalize(ray.direction);
     // Seen from the camera or through mirrors and glass: emission counts in full.
-    if (m.is_emissive()) radiance += beta * rc::emitted_radiance(m, si.ng, wo_world);
+    if (m.is_emissive()) radiance += beta * rc::scene::emitted_radiance(m, si.ng, wo_world);
     if (!m.is_traced_through()) {
       radiance += beta * shade(si, wo_world, ctx);
       break;
     }
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     const rc::Vec3 wo = frame.to_local(wo_world);
-    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, ctx.sampler.uniform(), ctx.sampler.uniform2());
+    const std::optional<rc::scene::BsdfSample> bs = rc::scene::bsdf_sample(m, wo, ctx.sampler.uniform(), ctx.sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
     const rc::Vec3 wi_world = frame.to_world(bs->wi);
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f, wi_above = glm::dot(wi_world, si.ng) > 0.0f;
     if (wi_above != (bs->transmission ? !wo_above : wo_above)) break;
     beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    ray = rc::spawn_ray(si, wi_world);
+    ray = rc::scene::spawn_ray(si, wi_world);
   }
   return radiance;
 }
 
-rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo_world, rc::SampleContext& ctx) const {
-  rc::Material textured;
-  const rc::Material& m = scene_.shading_material(si, textured);
+rc::Rgb PhotonMapper::shade(const rc::scene::SurfaceInteraction& si, const rc::Vec3& wo_world, rc::render::SampleContext& ctx) const {
+  rc::scene::Material textured;
+  const rc::scene::Material& m = scene_.shading_material(si, textured);
   const rc::Frame frame = rc::Frame::from_normal(si.ns);
   const rc::Vec3 wo = frame.to_local(wo_world);
   const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
   const rc::Vec3 lit_side = wo_above ? si.ng : -si.ng;
   const EstimateQuery query{si.p, lit_side, size_t(settings_.k), max_radius2_};
   const auto& lights = scene_.lights();
-  const rc::LightQuery light_query = rc::light_query(si, m, wo_above);  // sample_direct_mis's, for MIS
+  const rc::scene::LightQuery light_query =
+      rc::render::light_query(si, m, wo_above);  // sample_direct_mis's, for MIS
   const int gather = settings_.gather_rays;
   rc::Rgb l(0.0f);
 
@@ -192,7 +196,8 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   l += estimate_radiance(maps_.caustic, query, m, frame, wo, thread_scratch());
 
   // Direct light, MIS-weighted against the gather rays as BSDF samples.
-  l += rc::sample_direct_mis(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays, float(gather));
+  l +=
+      rc::render::sample_direct_mis(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays, float(gather));
   if (gather == 0) {
     // Without a final gather the global map is read at x itself.
     l += estimate_radiance(scene_, maps_.global, query, m, frame, wo, thread_scratch());
@@ -204,48 +209,49 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
   const bool caustics_in_map = !maps_.caustic.empty();
   // The gather rays of each camera sample are sub-samples: stratified among themselves and with
   // the other samples' rays in the pixel.
-  const rc::Sampler::SubSamples gather_samples = ctx.sampler.split(uint32_t(gather));
+  const rc::render::Sampler::SubSamples gather_samples = ctx.sampler.split(uint32_t(gather));
   for (int j = 0; j < gather; ++j) {
-    rc::Sampler sampler = gather_samples[uint32_t(j)];
-    const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, sampler.uniform(), sampler.uniform2());
+    rc::render::Sampler sampler = gather_samples[uint32_t(j)];
+    const std::optional<rc::scene::BsdfSample> bs =
+        rc::scene::bsdf_sample(m, wo, sampler.uniform(), sampler.uniform2());
     if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) continue;
     const rc::Vec3 wi_world = frame.to_world(bs->wi);
     const bool wi_above = glm::dot(wi_world, si.ng) > 0.0f;
     if (wi_above != (bs->transmission ? !wo_above : wo_above)) continue;
     rc::Rgb g = bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    rc::Ray ray = rc::spawn_ray(si, wi_world);
+    rc::scene::Ray ray = rc::scene::spawn_ray(si, wi_world);
     bool through_specular = false;
     for (int depth = 0; depth < settings_.max_depth; ++depth) {
       ++ctx.rays;
-      const std::optional<rc::Hit> hit = scene_.intersect(ray);
+      const std::optional<rc::scene::Hit> hit = scene_.intersect(ray);
       const rc::Vec3 dir = glm::normalize(ray.direction);
       if (!hit) {
         for (const uint32_t li : scene_.environment_lights()) {
           float w = 1.0f;
           if (!through_specular && !bs->delta)
-            w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    rc::light_choice_pmf(scene_, light_query, li) *
-                                        rc::light_pdf(scene_, lights[li], si, dir, si, rc::receiving_normal(light_query)));
+            w = rc::util::power_heuristic(float(gather), bs->pdf, 1.0f,
+                                    rc::render::light_choice_pmf(scene_, light_query, li) *
+                                        rc::scene::light_pdf(scene_, lights[li], si, dir, si, rc::scene::receiving_normal(light_query)));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
-          gathered += g * rc::environment_radiance(lights[li], dir) * w;
+          gathered += g * rc::scene::environment_radiance(lights[li], dir) * w;
         }
         break;
       }
-      const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
-      rc::Material textured_j;
-      const rc::Material& mj = scene_.shading_material(sj, textured_j);
-      if (mj.kind == rc::MaterialKind::dielectric && !sj.front_face && !mj.absorption.is_black())
+      const rc::scene::SurfaceInteraction sj = scene_.surface(ray, *hit);
+      rc::scene::Material textured_j;
+      const rc::scene::Material& mj = scene_.shading_material(sj, textured_j);
+      if (mj.kind == rc::scene::MaterialKind::dielectric && !sj.front_face && !mj.absorption.is_black())
         g *= rc::exp(mj.absorption * (-hit->t * glm::length(ray.direction)));
       if (mj.is_emissive()) {
-        const rc::Rgb le = rc::emitted_radiance(mj, sj.ng, -dir);
+        const rc::Rgb le = rc::scene::emitted_radiance(mj, sj.ng, -dir);
         if (!le.is_black()) {
           // Straight from x: the BSDF-sampled half of direct light. Through mirrors and glass:
           // a caustic, which the caustic map already holds (when there is one).
           float w = 1.0f;
           if (!through_specular && sj.light >= 0)
-            w = rc::power_heuristic(float(gather), bs->pdf, 1.0f,
-                                    rc::light_choice_pmf(scene_, light_query, uint32_t(sj.light)) * rc::light_pdf(scene_, lights[sj.light], si, dir, sj));
+            w = rc::util::power_heuristic(float(gather), bs->pdf, 1.0f,
+                                    rc::render::light_choice_pmf(scene_, light_query, uint32_t(sj.light)) * rc::scene::light_pdf(scene_, lights[sj.light], si, dir, sj));
           else if (through_specular && caustics_in_map)
             w = 0.0f;
           gathered += g * le * w;
@@ -254,16 +260,16 @@ rc::Rgb PhotonMapper::shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo
       if (mj.is_traced_through()) {
         const rc::Frame fj = rc::Frame::from_normal(sj.ns);
         const rc::Vec3 woj = fj.to_local(-dir);
-        const std::optional<rc::BsdfSample> bj = rc::bsdf_sample(mj, woj, sampler.uniform(), sampler.uniform2());
+        const std::optional<rc::scene::BsdfSample> bj = rc::scene::bsdf_sample(mj, woj, sampler.uniform(), sampler.uniform2());
         if (!bj || !(bj->pdf > 0.0f) || bj->f.is_black()) break;
         g *= bj->f * (std::fabs(bj->wi.z) / bj->pdf);
-        ray = rc::spawn_ray(sj, fj.to_world(bj->wi));
+        ray = rc::scene::spawn_ray(sj, fj.to_world(bj->wi));
         through_specular = true;
         continue;
       }
       // A diffuse or glossy hit: its reflected light from the precomputed irradiance.
       const rc::Vec3 side = glm::dot(-dir, sj.ng) > 0.0f ? sj.ng : -sj.ng;
-      gathered += g * rc::diffuse_reflectance(mj) * irradiance(sj.p, side, sampler) * rc::kInvPi;
+      gathered += g * rc::scene::diffuse_reflectance(mj) * irradiance(sj.p, side, sampler) * rc::kInvPi;
       break;
     }
   }

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "photonmap/photon_map.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::photonmap {
 
@@ -46,21 +46,21 @@ struct PhotonMapperStats {
 };
 
 /// The photon maps of a scene, ready to render from. radiance() is a RadianceFunction for
-/// raytrace_core::render_image; it is const and thread-safe.
+/// raytrace_core::render::render_image; it is const and thread-safe.
 class PhotonMapper {
  public:
   /// Traces the photons, builds the indexes and precomputes irradiance. `scene` must outlive it.
-  PhotonMapper(const rc::Scene& scene, const PhotonMapperSettings& settings);
+  PhotonMapper(const rc::scene::Scene& scene, const PhotonMapperSettings& settings);
 
   /// Radiance along a camera ray (W·sr⁻¹·m⁻²).
-  rc::Rgb radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
+  rc::Rgb radiance(const rc::scene::Ray& ray, rc::render::SampleContext& ctx) const;
 
   const PhotonMapperStats& stats() const { return stats_; }
   const PhotonMaps& maps() const { return maps_; }
 
   /// Irradiance at a point from the precomputed points (nearest with an agreeing normal), or
   /// computed on the spot when none is near (W·m⁻²). `normal` faces the side being lit.
-  rc::Rgb irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler) const;
+  rc::Rgb irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::render::Sampler& sampler) const;
 
  private:
   struct IrradiancePoint {
@@ -69,10 +69,11 @@ class PhotonMapper {
     rc::Rgb irradiance;
   };
 
-  rc::Rgb compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::Sampler& sampler, int direct_samples) const;
-  rc::Rgb shade(const rc::SurfaceInteraction& si, const rc::Vec3& wo_world, rc::SampleContext& ctx) const;
+  rc::Rgb compute_irradiance(const rc::Vec3& p, const rc::Vec3& normal, rc::render::Sampler& sampler, int direct_samples) const;
+  rc::Rgb shade(const rc::scene::SurfaceInteraction& si, const rc::Vec3& wo_world,
+                rc::render::SampleContext& ctx) const;
 
-  const rc::Scene& scene_;
+  const rc::scene::Scene& scene_;
   PhotonMapperSettings settings_;
   PhotonMaps maps_;
   std::vector<IrradiancePoint> points_;

@@ -12,14 +12,14 @@
 
 #include "photonmap/photon_index.h"
 #include "photonmap/photon_map.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/sobol.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/sobol.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::photonmap {
 namespace {
@@ -58,14 +58,15 @@ constexpr uint64_t kCoverageStream = 0xe100000000ull;
 /// turned within kSameSurfaceCosine of `lit`, the probe counts 1 / |cos| of the turn (the
 /// surface's area over its projection on the disk), else 0. Its mean over the iterations is the
 /// share of πr² the ball's surfaces hold, which the estimate divides by as well.
-float probe_coverage(const rc::Scene& scene, const rc::Vec3& p, const rc::Vec3& lit, float r, rc::Vec2 u) {
+float probe_coverage(const rc::scene::Scene& scene, const rc::Vec3& p, const rc::Vec3& lit, float r,
+                     rc::Vec2 u) {
   const rc::Frame frame = rc::Frame::from_normal(lit);
   const float rho = r * std::sqrt(u.x), phi = 2.0f * rc::kPi * u.y;
   const rc::Vec3 on_disk = p + rho * (std::cos(phi) * frame.s + std::sin(phi) * frame.t);
-  rc::Ray probe{on_disk + r * lit, -lit, 2.0f * r};
-  const std::optional<rc::Hit> hit = scene.intersect(probe);
+  rc::scene::Ray probe{on_disk + r * lit, -lit, 2.0f * r};
+  const std::optional<rc::scene::Hit> hit = scene.intersect(probe);
   if (!hit) return 0.0f;
-  const rc::SurfaceInteraction si = scene.surface(probe, *hit);
+  const rc::scene::SurfaceInteraction si = scene.surface(probe, *hit);
   if (glm::length(si.p - p) > r || scene.materials[si.material].is_traced_through()) return 0.0f;
   const float cosine = std::fabs(glm::dot(si.ng, lit));
   return cosine >= kSameSurfaceCosine ? 1.0f / cosine : 0.0f;
@@ -73,7 +74,7 @@ float probe_coverage(const rc::Scene& scene, const rc::Vec3& p, const rc::Vec3& 
 
 /// The settings render_sppm cannot run with, as InputError (and an uncommitted scene, a
 /// logic_error). Reads the scene's state and the settings; writes nothing.
-void check_sppm_settings(const rc::Scene& scene, const rc::RenderSettings& settings, const SppmSettings& sppm) {
+void check_sppm_settings(const rc::scene::Scene& scene, const rc::render::RenderSettings& settings, const SppmSettings& sppm) {
   if (!scene.committed()) throw std::logic_error("render_sppm: the scene was not committed");
   if (settings.width <= 0 || settings.height <= 0) throw rc::InputError("image size must be positive");
   if (settings.time_limit <= 0.0 && settings.spp <= 0) throw rc::InputError("iterations (--spp) must be positive");
@@ -90,8 +91,8 @@ struct SppmRun {
   /// processes each owns the rows y mod N (their camera pass and gather) and the photon chunks
   /// c mod N; the photons are joined in chunk order, so every process builds the index one
   /// process would.
-  SppmRun(const rc::Scene& scene, const rc::Camera& camera, const rc::RenderSettings& settings,
-          const SppmSettings& sppm)
+  SppmRun(const rc::scene::Scene& scene, const rc::scene::Camera& camera,
+          const rc::render::RenderSettings& settings, const SppmSettings& sppm)
       : scene(scene),
         camera(camera),
         settings(settings),
@@ -104,25 +105,25 @@ struct SppmRun {
         lights(scene.lights()),
         choice(scene.light_distribution()),
         timed(settings.time_limit > 0.0),
-        group(rc::processes()) {
+        group(rc::util::processes()) {
     for (PixelState& p : state) p.radius = r0;
     for (size_t y = 0; y < size_t(height); ++y)
       if (group.owns(y)) rows.push_back(y);
   }
 
-  const rc::Scene& scene;
-  const rc::Camera& camera;
-  const rc::RenderSettings& settings;
+  const rc::scene::Scene& scene;
+  const rc::scene::Camera& camera;
+  const rc::render::RenderSettings& settings;
   const SppmSettings& sppm;
   const std::chrono::steady_clock::time_point start;
   const int width, height;
   const float r0;
   std::vector<PixelState> state;
-  const std::vector<rc::Light>& lights;
-  const rc::Distribution1D& choice;
+  const std::vector<rc::scene::Light>& lights;
+  const rc::util::Distribution1D& choice;
   std::atomic<uint64_t> rays{0};
   const bool timed;
-  const rc::Processes& group;
+  const rc::util::Processes& group;
   std::vector<size_t> rows;  ///< the rows this process owns
   int iteration = 0;
   std::vector<Photon> photons;      ///< this iteration's, stored by the photon pass
@@ -138,38 +139,39 @@ struct SppmRun {
 /// to it. Reads the scene, camera, settings and run.iteration; writes each pixel's visible point,
 /// its direct_sum, and run.rays.
 void trace_visible_row(SppmRun& run, size_t y) {
-  const rc::Scene& scene = run.scene;
-  const rc::RenderSettings& settings = run.settings;
+  const rc::scene::Scene& scene = run.scene;
+  const rc::render::RenderSettings& settings = run.settings;
   const int width = run.width, iteration = run.iteration;
   uint64_t local_rays = 0;
   for (int x = 0; x < width; ++x) {
     const uint64_t pixel = uint64_t(y) * width + x;
     PixelState& ps = run.state[pixel];
     ps.visible = false;
-    rc::Sampler sampler = rc::Sampler::for_pixel_sample(settings.sampler, settings.seed, pixel, uint64_t(iteration));
-    rc::Ray ray = rc::camera_ray(run.camera, settings, x, y, sampler);
+    rc::render::Sampler sampler = rc::render::Sampler::for_pixel_sample(settings.sampler, settings.seed, pixel, uint64_t(iteration));
+    rc::scene::Ray ray = rc::render::camera_ray(run.camera, settings, x, y, sampler);
     rc::Rgb beta(1.0f), direct(0.0f);
     // Mirrors and glass only, without Russian roulette: 64 bounces at most.
     for (int depth = 0; depth < std::min(run.sppm.max_depth, 64); ++depth) {
       sampler.start_bounce(depth);
       ++local_rays;
-      const std::optional<rc::Hit> hit = scene.intersect(ray);
+      const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
       if (!hit) {
-        direct += beta * rc::escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
+        direct += beta * rc::scene::escaped_radiance(scene.punctual_lights, glm::normalize(ray.direction));
         break;
       }
-      const rc::SurfaceInteraction si = scene.surface(ray, *hit);
-      rc::Material textured;
-      const rc::Material& m = scene.shading_material(si, textured);
-      if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+      const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
+      rc::scene::Material textured;
+      const rc::scene::Material& m = scene.shading_material(si, textured);
+      if (m.kind == rc::scene::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
         beta *= rc::exp(m.absorption * (-hit->t * glm::length(ray.direction)));
       const rc::Vec3 wo_world = -glm::normalize(ray.direction);
-      if (m.is_emissive()) direct += beta * rc::emitted_radiance(m, si.ng, wo_world);
+      if (m.is_emissive()) direct += beta * rc::scene::emitted_radiance(m, si.ng, wo_world);
       const rc::Frame frame = rc::Frame::from_normal(si.ns);
       const rc::Vec3 wo = frame.to_local(wo_world);
       const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
       if (!m.is_traced_through()) {
-        direct += beta * rc::sample_direct_mis(scene, si, m, frame, wo, wo_above, sampler, local_rays, 0.0f);
+        direct += beta *
+                  rc::render::sample_direct_mis(scene, si, m, frame, wo, wo_above, sampler, local_rays, 0.0f);
         ps.visible = true;
         ps.position = si.p;
         ps.lit_side = wo_above ? si.ng : -si.ng;
@@ -180,12 +182,13 @@ void trace_visible_row(SppmRun& run, size_t y) {
         ps.beta = beta;
         break;
       }
-      const std::optional<rc::BsdfSample> bs = rc::bsdf_sample(m, wo, sampler.uniform(), sampler.uniform2());
+      const std::optional<rc::scene::BsdfSample> bs =
+          rc::scene::bsdf_sample(m, wo, sampler.uniform(), sampler.uniform2());
       if (!bs || !(bs->pdf > 0.0f) || bs->f.is_black()) break;
       const rc::Vec3 wi_world = frame.to_world(bs->wi);
       if ((glm::dot(wi_world, si.ng) > 0.0f) != (bs->transmission ? !wo_above : wo_above)) break;
       beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-      ray = rc::spawn_ray(si, wi_world);
+      ray = rc::scene::spawn_ray(si, wi_world);
     }
     if (direct.is_finite()) ps.direct_sum += direct;
   }
@@ -194,28 +197,30 @@ void trace_visible_row(SppmRun& run, size_t y) {
 
 /// 1. Camera pass over the rows this process owns (trace_visible_row).
 void trace_visible_points(SppmRun& run) {
-  rc::parallel_for(run.rows.size(), [&](size_t k) { trace_visible_row(run, run.rows[k]); });
+  rc::util::parallel_for(run.rows.size(), [&](size_t k) { trace_visible_row(run, run.rows[k]); });
 }
 
 /// 2. Photon pass: every diffuse or glossy hit but the first (direct light is the camera pass's),
 /// unnormalised power. Reads the scene's lights, the settings and run.iteration; writes
 /// run.photons and run.positions (every process's, in chunk order) and run.rays.
 void trace_photons(SppmRun& run) {
-  const rc::Scene& scene = run.scene;
+  const rc::scene::Scene& scene = run.scene;
   const SppmSettings& sppm = run.sppm;
   const uint64_t count = sppm.photons_per_iteration;
   constexpr uint64_t kChunk = 4096;
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   std::vector<std::vector<Photon>> stored(chunks);
   if (run.choice.size() > 0) {
-    rc::distributed_chunks<Photon>(stored, [&](size_t c, std::vector<Photon>& out) {
+    rc::util::distributed_chunks<Photon>(stored, [&](size_t c, std::vector<Photon>& out) {
       uint64_t local_rays = 0;
       for (uint64_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) {
-        rc::Rng rng = rc::Rng::for_item(run.settings.seed, i, kPhotonStream + uint64_t(run.iteration));
+        rc::util::Rng rng =
+            rc::util::Rng::for_item(run.settings.seed, i, kPhotonStream + uint64_t(run.iteration));
         const uint32_t li = run.choice.sample(rng.uniform());
         const float pmf = run.choice.pmf(li);
         const rc::Vec2 u_position = rng.uniform2(), u_direction = rng.uniform2();
-        const rc::EmissionSample es = rc::sample_emission(scene, run.lights[li], u_position, u_direction);
+        const rc::scene::EmissionSample es =
+            rc::scene::sample_emission(scene, run.lights[li], u_position, u_direction);
         if (es.power.is_black() || !(pmf > 0.0f)) continue;
         local_rays += trace_photon_path(scene, es.ray, es.power / pmf, rng, sppm.max_depth,
                                         [&](const Photon& p, int depth, bool) {
@@ -244,17 +249,17 @@ PhotonIndex index_photons(const SppmRun& run) {
 /// 3. Gather and radius update, one row. Reads the visible points, run.photons through the index
 /// and run.iteration; writes each visible pixel's coverage probe, τ, N and radius.
 void gather_row(SppmRun& run, const PhotonIndex& index, size_t y) {
-  const rc::Scene& scene = run.scene;
+  const rc::scene::Scene& scene = run.scene;
   const SppmSettings& sppm = run.sppm;
   const int width = run.width;
   for (int x = 0; x < width; ++x) {
     PixelState& ps = run.state[size_t(y) * width + x];
     if (!ps.visible) continue;
-    rc::SurfaceInteraction at;
+    rc::scene::SurfaceInteraction at;
     at.material = ps.material;
     at.uv = ps.uv;
-    rc::Material textured;
-    const rc::Material& m = scene.shading_material(at, textured);
+    rc::scene::Material textured;
+    const rc::scene::Material& m = scene.shading_material(at, textured);
     rc::Rgb phi(0.0f);
     uint32_t m_count = 0;
     index.for_each_within(ps.position, ps.radius * ps.radius, [&](Neighbour nb) {
@@ -267,18 +272,19 @@ void gather_row(SppmRun& run, const PhotonIndex& index, size_t y) {
       // (bench/README.md, "SPPM's test of a photon's surface").
       if (glm::dot(decode_direction(p.normal), ps.lit_side) < kSameSurfaceCosine) return;
       const rc::Vec3 wi = ps.frame.to_local(decode_direction(p.direction));
-      phi += rc::bsdf_eval(m, ps.wo, wi) * p.power;
+      phi += rc::scene::bsdf_eval(m, ps.wo, wi) * p.power;
       ++m_count;
     });
     // The pixel's probes, one an iteration, are the points of an Owen-scrambled 2D Sobol
     // sequence of its own: stratified over the disk, so a few dozen iterations already
     // measure the coverage closely (independent probes left 1 / coverage noisy enough to
     // bias the plank of test_sppm_convergence 6 % bright over 16 iterations).
-    rc::Rng seeds = rc::Rng::for_item(run.settings.seed, uint64_t(y) * width + x, kCoverageStream);
+    rc::util::Rng seeds =
+        rc::util::Rng::for_item(run.settings.seed, uint64_t(y) * width + x, kCoverageStream);
     const uint32_t seed_x = seeds.next_u32(), seed_y = seeds.next_u32();
     const auto sobol_index = uint32_t(run.iteration);
-    const rc::Vec2 u(rc::sobol::to_unit_float(rc::sobol::owen_scramble(rc::sobol::dimension0(sobol_index), seed_x)),
-                     rc::sobol::to_unit_float(rc::sobol::owen_scramble(rc::sobol::dimension1(sobol_index), seed_y)));
+    const rc::Vec2 u(rc::util::sobol::to_unit_float(rc::util::sobol::owen_scramble(rc::util::sobol::dimension0(sobol_index), seed_x)),
+                     rc::util::sobol::to_unit_float(rc::util::sobol::owen_scramble(rc::util::sobol::dimension1(sobol_index), seed_y)));
     ++ps.probes;
     ps.covered += probe_coverage(scene, ps.position, ps.lit_side, ps.radius, u);
     if (m_count == 0) continue;
@@ -292,7 +298,7 @@ void gather_row(SppmRun& run, const PhotonIndex& index, size_t y) {
 
 /// 3. Gather at the visible points and shrink the radii, over the rows this process owns (gather_row).
 void gather_and_shrink(SppmRun& run, const PhotonIndex& index) {
-  rc::parallel_for(run.rows.size(), [&](size_t k) { gather_row(run, index, run.rows[k]); });
+  rc::util::parallel_for(run.rows.size(), [&](size_t k) { gather_row(run, index, run.rows[k]); });
 }
 
 /// A pixel of the image as its row's owner made it.
@@ -304,7 +310,7 @@ struct PixelOut {
 /// 4. The image: mean direct light plus τ / (π R² · photons emitted), each row made by its owner
 /// and joined. Reads the pixels and run.iteration; writes run.emitted, run.radius_sum and
 /// run.radius_count, and returns the film.
-rc::Film develop_image(SppmRun& run) {
+rc::render::Film develop_image(SppmRun& run) {
   const int width = run.width, height = run.height, iteration = run.iteration;
   const double emitted = run.emitted = double(iteration) * double(run.sppm.photons_per_iteration);
   std::vector<std::vector<PixelOut>> out(static_cast<size_t>(height));
@@ -319,8 +325,8 @@ rc::Film develop_image(SppmRun& run) {
       }
       out[y].push_back(o);
     }
-  rc::join_chunks(out);
-  rc::Film film(width, height);
+  rc::util::join_chunks(out);
+  rc::render::Film film(width, height);
   double radius_sum = 0.0;
   size_t radius_count = 0;
   for (int y = 0; y < height; ++y)
@@ -350,13 +356,14 @@ void report_sppm_stats(const SppmRun& run, SppmStats* stats) {
 
 }  // namespace
 
-rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc::RenderSettings& settings,
-                     const SppmSettings& sppm, SppmStats* stats) {
+rc::render::Film render_sppm(const rc::scene::Scene& scene, const rc::scene::Camera& camera,
+                             const rc::render::RenderSettings& settings, const SppmSettings& sppm,
+                             SppmStats* stats) {
   check_sppm_settings(scene, settings, sppm);
-  const rc::ThreadLimit limit(settings.threads);
+  const rc::util::ThreadLimit limit(settings.threads);
   SppmRun run(scene, camera, settings, sppm);
   const bool timed = run.timed;
-  rc::Progress progress(timed ? "sppm (time budget)" : "sppm", timed ? 0 : uint64_t(settings.spp), "iterations",
+  rc::util::Progress progress(timed ? "sppm (time budget)" : "sppm", timed ? 0 : uint64_t(settings.spp), "iterations",
                         settings.progress && run.group.rank() == 0);
   for (;; ++run.iteration) {
     // Rank 0's clock decides for every process.
@@ -370,7 +377,7 @@ rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc:
     progress.advance(1);
   }
   progress.finish();
-  rc::Film film = develop_image(run);
+  rc::render::Film film = develop_image(run);
   report_sppm_stats(run, stats);
   return film;
 }

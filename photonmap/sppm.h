@@ -8,15 +8,15 @@
 #include <cstdint>
 
 #include "photonmap/photon_index.h"
-#include "raytrace_core/camera.h"
-#include "raytrace_core/film.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/scene/camera.h"
+#include "raytrace_core/render/film.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::photonmap {
 
 namespace rc = gilt::raytrace_core;
 
-/// SPPM parameters beyond the image's (which come from rc::RenderSettings: size, spp = the
+/// SPPM parameters beyond the image's (which come from rc::render::RenderSettings: size, spp = the
 /// iteration count, time limit, seed, threads, filter). Defaults are the documented ones.
 struct SppmSettings {
   uint64_t photons_per_iteration = 100'000;
@@ -41,7 +41,8 @@ struct SppmStats {
 /// settings.time_limit when it is positive. Iteration i draws pixel samples from
 /// Sampler::for_pixel_sample(settings.sampler, seed, pixel, i) and photon j from Rng::for_item(seed, j, i + stream), so the
 /// image does not depend on the thread count.
-rc::Film render_sppm(const rc::Scene& scene, const rc::Camera& camera, const rc::RenderSettings& settings,
-                     const SppmSettings& sppm, SppmStats* stats = nullptr);
+rc::render::Film render_sppm(const rc::scene::Scene& scene, const rc::scene::Camera& camera,
+                             const rc::render::RenderSettings& settings, const SppmSettings& sppm,
+                             SppmStats* stats = nullptr);
 
 }  // namespace gilt::photonmap

@@ -2,7 +2,7 @@
 // (api/methods.h, api/compare.h, radiosity/solver/solver.h) and hands back NumPy arrays and dicts.
 //
 // Every long call runs on a worker thread with the GIL released; the calling thread wakes every
-// 50 ms to let Python look for signals, and a Ctrl-C there calls raytrace_core::request_stop(),
+// 50 ms to let Python look for signals, and a Ctrl-C there calls raytrace_core::util::request_stop(),
 // which ends the run at its next work item with KeyboardInterrupt.
 
 #include <pybind11/numpy.h>
@@ -23,9 +23,9 @@
 #include "api/statistics.h"
 #include "radiosity/solver/budget.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace py = pybind11;
 namespace rc = gilt::raytrace_core;
@@ -38,7 +38,7 @@ namespace {
 template <class Work>
 auto run_interruptible(Work&& work) -> decltype(work()) {
   using Result = decltype(work());
-  rc::clear_stop();
+  rc::util::clear_stop();
   std::optional<Result> result;
   std::exception_ptr error;
   bool done = false, signalled = false;
@@ -65,14 +65,14 @@ auto run_interruptible(Work&& work) -> decltype(work()) {
         py::gil_scoped_acquire acquire;
         // A handler that raised (KeyboardInterrupt) leaves its exception set: stop the run and
         // raise it once the worker has ended.
-        if (PyErr_CheckSignals() != 0) signalled = true, rc::request_stop();
+        if (PyErr_CheckSignals() != 0) signalled = true, rc::util::request_stop();
       }
       lock.lock();
     }
     lock.unlock();
     worker.join();
   }
-  rc::clear_stop();
+  rc::util::clear_stop();
   if (signalled) throw py::error_already_set();
   if (error) std::rethrow_exception(error);
   return std::move(*result);
@@ -93,7 +93,7 @@ rc::Vec3 to_vec3(const py::sequence& s, const char* name) {
 }
 
 /// An H × W × 3 float32 array of linear RGB.
-py::array_t<float> to_array(const rc::Film& film) {
+py::array_t<float> to_array(const rc::render::Film& film) {
   const std::vector<rc::Rgb> pixels = film.pixels();
   py::array_t<float> out({py::ssize_t(film.height()), py::ssize_t(film.width()), py::ssize_t(3)});
   float* data = out.mutable_data();
@@ -113,13 +113,13 @@ py::array_t<float> rows_of_three(const std::vector<T>& values) {
 
 /// A loaded, committed scene; the camera may be replaced before rendering.
 struct PyScene {
-  rc::Scene scene;
+  rc::scene::Scene scene;
   std::string name;
 };
 
 PyScene load(const std::string& path, std::optional<std::string> env, float env_scale, float env_rotate,
              std::optional<std::vector<float>> sun, std::optional<float> sky, std::optional<py::object> camera) {
-  rc::ExtraLighting extra;
+  rc::io::ExtraLighting extra;
   if (env) extra.env_file = *env;
   extra.env_scale = env_scale, extra.env_rotate_degrees = env_rotate;
   if (sun) {
@@ -133,14 +133,14 @@ PyScene load(const std::string& path, std::optional<std::string> env, float env_
     if (!(*sky >= 1.0f && *sky <= 64.0f)) throw rc::InputError("sky: the turbidity must be from 1 to 64");
     extra.sky_turbidity = *sky;
   }
-  PyScene s{rc::load_scene(path, extra), path};
-  if (camera && !camera->is_none()) rc::select_camera(s.scene, py::str(*camera).cast<std::string>());
+  PyScene s{rc::io::load_scene(path, extra), path};
+  if (camera && !camera->is_none()) rc::io::select_camera(s.scene, py::str(*camera).cast<std::string>());
   return s;
 }
 
-rc::Camera make_camera(py::sequence look_from, py::sequence look_at, py::sequence up, float vfov, float aperture,
+rc::scene::Camera make_camera(py::sequence look_from, py::sequence look_at, py::sequence up, float vfov, float aperture,
                        float focus_distance, float ortho_height) {
-  rc::Camera c;
+  rc::scene::Camera c;
   c.look_from = to_vec3(look_from, "look_from"), c.look_at = to_vec3(look_at, "look_at"), c.up = to_vec3(up, "up");
   c.vfov_degrees = vfov, c.aperture_radius = aperture, c.focus_distance = focus_distance;
   c.orthographic = ortho_height > 0.0f, c.ortho_height = ortho_height;
@@ -152,7 +152,7 @@ py::tuple render(PyScene& s, const std::string& method, std::optional<int> spp, 
                  std::optional<int> width, std::optional<int> height, uint64_t seed, int threads,
                  const std::string& sampler, const std::string& light_sampler, int max_depth,
                  const api::PhotonOptions& photon, std::optional<int> elements, const std::string& radiosity_view) {
-  rc::RenderSettings settings;
+  rc::render::RenderSettings settings;
   const auto [w, h] = api::image_size(s.scene, width, height);
   settings.width = w, settings.height = h;
   if (spp && time) throw rc::InputError("give spp or time, not both");
@@ -165,9 +165,9 @@ py::tuple render(PyScene& s, const std::string& method, std::optional<int> spp, 
   if (threads < 0) throw rc::InputError("threads: 0 (all) or more");
   if (max_depth < 0) throw rc::InputError("max_depth: 0 (the method's default) or more");
   settings.seed = seed, settings.threads = threads, settings.progress = false;
-  settings.sampler = rc::parse_sampler(sampler);
-  s.scene.set_light_sampling(rc::parse_light_sampling(light_sampler));
-  const rc::Camera camera = s.scene.effective_camera(float(settings.width) / float(settings.height));
+  settings.sampler = rc::render::parse_sampler(sampler);
+  s.scene.set_light_sampling(rc::scene::parse_light_sampling(light_sampler));
+  const rc::scene::Camera camera = s.scene.effective_camera(float(settings.width) / float(settings.height));
   api::MethodOptions options;
   options.max_depth = max_depth;
   photon.apply(options);
@@ -262,20 +262,20 @@ PYBIND11_MODULE(gilt, m) {
     }
   });
 
-  py::class_<rc::Camera>(m, "Camera", "A pinhole or thin-lens camera")
+  py::class_<rc::scene::Camera>(m, "Camera", "A pinhole or thin-lens camera")
       .def(py::init(&make_camera), py::arg("look_from"), py::arg("look_at"), py::arg("up") = py::make_tuple(0, 1, 0),
            py::arg("vfov") = 40.0f, py::arg("aperture") = 0.0f, py::arg("focus_distance") = 0.0f,
            py::arg("ortho_height") = 0.0f,
            "A camera at look_from looking at look_at. vfov in degrees; aperture (lens radius) and\n"
            "focus_distance for depth of field; ortho_height > 0 makes it orthographic, the film that many\n"
            "scene units high.")
-      .def_property_readonly("look_from", [](const rc::Camera& c) { return to_tuple(c.look_from); })
-      .def_property_readonly("look_at", [](const rc::Camera& c) { return to_tuple(c.look_at); })
-      .def_property_readonly("up", [](const rc::Camera& c) { return to_tuple(c.up); })
-      .def_readonly("vfov", &rc::Camera::vfov_degrees)
-      .def_readonly("orthographic", &rc::Camera::orthographic)
-      .def_readonly("ortho_height", &rc::Camera::ortho_height)
-      .def("__repr__", [](const rc::Camera& c) {
+      .def_property_readonly("look_from", [](const rc::scene::Camera& c) { return to_tuple(c.look_from); })
+      .def_property_readonly("look_at", [](const rc::scene::Camera& c) { return to_tuple(c.look_at); })
+      .def_property_readonly("up", [](const rc::scene::Camera& c) { return to_tuple(c.up); })
+      .def_readonly("vfov", &rc::scene::Camera::vfov_degrees)
+      .def_readonly("orthographic", &rc::scene::Camera::orthographic)
+      .def_readonly("ortho_height", &rc::scene::Camera::ortho_height)
+      .def("__repr__", [](const rc::scene::Camera& c) {
         return "gilt.Camera(look_from=" + py::repr(to_tuple(c.look_from)).cast<std::string>() +
                ", look_at=" + py::repr(to_tuple(c.look_at)).cast<std::string>() +
                ", vfov=" + std::to_string(c.vfov_degrees) + ")";
@@ -299,7 +299,7 @@ PYBIND11_MODULE(gilt, m) {
       .def_property_readonly("size", [](const PyScene& s) { return py::make_tuple(s.scene.render.width, s.scene.render.height); })
       .def_property(
           "camera", [](const PyScene& s) { return s.scene.effective_camera(); },
-          [](PyScene& s, const rc::Camera& c) {
+          [](PyScene& s, const rc::scene::Camera& c) {
             c.validate();
             s.scene.camera = c;
           },

@@ -9,7 +9,7 @@ Both are GGX with alpha = roughness^2, separable Smith G2 = G1(wo) G1(wi) and et
 sample normals visible from wo (Heitz 2018), under which a lobe's weight is its Fresnel factor times
 G1(wi). They differ in where the Fresnel factor is taken (Cycles 3.4 sources named):
 
-  gilt (raytrace_core/rough_dielectric.h, Walter et al. 2007): per microfacet, F(wo.h);
+  gilt (raytrace_core/scene/rough_dielectric.h, Walter et al. 2007): per microfacet, F(wo.h);
       R = E[F(wo.h) G1(r)],  T = E[(1 - F(wo.h)) G1(t)]
   Cycles' Principled BSDF, distribution GGX, transmission 1 (svm/closure.h: a reflection closure of
       weight F(N.wo) whose colour interpolate_fresnel_color(...) is 1 for specular tint 0, plus a

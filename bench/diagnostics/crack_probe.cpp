@@ -30,13 +30,13 @@
 
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/closest_point.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/closest_point.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -68,12 +68,12 @@ float segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3
 
 /// The point of input mesh s nearest to q within `reach`, facing within 60 degrees of n, as a
 /// surface point whose normal is the input triangle's, turned to n's side; none when there is none.
-std::optional<rc::SurfacePoint> input_point(const rc::Scene& scene, uint32_t s, const Vec3& q, float reach,
-                                            const Vec3& n) {
+std::optional<rc::scene::SurfacePoint> input_point(const rc::scene::Scene& scene, uint32_t s, const Vec3& q,
+                                                   float reach, const Vec3& n) {
   if (s >= scene.meshes.size()) return std::nullopt;
   const auto near = scene.nearest_triangle(s, q, reach, n, 0.5f);
   if (!near) return std::nullopt;
-  const rc::TriangleMesh& tm = scene.meshes[s];
+  const rc::scene::TriangleMesh& tm = scene.meshes[s];
   const Vec3 a = tm.positions[tm.indices[3 * near->prim_id]], b = tm.positions[tm.indices[3 * near->prim_id + 1]],
              c = tm.positions[tm.indices[3 * near->prim_id + 2]];
   const Vec3 p_in = (1 - near->u - near->v) * a + near->u * b + near->v * c;
@@ -87,13 +87,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: crack_probe SCENE [ELEMENTS] [CSV]\n");
     return 2;
   }
-  const rc::Scene scene = rc::load_scene(argv[1]);
+  const rc::scene::Scene scene = rc::io::load_scene(argv[1]);
   std::FILE* camcsv = std::getenv("CAMCSV") ? std::fopen(std::getenv("CAMCSV"), "w") : nullptr;
   rad::mesh::MeshSettings ms;
   ms.elements = argc > 2 ? std::atoi(argv[2]) : rad::mesh::kDefaultElements;
   rad::mesh::MeshReport report;
   const rad::mesh::RadiosityMesh mesh = rad::mesh::build_mesh(scene, ms, &report);
-  const rc::Scene geo = rad::mesh::element_scene(scene, mesh);
+  const rc::scene::Scene geo = rad::mesh::element_scene(scene, mesh);
   std::printf("elements %zu, vertices %zu, edge %.4g, contact edges %zu, buried faces %zu, buried elements %zu, "
               "buried area %.4g of %.4g\n",
               mesh.element_count(), mesh.vertex_count(), report.max_edge, report.contact_edges, report.buried_faces,
@@ -131,10 +131,10 @@ int main(int argc, char** argv) {
 
   // Input coverage: area-weighted points on meshed input triangles, distance to the nearest element.
   {
-    rc::Rng rng(11);
+    rc::util::Rng rng(11);
     double total = 0.0, uncovered_far = 0.0, uncovered_mid = 0.0;
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
-      const rc::TriangleMesh& tm = scene.meshes[m];
+      const rc::scene::TriangleMesh& tm = scene.meshes[m];
       if (scene.materials[tm.material].is_traced_through()) continue;
       for (size_t t = 0; t < tm.triangle_count(); ++t) {
         const Vec3 a = tm.positions[tm.indices[3 * t]], b = tm.positions[tm.indices[3 * t + 1]],
@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
         const float area = 0.5f * glm::length(glm::cross(b - a, c - a));
         const int n = int(area / (0.01f * L * L) + rng.uniform());
         for (int i = 0; i < n; ++i) {
-          const rc::Vec2 u = rc::sample_uniform_triangle(rng.uniform2());
+          const rc::Vec2 u = rc::util::sample_uniform_triangle(rng.uniform2());
           const Vec3 p = (1 - u.x - u.y) * a + u.x * b + u.y * c;
           const auto near = geo.nearest_triangle(0, p, L, Vec3(0, 0, 1), -2.0f);
           const float d = near ? near->t : L;
@@ -156,9 +156,9 @@ int main(int argc, char** argv) {
                 total, 100.0 * uncovered_mid / total, 100.0 * uncovered_far / total);
   }
 
-  const rc::Light* sun = nullptr;
-  for (const rc::Light& l : scene.punctual_lights)
-    if (l.kind == rc::LightKind::directional) sun = &l;
+  const rc::scene::Light* sun = nullptr;
+  for (const rc::scene::Light& l : scene.punctual_lights)
+    if (l.kind == rc::scene::LightKind::directional) sun = &l;
   if (!sun) {
     std::fprintf(stderr, "no directional light\n");
     return 1;
@@ -188,29 +188,29 @@ int main(int argc, char** argv) {
     const float cos_e = glm::dot(n, wi);
     if (!(cos_e > 0.0f)) continue;
     const float w = mesh.element_area[e] * cos_e / float(side * side);
-    rc::Rng rng = rc::Rng::for_item(5, e, 0);
+    rc::util::Rng rng = rc::util::Rng::for_item(5, e, 0);
     for (int i = 0; i < side; ++i)
       for (int j = 0; j < side; ++j) {
-        const rc::Vec2 b = rc::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
+        const rc::Vec2 b = rc::util::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
         const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
         points += w;
-        const bool elem_blocked = geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(q, n), wi));
+        const bool elem_blocked = geo.occluded(rc::scene::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(q, n), wi));
         // The input point: nearest on the element's own input mesh, facing within 60 degrees.
         const uint32_t s = mesh.element_surface[e];
-        const std::optional<rc::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
+        const std::optional<rc::scene::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
         if (!found) {
           ++n_noinput;
           continue;
         }
-        const rc::SurfacePoint& at_in = *found;
-        std::optional<rc::Hit> hit;
-        const rc::Ray ray_in = rc::spawn_shadow_ray_to_infinity(at_in, wi);
+        const rc::scene::SurfacePoint& at_in = *found;
+        std::optional<rc::scene::Hit> hit;
+        const rc::scene::Ray ray_in = rc::scene::spawn_shadow_ray_to_infinity(at_in, wi);
         if (glm::dot(at_in.ng, wi) > 0.0f) hit = scene.intersect(ray_in);
         const bool input_blocked = glm::dot(at_in.ng, wi) <= 0.0f || hit.has_value();
         // As the README's experiment did: the element's own point traced against the input.
-        const bool raw_blocked = scene.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(q, n), wi));
+        const bool raw_blocked = scene.occluded(rc::scene::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(q, n), wi));
         // Interior: under a roof (an upward ray from the input point meets the input).
-        const bool interior = scene.occluded(rc::spawn_shadow_ray_to_infinity(at_in, Vec3(0, 1, 0)));
+        const bool interior = scene.occluded(rc::scene::spawn_shadow_ray_to_infinity(at_in, Vec3(0, 1, 0)));
         if (interior) {
           in_points += w;
           if (!elem_blocked) in_lit_elem += w;
@@ -281,7 +281,7 @@ int main(int argc, char** argv) {
   size_t buried = 0;
   for (Leak& k : leaks)
     if (k.category == 2) {
-      const rc::TriangleMesh& tm = scene.meshes[k.blocker_mesh];
+      const rc::scene::TriangleMesh& tm = scene.meshes[k.blocker_mesh];
       const uint32_t* idx = &tm.indices[3 * size_t(k.blocker_prim)];
       k.blocker_buried = rad::mesh::input_triangle_buried(scene, tm.positions[idx[0]], tm.positions[idx[1]], tm.positions[idx[2]]);
       buried += k.blocker_buried;
@@ -290,12 +290,12 @@ int main(int argc, char** argv) {
   // Gather rays from interior points (cosine over the element's front, as a form factor sees):
   // the reflected sunlight each reaches in the element scene, against the same ray in the input.
   {
-    rc::Rng rng(17);
+    rc::util::Rng rng(17);
     double read_elem = 0, read_in = 0, rays = 0, leak_rays = 0, leak_light = 0, leak_sky = 0, rev_light = 0;
     size_t n_leak_sky = 0, n_leak_lit = 0;
     std::vector<Leak> gleaks;
     const auto reflected = [&](uint32_t e) {
-      return rc::diffuse_reflectance(scene.materials[mesh.element_material[e]]).luminance() * sun_elem[e] / 3.14159265f;
+      return rc::scene::diffuse_reflectance(scene.materials[mesh.element_material[e]]).luminance() * sun_elem[e] / 3.14159265f;
     };
     for (size_t e = 0; e < mesh.element_count(); ++e) {
       const auto& el = mesh.elements[e];
@@ -303,24 +303,24 @@ int main(int argc, char** argv) {
       const uint32_t s = mesh.element_surface[e];
       if (s >= scene.meshes.size()) continue;
       for (int r = 0; r < 4; ++r) {
-        const rc::Vec2 b = rc::sample_uniform_triangle(rng.uniform2());
+        const rc::Vec2 b = rc::util::sample_uniform_triangle(rng.uniform2());
         const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
-        const std::optional<rc::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
+        const std::optional<rc::scene::SurfacePoint> found = input_point(scene, s, q, 2.0f * L, n);
         if (!found) continue;
-        const rc::SurfacePoint& at_in = *found;
-        if (!scene.occluded(rc::spawn_shadow_ray_to_infinity(at_in, Vec3(0, 1, 0)))) continue;  // interior only
-        const Vec3 wl = rc::sample_cosine_hemisphere(rng.uniform2());
+        const rc::scene::SurfacePoint& at_in = *found;
+        if (!scene.occluded(rc::scene::spawn_shadow_ray_to_infinity(at_in, Vec3(0, 1, 0)))) continue;  // interior only
+        const Vec3 wl = rc::util::sample_cosine_hemisphere(rng.uniform2());
         const Vec3 w = rc::Frame::from_normal(n).to_world(wl);
         if (!(glm::dot(w, at_in.ng) > 0.0f)) continue;
         rays += 1;
-        const rc::Ray ray_e = rc::spawn_ray(rad::mesh::mesh_surface_point(q, n), w);
-        const rc::Ray ray_i = rc::spawn_ray(at_in, w);
+        const rc::scene::Ray ray_e = rc::scene::spawn_ray(rad::mesh::mesh_surface_point(q, n), w);
+        const rc::scene::Ray ray_i = rc::scene::spawn_ray(at_in, w);
         const auto he = geo.intersect(ray_e);
         const auto hi = scene.intersect(ray_i);
         float le = 0.0f, li = 0.0f;
         if (he && he->geom_id == 0 && geo.surface(ray_e, *he).front_face) le = reflected(he->prim_id);
         if (hi) {
-          const rc::SurfaceInteraction si = scene.surface(ray_i, *hi);
+          const rc::scene::SurfaceInteraction si = scene.surface(ray_i, *hi);
           const Vec3 lit = si.front_face ? si.ng : -si.ng;
           const auto loc = geo.nearest_triangle(0, si.p, 2.0f * L, lit, 0.5f);
           if (loc) li = reflected(loc->prim_id);
@@ -334,9 +334,9 @@ int main(int argc, char** argv) {
         if (hi && he && he->geom_id == 0) {
           const Vec3 h = ray_i.origin + hi->t * w;
           const auto& ee = mesh.elements[he->prim_id];
-          const rc::Vec2 uv = rc::closest_point_on_triangle(h, mesh.positions[ee[0]], mesh.positions[ee[1]], mesh.positions[ee[2]]);
+          const rc::Vec2 uv = rc::util::closest_point_on_triangle(h, mesh.positions[ee[0]], mesh.positions[ee[1]], mesh.positions[ee[2]]);
           const Vec3 x = (1 - uv.x - uv.y) * mesh.positions[ee[0]] + uv.x * mesh.positions[ee[1]] + uv.y * mesh.positions[ee[2]];
-          const rc::SurfaceInteraction sb = scene.surface(ray_i, *hi);
+          const rc::scene::SurfaceInteraction sb = scene.surface(ray_i, *hi);
           const Vec3 side_b = glm::dot(sb.ng, w) < 0.0f ? sb.ng : -sb.ng;  // the blocker's side the ray meets
           same = glm::length(x - h) < 0.15f * L && glm::dot(side_b, mesh.element_normal[he->prim_id]) > 0.5f;
         }
@@ -366,7 +366,7 @@ int main(int argc, char** argv) {
               if (point_segment(k.h, u, v) > 3 * L) continue;
               k.d_open = std::min(k.d_open, segment_segment(s0, s1, u, v));
             }
-            const rc::SurfaceInteraction si = scene.surface(ray_i, *hi);
+            const rc::scene::SurfaceInteraction si = scene.surface(ray_i, *hi);
             k.cos_blocker = std::abs(glm::dot(si.ng, w));
           }
           k.category = !he ? 5 : 6;
@@ -403,14 +403,14 @@ int main(int argc, char** argv) {
   // Camera-weighted: points the camera sees (256 x 192), each located on its element as the view
   // does, gather 16 cosine rays from the element point (element scene) and from the input point.
   {
-    const rc::Camera cam = scene.effective_camera(256.0f / 192.0f);
+    const rc::scene::Camera cam = scene.effective_camera(256.0f / 192.0f);
     const Vec3 fwd = glm::normalize(cam.look_at - cam.look_from), right = glm::normalize(glm::cross(fwd, cam.up)),
                up = glm::cross(right, fwd);
     const float th = std::tan(0.5f * cam.vfov_degrees * 3.14159265f / 180.0f);
     const auto reflected = [&](uint32_t e) {
-      return rc::diffuse_reflectance(scene.materials[mesh.element_material[e]]).luminance() * sun_elem[e] / 3.14159265f;
+      return rc::scene::diffuse_reflectance(scene.materials[mesh.element_material[e]]).luminance() * sun_elem[e] / 3.14159265f;
     };
-    rc::Rng rng(23);
+    rc::util::Rng rng(23);
     double cam_bin[2][4] = {};
     double true_v_bin[4] = {};
     double read_near = 0, read_ve = 0, read_v_bin[4] = {}, read_n_bin[4] = {};
@@ -426,10 +426,10 @@ int main(int argc, char** argv) {
       for (int x = 0; x < 256; ++x) {
         const Vec3 d = glm::normalize(fwd + ((2 * (x + 0.5f) / 256 - 1) * th * 256.0f / 192.0f) * right +
                                       ((1 - 2 * (y + 0.5f) / 192) * th) * up);
-        const rc::Ray cr{cam.look_from, d, rc::kInfinity};
+        const rc::scene::Ray cr{cam.look_from, d, rc::kInfinity};
         const auto ch = scene.intersect(cr);
         if (!ch) continue;
-        const rc::SurfaceInteraction si = scene.surface(cr, *ch);
+        const rc::scene::SurfaceInteraction si = scene.surface(cr, *ch);
         if (scene.materials[si.material].is_traced_through()) continue;
         ++pix;
         const Vec3 lit = si.front_face ? si.ng : -si.ng;
@@ -457,12 +457,12 @@ int main(int argc, char** argv) {
           const float size = glm::length(towards);
           const Vec3 pv = mesh.positions[v] + 1e-3f * (towards - glm::dot(towards, nv) * nv + size * nv);
           const rc::Frame fv = rc::Frame::from_normal(nv);
-          std::optional<rc::SurfacePoint> vin;
+          std::optional<rc::scene::SurfacePoint> vin;
           {
             const uint32_t sv = mesh.element_surface[loc->prim_id];
             const auto nn = sv < scene.meshes.size() ? scene.nearest_triangle(sv, pv, 2.0f * L, nv, 0.5f) : std::nullopt;
             if (nn) {
-              const rc::TriangleMesh& tm = scene.meshes[sv];
+              const rc::scene::TriangleMesh& tm = scene.meshes[sv];
               const Vec3 a = tm.positions[tm.indices[3 * nn->prim_id]], bb = tm.positions[tm.indices[3 * nn->prim_id + 1]],
                          cc = tm.positions[tm.indices[3 * nn->prim_id + 2]];
               Vec3 ni = glm::normalize(glm::cross(bb - a, cc - a));
@@ -471,8 +471,8 @@ int main(int argc, char** argv) {
             }
           }
           for (int r = 0; r < 16; ++r) {
-            const Vec3 w = fv.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
-            const auto hv = geo.intersect(rc::spawn_ray(rad::mesh::mesh_surface_point(pv, nv), w));
+            const Vec3 w = fv.to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
+            const auto hv = geo.intersect(rc::scene::spawn_ray(rad::mesh::mesh_surface_point(pv, nv), w));
             float lv = 0.0f;
             if (hv && hv->geom_id == 0 && glm::dot(mesh.element_normal[hv->prim_id], w) < 0.0f) lv = reflected(hv->prim_id);
             read_v += lv;
@@ -480,20 +480,21 @@ int main(int argc, char** argv) {
             if (hv && lv > 0) {
               // The sun at the input point under the hit: what the element's mean stands for there.
               const uint32_t e2 = hv->prim_id, s2 = mesh.element_surface[e2];
-              const Vec3 x2 = rc::spawn_ray(rad::mesh::mesh_surface_point(pv, nv), w).origin + hv->t * w;
+              const Vec3 x2 =
+                  rc::scene::spawn_ray(rad::mesh::mesh_surface_point(pv, nv), w).origin + hv->t * w;
               const Vec3 n2 = mesh.element_normal[e2];
               float tr = 0.0f;
               const auto nn = s2 < scene.meshes.size() ? scene.nearest_triangle(s2, x2, L, n2, 0.5f) : std::nullopt;
               if (nn) {
-                const rc::TriangleMesh& tm = scene.meshes[s2];
+                const rc::scene::TriangleMesh& tm = scene.meshes[s2];
                 const Vec3 a = tm.positions[tm.indices[3 * nn->prim_id]], bb = tm.positions[tm.indices[3 * nn->prim_id + 1]],
                            cc = tm.positions[tm.indices[3 * nn->prim_id + 2]];
                 Vec3 ni = glm::normalize(glm::cross(bb - a, cc - a));
                 if (glm::dot(ni, n2) < 0) ni = -ni;
-                const rc::SurfacePoint sp = rad::mesh::mesh_surface_point((1 - nn->u - nn->v) * a + nn->u * bb + nn->v * cc, ni);
+                const rc::scene::SurfacePoint sp = rad::mesh::mesh_surface_point((1 - nn->u - nn->v) * a + nn->u * bb + nn->v * cc, ni);
                 const float cs = glm::dot(ni, wi);
-                if (cs > 0 && !scene.occluded(rc::spawn_shadow_ray_to_infinity(sp, wi)))
-                  tr = rc::diffuse_reflectance(scene.materials[mesh.element_material[e2]]).luminance() * sun->irradiance.luminance() * cs / 3.14159265f;
+                if (cs > 0 && !scene.occluded(rc::scene::spawn_shadow_ray_to_infinity(sp, wi)))
+                  tr = rc::scene::diffuse_reflectance(scene.materials[mesh.element_material[e2]]).luminance() * sun->irradiance.luminance() * cs / 3.14159265f;
               }
               const int bin = hv->t < 0.02f * L ? 0 : hv->t < 0.1f * L ? 1 : hv->t < 0.5f * L ? 2 : 3;
               true_v_bin[bin] += tr;
@@ -513,18 +514,18 @@ int main(int argc, char** argv) {
               const Vec3 pn = 0.9f * mesh.positions[v] + 0.05f * (3.0f * c - mesh.positions[v]);
               const rc::Frame fe = rc::Frame::from_normal(ne);
               const Vec3 we = fe.to_world(fv.to_local(w));
-              const auto h1 = geo.intersect(rc::spawn_ray(rad::mesh::mesh_surface_point(pn, ne), we));
+              const auto h1 = geo.intersect(rc::scene::spawn_ray(rad::mesh::mesh_surface_point(pn, ne), we));
               if (h1 && h1->geom_id == 0 && glm::dot(mesh.element_normal[h1->prim_id], we) < 0.0f) {
                 read_near += reflected(h1->prim_id);
                 read_n_bin[h1->t < 0.02f * L ? 0 : h1->t < 0.1f * L ? 1 : h1->t < 0.5f * L ? 2 : 3] += reflected(h1->prim_id);
               }
               const Vec3 pve = mesh.positions[v] + 1e-3f * (towards - glm::dot(towards, ne) * ne + size * ne);
-              const auto h2 = geo.intersect(rc::spawn_ray(rad::mesh::mesh_surface_point(pve, ne), we));
+              const auto h2 = geo.intersect(rc::scene::spawn_ray(rad::mesh::mesh_surface_point(pve, ne), we));
               if (h2 && h2->geom_id == 0 && glm::dot(mesh.element_normal[h2->prim_id], we) < 0.0f) read_ve += reflected(h2->prim_id);
             }
             if (!(lv > 0.0f) || !vin) continue;
             // Against the input from the vertex's input point: does the element ray pass the input's blocker?
-            const rc::Ray ri = rc::spawn_ray(*vin, w);
+            const rc::scene::Ray ri = rc::scene::spawn_ray(*vin, w);
             const auto hi = scene.intersect(ri);
             if (!hi || glm::dot(w, vin->ng) <= 0.0f) {
               if (glm::dot(w, vin->ng) <= 0.0f) vleak_below += lv;
@@ -532,9 +533,9 @@ int main(int argc, char** argv) {
             }
             const Vec3 h = ri.origin + hi->t * w;
             const auto& ee = mesh.elements[hv->prim_id];
-            const rc::Vec2 uv = rc::closest_point_on_triangle(h, mesh.positions[ee[0]], mesh.positions[ee[1]], mesh.positions[ee[2]]);
+            const rc::Vec2 uv = rc::util::closest_point_on_triangle(h, mesh.positions[ee[0]], mesh.positions[ee[1]], mesh.positions[ee[2]]);
             const Vec3 xx = (1 - uv.x - uv.y) * mesh.positions[ee[0]] + uv.x * mesh.positions[ee[1]] + uv.y * mesh.positions[ee[2]];
-            const rc::SurfaceInteraction sb = scene.surface(ri, *hi);
+            const rc::scene::SurfaceInteraction sb = scene.surface(ri, *hi);
             const Vec3 side_b = glm::dot(sb.ng, w) < 0.0f ? sb.ng : -sb.ng;
             const bool vsame = glm::length(xx - h) < 0.15f * L && glm::dot(side_b, mesh.element_normal[hv->prim_id]) > 0.5f;
             if (!vsame && hv->t > hi->t + 0.01f * L) {
@@ -544,15 +545,15 @@ int main(int argc, char** argv) {
             }
           }
         }
-        rc::SurfacePoint at_in = si;
+        rc::scene::SurfacePoint at_in = si;
         at_in.ng = lit;
         const rc::Frame frame = rc::Frame::from_normal(lit);
         for (int r = 0; r < 16; ++r) {
-          const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
+          const Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
           if (!(glm::dot(w, n) > 0.0f)) continue;
           nrays += 1;
-          const rc::Ray ray_e = rc::spawn_ray(rad::mesh::mesh_surface_point(q, n), w);
-          const rc::Ray ray_i = rc::spawn_ray(at_in, w);
+          const rc::scene::Ray ray_e = rc::scene::spawn_ray(rad::mesh::mesh_surface_point(q, n), w);
+          const rc::scene::Ray ray_i = rc::scene::spawn_ray(at_in, w);
           const auto he = geo.intersect(ray_e);
           const auto hi = scene.intersect(ray_i);
           float le = 0.0f, li = 0.0f;
@@ -562,20 +563,20 @@ int main(int argc, char** argv) {
             const Vec3 ne2 = mesh.element_normal[he->prim_id];
             const float c2 = glm::dot(ne2, wi);
             const Vec3 x2 = ray_e.origin + he->t * w;
-            if (c2 > 0.0f && !geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(x2, ne2), wi)))
-              read_pt += rc::diffuse_reflectance(scene.materials[mesh.element_material[he->prim_id]]).luminance() *
+            if (c2 > 0.0f && !geo.occluded(rc::scene::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(x2, ne2), wi)))
+              read_pt += rc::scene::diffuse_reflectance(scene.materials[mesh.element_material[he->prim_id]]).luminance() *
                          sun->irradiance.luminance() * c2 / 3.14159265f;
           }
           if (hi) {
-            const rc::SurfaceInteraction sj = scene.surface(ray_i, *hi);
+            const rc::scene::SurfaceInteraction sj = scene.surface(ray_i, *hi);
             const Vec3 lj = sj.front_face ? sj.ng : -sj.ng;
             // Truth: the sun at the input point itself.
             float truth = 0.0f;
             const float cs = glm::dot(lj, wi);
-            rc::SurfacePoint sp = sj;
+            rc::scene::SurfacePoint sp = sj;
             sp.ng = lj;
-            if (cs > 0.0f && !scene.occluded(rc::spawn_shadow_ray_to_infinity(sp, wi)))
-              truth = rc::diffuse_reflectance(scene.materials[sj.material]).luminance() * sun->irradiance.luminance() * cs / 3.14159265f;
+            if (cs > 0.0f && !scene.occluded(rc::scene::spawn_shadow_ray_to_infinity(sp, wi)))
+              truth = rc::scene::diffuse_reflectance(scene.materials[sj.material]).luminance() * sun->irradiance.luminance() * cs / 3.14159265f;
             read_t += truth;
             const auto lo = geo.nearest_triangle(0, sj.p, 0.5f * L, lj, 0.5f);
             li = lo ? reflected(lo->prim_id) : truth;
@@ -597,9 +598,9 @@ int main(int argc, char** argv) {
           if (hi) h = ray_i.origin + hi->t * w;
           if (hi && he && he->geom_id == 0) {
             const auto& ee = mesh.elements[he->prim_id];
-            const rc::Vec2 uv = rc::closest_point_on_triangle(h, mesh.positions[ee[0]], mesh.positions[ee[1]], mesh.positions[ee[2]]);
+            const rc::Vec2 uv = rc::util::closest_point_on_triangle(h, mesh.positions[ee[0]], mesh.positions[ee[1]], mesh.positions[ee[2]]);
             const Vec3 xx = (1 - uv.x - uv.y) * mesh.positions[ee[0]] + uv.x * mesh.positions[ee[1]] + uv.y * mesh.positions[ee[2]];
-            const rc::SurfaceInteraction sb = scene.surface(ray_i, *hi);
+            const rc::scene::SurfaceInteraction sb = scene.surface(ray_i, *hi);
             const Vec3 side_b = glm::dot(sb.ng, w) < 0.0f ? sb.ng : -sb.ng;
             same = glm::length(xx - h) < 0.15f * L && glm::dot(side_b, mesh.element_normal[he->prim_id]) > 0.5f;
           }

@@ -19,11 +19,11 @@
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/bsdf.h"
+#include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -32,11 +32,11 @@ using rc::Vec3;
 
 int main(int argc, char** argv) {
   if (argc < 2) return 2;
-  rc::Scene scene = rc::load_scene_file(argv[1]);
+  rc::scene::Scene scene = rc::io::load_scene_file(argv[1]);
   // The sun alone.
-  std::erase_if(scene.punctual_lights, [](const rc::Light& l) { return l.kind != rc::LightKind::directional; });
+  std::erase_if(scene.punctual_lights, [](const rc::scene::Light& l) { return l.kind != rc::scene::LightKind::directional; });
   scene.commit();
-  const rc::Light& sun = scene.punctual_lights.at(0);
+  const rc::scene::Light& sun = scene.punctual_lights.at(0);
   const Vec3 wi = -glm::normalize(sun.direction);
   rad::solver::SolverSettings ss;
   ss.mesh.elements = argc > 3 ? std::atoi(argv[3]) : rad::mesh::kDefaultElements;
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   const rad::mesh::RadiosityMesh& mesh = sol.mesh;
   std::printf("solved: %zu elements, %zu links, %d iterations, final gather %d\n", mesh.element_count(), sol.links,
               sol.iterations, int(sol.final_gather));
-  const rc::Scene geo = rad::mesh::element_scene(scene, mesh);
+  const rc::scene::Scene geo = rad::mesh::element_scene(scene, mesh);
   if (const char* path = std::getenv("ELEMCSV")) {
     std::FILE* f = std::fopen(path, "w");
     for (size_t e = 0; e < mesh.element_count(); ++e) {
@@ -64,15 +64,17 @@ int main(int argc, char** argv) {
     std::fclose(f);
   }
   const float L = sol.mesh_report.max_edge, reach = 2.0f * L;
-  const auto albedo = [&](uint32_t m) { return rc::diffuse_reflectance(scene.materials[m]).luminance(); };
+  const auto albedo = [&](uint32_t m) {
+    return rc::scene::diffuse_reflectance(scene.materials[m]).luminance();
+  };
   const auto elem_b = [&](uint32_t e) { return albedo(mesh.element_material[e]) * sol.element_direct[e].luminance(); };
   const float E = sun.irradiance.luminance();
 
-  const rc::Camera cam = scene.effective_camera(256.0f / 192.0f);
+  const rc::scene::Camera cam = scene.effective_camera(256.0f / 192.0f);
   const Vec3 fwd = glm::normalize(cam.look_at - cam.look_from), right = glm::normalize(glm::cross(fwd, cam.up)),
              up = glm::cross(right, fwd);
   const float th = std::tan(0.5f * cam.vfov_degrees * 3.14159265f / 180.0f);
-  rc::Rng rng(29);
+  rc::util::Rng rng(29);
   double solver = 0, gather_elem = 0, gather_point = 0, truth_front = 0, truth_both = 0, pixels = 0;
   const int rays = 64;
   std::FILE* pix = std::getenv("PIXCSV") ? std::fopen(std::getenv("PIXCSV"), "w") : nullptr;
@@ -80,10 +82,10 @@ int main(int argc, char** argv) {
     for (int x = 0; x < 256; ++x) {
       const Vec3 d = glm::normalize(fwd + ((2 * (x + 0.5f) / 256 - 1) * th * 256.0f / 192.0f) * right +
                                     ((1 - 2 * (y + 0.5f) / 192) * th) * up);
-      const rc::Ray cr{cam.look_from, d, rc::kInfinity};
+      const rc::scene::Ray cr{cam.look_from, d, rc::kInfinity};
       const auto ch = scene.intersect(cr);
       if (!ch) continue;
-      const rc::SurfaceInteraction si = scene.surface(cr, *ch);
+      const rc::scene::SurfaceInteraction si = scene.surface(cr, *ch);
       if (scene.materials[si.material].is_traced_through()) continue;
       const Vec3 lit = si.front_face ? si.ng : -si.ng;
       const auto loc = geo.nearest_triangle(0, si.p, reach, lit, 0.5f);
@@ -97,27 +99,27 @@ int main(int argc, char** argv) {
       const Vec3 q = b0 * mesh.positions[el[0]] + loc->u * mesh.positions[el[1]] + loc->v * mesh.positions[el[2]];
       const Vec3 n = mesh.element_normal[loc->prim_id];
       const rc::Frame fe = rc::Frame::from_normal(n), fi = rc::Frame::from_normal(lit);
-      rc::SurfacePoint at_in = si;
+      rc::scene::SurfacePoint at_in = si;
       at_in.ng = lit;
       double ge = 0, gp = 0, tf = 0, tb = 0;
       for (int r = 0; r < rays; ++r) {
-        const Vec3 wl = rc::sample_cosine_hemisphere(rng.uniform2());
-        const rc::Ray re = rc::spawn_ray(rad::mesh::mesh_surface_point(q, n), fe.to_world(wl));
+        const Vec3 wl = rc::util::sample_cosine_hemisphere(rng.uniform2());
+        const rc::scene::Ray re = rc::scene::spawn_ray(rad::mesh::mesh_surface_point(q, n), fe.to_world(wl));
         if (const auto he = geo.intersect(re); he && he->geom_id == 0 && geo.surface(re, *he).front_face) {
           ge += elem_b(he->prim_id);
           const Vec3 n2 = mesh.element_normal[he->prim_id];
           const float c2 = glm::dot(n2, wi);
-          if (c2 > 0 && !geo.occluded(rc::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(re.origin + he->t * re.direction, n2), wi)))
+          if (c2 > 0 && !geo.occluded(rc::scene::spawn_shadow_ray_to_infinity(rad::mesh::mesh_surface_point(re.origin + he->t * re.direction, n2), wi)))
             gp += albedo(mesh.element_material[he->prim_id]) * E * c2;
         }
-        const rc::Ray ri = rc::spawn_ray(at_in, fi.to_world(wl));
+        const rc::scene::Ray ri = rc::scene::spawn_ray(at_in, fi.to_world(wl));
         if (const auto hi = scene.intersect(ri)) {
-          const rc::SurfaceInteraction sj = scene.surface(ri, *hi);
+          const rc::scene::SurfaceInteraction sj = scene.surface(ri, *hi);
           const Vec3 lj = sj.front_face ? sj.ng : -sj.ng;
-          rc::SurfacePoint sp = sj;
+          rc::scene::SurfacePoint sp = sj;
           sp.ng = lj;
           const float c2 = glm::dot(lj, wi);
-          if (c2 > 0 && !scene.occluded(rc::spawn_shadow_ray_to_infinity(sp, wi))) {
+          if (c2 > 0 && !scene.occluded(rc::scene::spawn_shadow_ray_to_infinity(sp, wi))) {
             const double b = albedo(sj.material) * E * c2;
             tb += b;
             if (sj.front_face) tf += b;

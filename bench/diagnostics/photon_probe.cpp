@@ -17,17 +17,17 @@
 #include "photonmap/coverage.h"
 #include "photonmap/photon_map.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;
 
 int main(int argc, char** argv) {
   if (argc < 2) return 2;
-  rc::Scene scene = rc::load_scene(argv[1]);
+  rc::scene::Scene scene = rc::io::load_scene(argv[1]);
   pm::PhotonSettings ps;
   ps.global_photons = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 200000;
   ps.caustic_photons = 0;
@@ -49,12 +49,12 @@ int main(int argc, char** argv) {
     size_t on_closed = 0, found = 0;
     for (const pm::Photon& ph : maps.global.photons) {
       const rc::Vec3 n = pm::decode_direction(ph.normal);
-      rc::Ray back{ph.position + 1e-3f * n, -n};
+      rc::scene::Ray back{ph.position + 1e-3f * n, -n};
       back.tmax = 2e-3f;
       const auto h = scene.intersect(back);
       if (!h || h->geom_id == scene.sphere_geom_id()) continue;
       ++found;
-      const rc::TriangleMesh& m = scene.meshes[h->geom_id];
+      const rc::scene::TriangleMesh& m = scene.meshes[h->geom_id];
       const uint32_t* j = &m.indices[3 * size_t(h->prim_id)];
       const bool front = glm::dot(glm::cross(m.positions[j[1]] - m.positions[j[0]], m.positions[j[2]] - m.positions[j[0]]), n) >= 0.0f;
       if (!maps.global.sides.holds(h->geom_id, h->prim_id, front)) ++on_closed;
@@ -65,22 +65,22 @@ int main(int argc, char** argv) {
   }
   std::printf("%zu global photons from %llu paths\n", maps.global.photons.size(), (unsigned long long)maps.paths);
   const float max_r = 0.05f * scene.bounds().radius();
-  const rc::Camera camera = scene.effective_camera(256.0f / 192.0f);
-  rc::RenderSettings rs;
+  const rc::scene::Camera camera = scene.effective_camera(256.0f / 192.0f);
+  rc::render::RenderSettings rs;
   rs.width = 256;
   rs.height = 192;
   rs.filter.radius = 0.0f;
   struct Point { double photon, path; };
   std::vector<Point> points;
   pm::EstimateScratch scratch;
-  const rc::PathSettings path;
+  const rc::render::PathSettings path;
   for (int y = 4; y < 192; y += 8)
     for (int x = 4; x < 256; x += 8) {
-      rc::Sampler cs(rc::Rng::for_item(1, uint64_t(y) * 256 + x, 0));
-      const rc::Ray ray = rc::camera_ray(camera, rs, x, y, cs);
+      rc::render::Sampler cs(rc::util::Rng::for_item(1, uint64_t(y) * 256 + x, 0));
+      const rc::scene::Ray ray = rc::render::camera_ray(camera, rs, x, y, cs);
       const auto hit = scene.intersect(ray);
       if (!hit) continue;
-      const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+      const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
       if (scene.materials[si.material].is_traced_through()) continue;
       const rc::Vec3 n = glm::dot(-ray.direction, si.ng) > 0.0f ? si.ng : -si.ng;
       const pm::EstimateQuery q{si.p, n, k, max_r * max_r};
@@ -89,16 +89,16 @@ int main(int argc, char** argv) {
       const rc::Frame frame = rc::Frame::from_normal(n);
       double sum = 0.0;
       for (int i = 0; i < rays; ++i) {
-        rc::Rng rng = rc::Rng::for_item(2, uint64_t(y) * 256 + x, uint64_t(i));
-        const rc::Vec3 d = frame.to_world(rc::sample_cosine_hemisphere(rng.uniform2()));
-        const rc::Ray r = rc::spawn_ray(si, d);
+        rc::util::Rng rng = rc::util::Rng::for_item(2, uint64_t(y) * 256 + x, uint64_t(i));
+        const rc::Vec3 d = frame.to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
+        const rc::scene::Ray r = rc::scene::spawn_ray(si, d);
         const auto h = scene.intersect(r);
         if (!h) continue;
-        rc::SampleContext ctx{rc::Sampler(rng)};
+        rc::render::SampleContext ctx{rc::render::Sampler(rng)};
         rc::Rgb l = path_radiance(scene, r, ctx, path);
-        const rc::SurfaceInteraction sy = scene.surface(r, *h);
-        const rc::Material& my = scene.materials[sy.material];
-        if (my.is_emissive()) l -= rc::emitted_radiance(my, sy.ng, -d);
+        const rc::scene::SurfaceInteraction sy = scene.surface(r, *h);
+        const rc::scene::Material& my = scene.materials[sy.material];
+        if (my.is_emissive()) l -= rc::scene::emitted_radiance(my, sy.ng, -d);
         sum += l.average();
       }
       points.push_back({photon, rc::kPi * sum / rays});

@@ -29,11 +29,11 @@
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/staged_file.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/staged_file.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::bake {
 
@@ -53,16 +53,16 @@ namespace {
 
 /// Path settings whose first surface is a white, unlit Lambertian: π times their radiance
 /// estimate is the irradiance where the path starts.
-rc::PathSettings irradiance_probe() {
-  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
-  rc::PathSettings path;
+rc::render::PathSettings irradiance_probe() {
+  static const rc::scene::Material white = rc::scene::Material::make_diffuse("irradiance probe", Rgb(1.0f));
+  rc::render::PathSettings path;
   path.first_surface = &white;
   return path;
 }
 
 }  // namespace
 
-CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& solution, const CheckSettings& settings) {
+CheckResult check_against_path_tracer(const rc::scene::Scene& scene, const Solution& solution, const CheckSettings& settings) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
   CheckResult result;
@@ -75,8 +75,8 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
   const std::vector<float> radius = vertex_disk_radius(mesh);
   std::vector<Rgb> mean(count), standard_error(count);
   std::vector<char> usable(count, 0);
-  const rc::PathSettings path = irradiance_probe();
-  rc::parallel_for(count, [&](size_t i) {
+  const rc::render::PathSettings path = irradiance_probe();
+  rc::util::parallel_for(count, [&](size_t i) {
     const size_t v = i * nv / count;
     const Vec3 n = mesh.normals[v];
     const rc::Frame frame = rc::Frame::from_normal(n);
@@ -84,14 +84,14 @@ CheckResult check_against_path_tracer(const rc::Scene& scene, const Solution& so
     Rgb sum(0.0f), sum_squares(0.0f);
     int taken = 0;
     for (int s = 0; s < settings.samples; ++s) {
-      rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(settings.seed, v, 0xc0ffee0000ull + uint64_t(s))), 0};
-      const rc::Vec2 u = rc::sample_uniform_disk(ctx.sampler.uniform2()) * r;
+      rc::render::SampleContext ctx{rc::render::Sampler(rc::util::Rng::for_item(settings.seed, v, 0xc0ffee0000ull + uint64_t(s))), 0};
+      const rc::Vec2 u = rc::util::sample_uniform_disk(ctx.sampler.uniform2()) * r;
       // Only the surface on the vertex's side of a crease (vertices are split at 30°) counts.
       const Vec3 offset = origin[v] - mesh.positions[v] + frame.to_world(Vec3(u.x, u.y, 0.0f));
       const std::optional<InputPoint> under = input_surface_under(scene, mesh, v, offset, r);
       if (!under) continue;
-      const rc::Ray& ray = under->ray;
-      const Rgb e = rc::path_radiance(scene, ray, ctx, path) * rc::kPi;
+      const rc::scene::Ray& ray = under->ray;
+      const Rgb e = rc::render::path_radiance(scene, ray, ctx, path) * rc::kPi;
       sum += e;
       sum_squares += e * e;
       ++taken;
@@ -170,12 +170,13 @@ struct CheckedPoint {
 
 /// Reads the scene; returns the faces the bake covers and their areas, the weights points are
 /// drawn by (mirror and glass faces, which carry no radiosity of their own, are left out).
-std::vector<CheckFace> checked_faces(const rc::Scene& scene, const std::function<bool(size_t)>& drawn_from,
+std::vector<CheckFace> checked_faces(const rc::scene::Scene& scene,
+                                     const std::function<bool(size_t)>& drawn_from,
                                      std::vector<float>& area) {
   std::vector<CheckFace> faces;
   for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
-    const rc::TriangleMesh& mesh = scene.meshes[m];
-    const rc::Material& mat = scene.materials[mesh.material];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
+    const rc::scene::Material& mat = scene.materials[mesh.material];
     if (!drawn_from(m) || mat.is_traced_through()) continue;
     for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
       const Vec3 &a = mesh.positions[mesh.indices[3 * t]], &b = mesh.positions[mesh.indices[3 * t + 1]],
@@ -189,13 +190,14 @@ std::vector<CheckFace> checked_faces(const rc::Scene& scene, const std::function
 
 /// Draws point i on `face` with `rng`, path-traces its irradiance (settings.samples samples, along
 /// rays `step` above it) and asks `baked_at` for the bake's value there.
-CheckedPoint check_point(const rc::Scene& scene, const CheckFace& face, rc::Rng& rng, size_t i, float step,
-                         const rc::PathSettings& path, const BakedAt& baked_at, const CheckSettings& settings) {
+CheckedPoint check_point(const rc::scene::Scene& scene, const CheckFace& face, rc::util::Rng& rng, size_t i,
+                         float step, const rc::render::PathSettings& path, const BakedAt& baked_at,
+                         const CheckSettings& settings) {
   CheckedPoint out;
-  const rc::TriangleMesh& mesh = scene.meshes[face.mesh];
-  const rc::Material& m = scene.materials[mesh.material];
+  const rc::scene::TriangleMesh& mesh = scene.meshes[face.mesh];
+  const rc::scene::Material& m = scene.materials[mesh.material];
   const uint32_t* corner = &mesh.indices[3 * size_t(face.triangle)];
-  const rc::Vec2 uv = rc::sample_uniform_triangle(rng.uniform2());
+  const rc::Vec2 uv = rc::util::sample_uniform_triangle(rng.uniform2());
   DrawnPoint point{face.mesh, face.triangle, {1.0f - uv.x - uv.y, uv.x, uv.y}, Vec3(0.0f), Vec3(0.0f)};
   for (int k = 0; k < 3; ++k) point.position += point.weight[k] * mesh.positions[corner[k]];
   point.normal = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
@@ -210,12 +212,13 @@ CheckedPoint check_point(const rc::Scene& scene, const CheckFace& face, rc::Rng&
   Rgb sum(0.0f), sum_squares(0.0f);
   int taken = 0;
   for (int s = 0; s < settings.samples; ++s) {
-    rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s))), 0};
-    const rc::Ray ray{p + step * n, -n, 2.0f * step};
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    rc::render::SampleContext ctx{
+        rc::render::Sampler(rc::util::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s))), 0};
+    const rc::scene::Ray ray{p + step * n, -n, 2.0f * step};
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     // Something lies on the point, or coincides with its face (a duplicate, facing either way).
     if (!hit || hit->geom_id != face.mesh || hit->prim_id != face.triangle) return out;
-    const Rgb e = rc::path_radiance(scene, ray, ctx, path) * rc::kPi;
+    const Rgb e = rc::render::path_radiance(scene, ray, ctx, path) * rc::kPi;
     sum += e;
     sum_squares += e * e;
     ++taken;
@@ -281,21 +284,21 @@ void score_points(std::vector<CheckedPoint>& points, size_t used, double referen
 /// The check behind check_input_colours, check_lightmap and check_element_colours: draws
 /// settings.points points by area over the faces of the scene meshes `drawn_from(m)` accepts
 /// (mirrors and glass never), path-traces the irradiance at each and compares it with `baked_at`.
-SurfaceCheckResult check_baked(const rc::Scene& scene, const std::function<bool(size_t)>& drawn_from,
+SurfaceCheckResult check_baked(const rc::scene::Scene& scene, const std::function<bool(size_t)>& drawn_from,
                                const BakedAt& baked_at, const CheckSettings& settings) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
   std::vector<float> area;
   const std::vector<CheckFace> faces = checked_faces(scene, drawn_from, area);
   SurfaceCheckResult result;
-  const rc::Distribution1D pick(area);
+  const rc::util::Distribution1D pick(area);
   if (pick.size() == 0) return result;
   const float step = 1e-4f * glm::length(scene.bounds().diagonal());
   const size_t count = size_t(settings.points);
   std::vector<CheckedPoint> points(count);
-  const rc::PathSettings path = irradiance_probe();
-  rc::parallel_for(count, [&](size_t i) {
-    rc::Rng rng = rc::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
+  const rc::render::PathSettings path = irradiance_probe();
+  rc::util::parallel_for(count, [&](size_t i) {
+    rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
     const CheckFace& face = faces[pick.sample(rng.uniform())];
     points[i] = check_point(scene, face, rng, i, step, path, baked_at, settings);
   });
@@ -314,7 +317,8 @@ SurfaceCheckResult check_baked(const rc::Scene& scene, const std::function<bool(
 
 }  // namespace
 
-void write_check_points(const std::string& path, const rc::Scene& scene, const SurfaceCheckResult& result) {
+void write_check_points(const std::string& path, const rc::scene::Scene& scene,
+                        const SurfaceCheckResult& result) {
   std::string out =
       "gltf_mesh,gltf_primitive,v0,v1,v2,w0,w1,w2,x,y,z,albedo_r,albedo_g,albedo_b,reference_r,reference_g,"
       "reference_b,standard_error_r,standard_error_g,standard_error_b,baked_r,baked_g,baked_b\n";
@@ -324,7 +328,7 @@ void write_check_points(const std::string& path, const rc::Scene& scene, const S
     out += line;
   };
   for (const SurfaceCheckPoint& p : result.compared) {
-    const rc::MeshOrigin& origin = scene.meshes[p.mesh].origin;
+    const rc::scene::MeshOrigin& origin = scene.meshes[p.mesh].origin;
     std::snprintf(line, sizeof line, "%d,%d,%u,%u,%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", origin.mesh, origin.primitive,
                   p.file_vertex[0], p.file_vertex[1], p.file_vertex[2], double(p.weight[0]), double(p.weight[1]),
                   double(p.weight[2]), double(p.position.x), double(p.position.y), double(p.position.z));
@@ -335,7 +339,7 @@ void write_check_points(const std::string& path, const rc::Scene& scene, const S
     rgb(p.baked);
     out += '\n';
   }
-  rc::StagedFile(path, out).commit();
+  rc::util::StagedFile(path, out).commit();
 }
 
 void write_check_points(const std::string& path, const CheckResult& result) {
@@ -353,16 +357,16 @@ void write_check_points(const std::string& path, const CheckResult& result) {
                   double(p.solved.b));
     out += line;
   }
-  rc::StagedFile(path, out).commit();
+  rc::util::StagedFile(path, out).commit();
 }
 
-SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
+SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings) {
   const auto baked_on = [&](size_t m) {
     return irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty() : !irradiance.per_mesh[m].empty();
   };
   const auto baked_at = [&](const DrawnPoint& at) -> std::optional<Rgb> {
-    const rc::TriangleMesh& mesh = scene.meshes[at.mesh];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[at.mesh];
     Rgb value(0.0f);
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = mesh.indices[3 * size_t(at.triangle) + size_t(k)];
@@ -378,7 +382,7 @@ SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColour
       baked_at, settings);
 }
 
-SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings) {
+SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings) {
   return check_baked(
       scene,
       [&](size_t m) {
@@ -390,7 +394,7 @@ SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradi
       settings);
 }
 
-SurfaceCheckResult check_element_colours(const rc::Scene& scene, const RadiosityMesh& exported,
+SurfaceCheckResult check_element_colours(const rc::scene::Scene& scene, const RadiosityMesh& exported,
                                          const std::vector<Rgb>& vertex_irradiance,
                                          const CheckSettings& settings) {
   if (vertex_irradiance.size() != exported.vertex_count())
@@ -398,13 +402,14 @@ SurfaceCheckResult check_element_colours(const rc::Scene& scene, const Radiosity
                            " irradiance values for " + std::to_string(exported.vertex_count()) + " vertices");
   const auto start = std::chrono::steady_clock::now();
   // The elements in a BVH (geometry 0 of element_scene, its primitive ids the element indices).
-  std::optional<rc::Scene> elements;
+  std::optional<rc::scene::Scene> elements;
   if (exported.element_count() > 0) elements.emplace(element_scene(scene, exported));
   const float reach = 1e-4f * glm::length(scene.bounds().diagonal());
   const float facing = std::cos(2.5f * rc::kPi / 180.0f);
   const auto baked_at = [&](const DrawnPoint& at) -> std::optional<Rgb> {
     if (!elements) return std::nullopt;
-    const std::optional<rc::Hit> near = elements->nearest_triangle(0, at.position, reach, at.normal, facing);
+    const std::optional<rc::scene::Hit> near =
+        elements->nearest_triangle(0, at.position, reach, at.normal, facing);
     if (!near) return std::nullopt;
     const std::array<uint32_t, 3>& corner = exported.elements[near->prim_id];
     return (1.0f - near->u - near->v) * vertex_irradiance[corner[0]] +

@@ -52,7 +52,7 @@ struct CheckResult {
 /// tracer's views land on its material. Each
 /// vertex's estimate draws from its own random stream, so the result is the same for any thread
 /// count.
-CheckResult check_against_path_tracer(const rc::Scene& scene, const solver::Solution& solution, const CheckSettings& settings);
+CheckResult check_against_path_tracer(const rc::scene::Scene& scene, const solver::Solution& solution, const CheckSettings& settings);
 
 struct InputColours;  // radiosity/bake/onto_input.h
 
@@ -96,7 +96,8 @@ struct SurfaceCheckResult {
 
 /// Writes `result.compared` as CSV with a header line (atomically); throws rc::InputError when
 /// the file cannot be written.
-void write_check_points(const std::string& path, const rc::Scene& scene, const SurfaceCheckResult& result);
+void write_check_points(const std::string& path, const rc::scene::Scene& scene,
+                        const SurfaceCheckResult& result);
 /// The same for the element check: one line per compared vertex (index, position, normal, disk
 /// radius, reference with its standard error, solved irradiance).
 void write_check_points(const std::string& path, const CheckResult& result);
@@ -110,14 +111,14 @@ void write_check_points(const std::string& path, const CheckResult& result);
 /// and so is a buried point (input_triangle_buried for its face, which the fit leaves out, or
 /// input_point_buried for the point: inside a closed solid or under an object) or one no
 /// path-traced sample brings any light to: no one sees their colour.
-SurfaceCheckResult check_input_colours(const rc::Scene& scene, const InputColours& irradiance,
+SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings);
 
 struct Lightmap;  // radiosity/bake/lightmap.h
 
 /// The same check for a lightmap of irradiance (`--lightmap`): the baked value at each point is
 /// the atlas read bilinearly at the point's UV, as a viewer reads it.
-SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings);
+SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings);
 
 /// The same check for gilt's element mesh as exported (`--onto elements`), at the same random
 /// points inside the input's faces, drawn over every input mesh the mesher meshes (mirrors and
@@ -130,7 +131,7 @@ SurfaceCheckResult check_lightmap(const rc::Scene& scene, const Lightmap& irradi
 /// over the elements (O(log n) a point). A point with no such element is counted in `uncovered`
 /// and left out of the figures: on a flat input, a share below 1 is a hole or a flipped element
 /// in the export. Throws std::logic_error when vertex_irradiance does not match the mesh.
-SurfaceCheckResult check_element_colours(const rc::Scene& scene, const mesh::RadiosityMesh& exported,
+SurfaceCheckResult check_element_colours(const rc::scene::Scene& scene, const mesh::RadiosityMesh& exported,
                                          const std::vector<Rgb>& vertex_irradiance,
                                          const CheckSettings& settings);
 

@@ -3,7 +3,7 @@
 // PLY is written directly (binary little-endian); OBJ + MTL are written as text, since no OBJ writer among
 // gilt's libraries emits `v x y z r g b` vertex colours; glTF and GLB go through tinygltf. Every
 // file is encoded in memory first, then written to a hidden temporary beside its destination,
-// flushed to disk and renamed into place (the scheme of raytrace_core/image_io.cpp): a failure
+// flushed to disk and renamed into place (the scheme of raytrace_core/util/image_io.cpp): a failure
 // leaves the destination as it was and no temporary behind.
 //
 // Materials are written so that gilt's own loaders read them back as the same kind:
@@ -45,9 +45,9 @@
 #include <system_error>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::radiosity::bake {
 
@@ -56,8 +56,8 @@ using solver::Solution;
 
 namespace fs = std::filesystem;
 using rc::InputError;
-using rc::Material;
-using rc::StagedFile;
+using rc::scene::Material;
+using rc::util::StagedFile;
 
 // glTF buffers and binary PLY are little-endian; the buffers below are copied raw.
 static_assert(std::endian::native == std::endian::little, "mesh export assumes a little-endian host");
@@ -251,20 +251,20 @@ std::string encode_mtl(const std::vector<Material>& materials, const std::vector
     int illum = 1;
     float ns = 0.0f;
     switch (mat.kind) {
-      case rc::MaterialKind::diffuse:
+      case rc::scene::MaterialKind::diffuse:
         break;
-      case rc::MaterialKind::glossy:
+      case rc::scene::MaterialKind::glossy:
         illum = 2;
         ns = mat.exponent;
         break;
-      case rc::MaterialKind::mirror:
+      case rc::scene::MaterialKind::mirror:
         illum = 3;
         ns = 1000.0f;
         break;
-      case rc::MaterialKind::dielectric:
+      case rc::scene::MaterialKind::dielectric:
         illum = 7;
         break;
-      case rc::MaterialKind::metallic_roughness:  // Pr and Pm below; Ns the Phong equivalent of α
+      case rc::scene::MaterialKind::metallic_roughness:  // Pr and Pm below; Ns the Phong equivalent of α
         illum = 2;
         ns = std::clamp(2.0f / std::max(1e-6f, rc::sqr(rc::sqr(mat.roughness))) - 2.0f, 1.0f, 1e4f);
         break;
@@ -277,9 +277,10 @@ std::string encode_mtl(const std::vector<Material>& materials, const std::vector
     out += "\nNi";
     append_float(out, mat.ior);
     out += "\nd 1\n";
-    if (mat.kind == rc::MaterialKind::dielectric) append_line(out, "Tf", rc::exp(mat.absorption * -1.0f));
+    if (mat.kind == rc::scene::MaterialKind::dielectric)
+      append_line(out, "Tf", rc::exp(mat.absorption * -1.0f));
     append_line(out, "Ke", mat.emission);
-    if (mat.kind == rc::MaterialKind::metallic_roughness) {
+    if (mat.kind == rc::scene::MaterialKind::metallic_roughness) {
       out += "Pr";
       append_float(out, mat.roughness);
       out += "\nPm";
@@ -365,7 +366,7 @@ tinygltf::Material gltf_material(const Material& m, const std::string& name, tin
   tinygltf::Material out;
   out.name = name;
   out.pbrMetallicRoughness.baseColorFactor = {m.albedo.r, m.albedo.g, m.albedo.b, 1.0};
-  const bool pbr = m.kind == rc::MaterialKind::metallic_roughness;
+  const bool pbr = m.kind == rc::scene::MaterialKind::metallic_roughness;
   out.pbrMetallicRoughness.metallicFactor = pbr ? m.metallic : 0.0;
   out.pbrMetallicRoughness.roughnessFactor = pbr ? m.roughness : 1.0;
   const auto use_extension = [&](const std::string& used) {
@@ -394,9 +395,10 @@ tinygltf::Material gltf_material(const Material& m, const std::string& name, tin
 }
 
 /// One mesh with one primitive per material; each primitive holds the vertices its elements use.
-std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const std::vector<Rgb>& colours,
-                        const std::vector<std::string>& names, const std::vector<std::vector<uint32_t>>& groups,
-                        const ExportSettings& settings, bool binary) {
+std::string encode_gltf(const rc::scene::Scene& scene, const RadiosityMesh& mesh,
+                        const std::vector<Rgb>& colours, const std::vector<std::string>& names,
+                        const std::vector<std::vector<uint32_t>>& groups, const ExportSettings& settings,
+                        bool binary) {
   const float scale = std::exp2(settings.exposure);
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -490,8 +492,8 @@ std::string encode_gltf(const rc::Scene& scene, const RadiosityMesh& mesh, const
 
 }  // namespace
 
-RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats,
-                               rc::Progress* progress) {
+RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats,
+                               rc::util::Progress* progress) {
   RadiosityMesh out = mesh;
   if (mesh.element_surface.size() != mesh.element_count() || mesh.element_normal.size() != mesh.element_count() ||
       mesh.normals.size() != mesh.vertex_count()) {
@@ -513,16 +515,16 @@ RadiosityMesh snapped_to_input(const rc::Scene& scene, const RadiosityMesh& mesh
     }
   }
   std::vector<float> moved(mesh.vertex_count(), -1.0f);
-  rc::parallel_for(mesh.vertex_count(), [&](size_t v) {
+  rc::util::parallel_for(mesh.vertex_count(), [&](size_t v) {
     if (progress) progress->advance(1);
-    std::optional<rc::Hit> best;
+    std::optional<rc::scene::Hit> best;
     for (uint8_t k = 0; k < count[v]; ++k) {
-      const std::optional<rc::Hit> h =
+      const std::optional<rc::scene::Hit> h =
           scene.nearest_triangle(surfaces[v][k], mesh.positions[v], best ? best->t : reach, mesh.normals[v], 0.5f);
       if (h && (!best || h->t < best->t)) best = h;
     }
     if (!best) return;
-    const rc::TriangleMesh& m = scene.meshes[best->geom_id];
+    const rc::scene::TriangleMesh& m = scene.meshes[best->geom_id];
     const uint32_t* c = &m.indices[3 * size_t(best->prim_id)];
     out.positions[v] = (1.0f - best->u - best->v) * m.positions[c[0]] + best->u * m.positions[c[1]] +
                        best->v * m.positions[c[2]];
@@ -666,7 +668,7 @@ WriteForecast onto_input_forecast(size_t input_triangles, int lightmap_size) {
   return {kWriteSeconds + kOntoSecondsPerTriangle * double(input_triangles) + kLightmapSecondsPerTexel * texels, 0.0};
 }
 
-void write_solution(const std::string& path, const rc::Scene& scene, const Solution& solution,
+void write_solution(const std::string& path, const rc::scene::Scene& scene, const Solution& solution,
                     const ExportSettings& settings, SnapStats* snap) {
   const fs::path destination(path);
   const Format format = format_of(destination);
@@ -677,7 +679,7 @@ void write_solution(const std::string& path, const rc::Scene& scene, const Solut
   require_folder(destination);
   // Vertices on the input's own surface: remeshing, contact imprints and repairs leave some a
   // little off it, and a viewer shows the model, not gilt's approximation of it.
-  rc::Progress snapping("export: snapping onto the input", solution.mesh.vertex_count(), "vertices", settings.progress);
+  rc::util::Progress snapping("export: snapping onto the input", solution.mesh.vertex_count(), "vertices", settings.progress);
   const RadiosityMesh mesh =
       without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap, &snapping), snap);
   check_mesh(mesh, scene.materials.size());

@@ -26,7 +26,7 @@ struct ExportSettings {
   bool linear_float = false;
   /// Display colours (PLY and OBJ by default, glTF COLOR_0) show the quantity × 2^exposure.
   float exposure = 0.0f;
-  bool progress = false;  ///< report snapping the vertices onto the input on stderr (rc::Progress)
+  bool progress = false;  ///< report snapping the vertices onto the input on stderr (rc::util::Progress)
 };
 
 /// Linear value to a display value: scaled, clamped to [0, 1], sRGB-encoded (IEC 61966-2-1).
@@ -64,8 +64,8 @@ struct SnapStats {
 /// with none keep their place, and so do the vertices of an element the moves would turn over
 /// (and every vertex of a mesh without element_surface and element_normal for each element).
 /// write_solution exports this. Advances `progress` (if any) by one per vertex.
-mesh::RadiosityMesh snapped_to_input(const rc::Scene& scene, const mesh::RadiosityMesh& mesh, float reach,
-                               SnapStats* stats = nullptr, rc::Progress* progress = nullptr);
+mesh::RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const mesh::RadiosityMesh& mesh, float reach,
+                               SnapStats* stats = nullptr, rc::util::Progress* progress = nullptr);
 
 /// The mesh without elements that repeat an earlier element: the same three corner positions (to
 /// the bit, after snapping) in the same turning order, so the same face facing the same way, which
@@ -86,7 +86,7 @@ mesh::RadiosityMesh without_coincident(const mesh::RadiosityMesh& mesh, SnapStat
 /// solution's target edge), then coincident elements dropped (without_coincident); `snap`
 /// receives what both did. Throws InputError for an unsupported
 /// extension or an unwritable destination.
-void write_solution(const std::string& path, const rc::Scene& scene, const solver::Solution& solution,
+void write_solution(const std::string& path, const rc::scene::Scene& scene, const solver::Solution& solution,
                     const ExportSettings& settings, SnapStats* snap = nullptr);
 
 /// What write_solution is foretold to take on a mesh of n elements: seconds + seconds_per_element

@@ -19,10 +19,10 @@
 #include "raytrace_core/io/gltf_file.h"
 
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::radiosity::bake {
 
@@ -91,7 +91,7 @@ bool triangles_overlap(const Vec2* a, const Vec2* b, float eps) {
 }
 
 /// Grows the charts of one mesh.
-void grow_charts(const rc::TriangleMesh& mesh, uint32_t mesh_index, std::vector<Chart>& charts) {
+void grow_charts(const rc::scene::TriangleMesh& mesh, uint32_t mesh_index, std::vector<Chart>& charts) {
   const size_t faces = mesh.triangle_count();
   if (faces == 0) return;
   const std::vector<uint32_t> id = weld(mesh.positions);
@@ -306,8 +306,8 @@ struct InputUvs {
 
 /// Vertex UVs of a glTF primitive's TEXCOORD_<set> (float, or normalized unsigned byte or
 /// short); empty when it has none or they do not match the mesh's vertices.
-std::vector<Vec2> gltf_uvs(const tinygltf::Model& model, const rc::TriangleMesh& mesh, int set) {
-  const rc::MeshOrigin& o = mesh.origin;
+std::vector<Vec2> gltf_uvs(const tinygltf::Model& model, const rc::scene::TriangleMesh& mesh, int set) {
+  const rc::scene::MeshOrigin& o = mesh.origin;
   if (o.mesh < 0 || size_t(o.mesh) >= model.meshes.size() ||
       size_t(o.primitive) >= model.meshes[size_t(o.mesh)].primitives.size())
     return {};
@@ -352,12 +352,12 @@ std::vector<Vec2> gltf_uvs(const tinygltf::Model& model, const rc::TriangleMesh&
 /// area flattened to none, and no two faces on the same texels (texel centres inside two faces,
 /// at the atlas's size, beyond 0.1 % of those covered: touching charts share a few by rounding).
 /// Returns an empty string when it can, else why not.
-std::string check_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked,
+std::string check_uv_set(const rc::scene::Scene& scene, const std::vector<uint32_t>& baked,
                          const std::vector<std::vector<Vec2>>& corner_uv, int size) {
   std::vector<uint32_t> claimed(size_t(size) * size_t(size), 0);
   size_t covered = 0, shared = 0;
   for (uint32_t m : baked) {
-    const rc::TriangleMesh& mesh = scene.meshes[m];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
     for (size_t f = 0; f < mesh.triangle_count(); ++f) {
       const Vec2* c = &corner_uv[m][3 * f];
       Vec2 t[3];
@@ -392,15 +392,15 @@ std::string check_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& ba
   return {};
 }
 
-InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked, int size) {
+InputUvs input_uv_set(const rc::scene::Scene& scene, const std::vector<uint32_t>& baked, int size) {
   InputUvs out;
   const std::string& file = scene.model_files.at(size_t(scene.meshes[baked[0]].origin.file));
-  const std::string ext = rc::lower_extension(file);
+  const std::string ext = rc::io::lower_extension(file);
   std::vector<std::string> reasons;
-  const auto try_set = [&](int set, const std::function<std::vector<Vec2>(const rc::TriangleMesh&)>& vertex_uvs) {
+  const auto try_set = [&](int set, const std::function<std::vector<Vec2>(const rc::scene::TriangleMesh&)>& vertex_uvs) {
     std::vector<std::vector<Vec2>> corner(scene.meshes.size());
     for (uint32_t m : baked) {
-      const rc::TriangleMesh& mesh = scene.meshes[m];
+      const rc::scene::TriangleMesh& mesh = scene.meshes[m];
       const std::vector<Vec2> uv = vertex_uvs(mesh);
       if (uv.size() != mesh.positions.size()) {
         reasons.push_back("set " + std::to_string(set) + ": not on every mesh");
@@ -418,7 +418,7 @@ InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked
     return true;
   };
   if (ext == ".gltf" || ext == ".glb") {
-    const tinygltf::Model model = rc::read_gltf_file(file);
+    const tinygltf::Model model = rc::io::read_gltf_file(file);
     // A mesh placed by several nodes shares its UVs between its instances, which are lit
     // differently: the input's sets cannot hold them all.
     std::map<int32_t, std::set<int32_t>> nodes_of_mesh;
@@ -429,10 +429,11 @@ InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked
       reasons.push_back("a mesh is placed by several nodes, and each instance needs its own texels");
     } else {
       for (int set : {1, 0})
-        if (try_set(set, [&](const rc::TriangleMesh& mesh) { return gltf_uvs(model, mesh, set); })) break;
+        if (try_set(set, [&](const rc::scene::TriangleMesh& mesh) { return gltf_uvs(model, mesh, set); }))
+          break;
     }
   } else {  // OBJ and PLY: one set, v counted up from the bottom
-    try_set(0, [](const rc::TriangleMesh& mesh) {
+    try_set(0, [](const rc::scene::TriangleMesh& mesh) {
       std::vector<Vec2> uv;
       for (const Vec2& t : mesh.uvs) uv.emplace_back(t.x, 1.0f - t.y);
       return uv;
@@ -453,11 +454,11 @@ InputUvs input_uv_set(const rc::Scene& scene, const std::vector<uint32_t>& baked
 /// gilt's own charts over the baked meshes, packed into a size × size atlas at the highest
 /// density that fits (returned in `density`, texels per scene unit). Throws InputError when the
 /// charts do not fit even at one texel each.
-std::vector<Chart> lay_out_charts(const rc::Scene& scene, const std::vector<uint32_t>& baked_meshes, int size,
-                                  double& density) {
+std::vector<Chart> lay_out_charts(const rc::scene::Scene& scene, const std::vector<uint32_t>& baked_meshes,
+                                  int size, double& density) {
   std::vector<Chart> charts;
   for (uint32_t m : baked_meshes) grow_charts(scene.meshes[m], m, charts);
-  rc::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
+  rc::util::parallel_for(charts.size(), [&](size_t c) { fit_rectangle(charts[c]); });
   std::stable_sort(charts.begin(), charts.end(), [](const Chart& a, const Chart& b) { return a.extent.y > b.extent.y; });
   double chart_area = 0.0;
   for (const Chart& c : charts) chart_area += double(c.extent.x) * double(c.extent.y);
@@ -483,7 +484,7 @@ std::vector<Chart> lay_out_charts(const rc::Scene& scene, const std::vector<uint
 }
 
 /// The meshes of the scene's model file that a lightmap bakes: all but mirrors and glass.
-std::vector<uint32_t> lightmap_meshes(const rc::Scene& scene) {
+std::vector<uint32_t> lightmap_meshes(const rc::scene::Scene& scene) {
   const int32_t file = onto_input_file(scene);
   std::vector<uint32_t> baked;
   for (uint32_t m = 0; m < scene.meshes.size(); ++m)
@@ -509,7 +510,7 @@ Rgb Lightmap::at(size_t mesh, size_t face, float u, float v) const {
          (texel(x0, y0 + 1) * (1.0f - fx) + texel(x0 + 1, y0 + 1) * fx) * fy;
 }
 
-void check_lightmap_layout(const rc::Scene& scene, int size) {
+void check_lightmap_layout(const rc::scene::Scene& scene, int size) {
   if (size < 16 || size > 16384)
     throw InputError("--lightmap " + std::to_string(size) + ": the atlas's size must be 16 to 16384 texels");
   const std::vector<uint32_t> baked = lightmap_meshes(scene);
@@ -536,12 +537,12 @@ struct TexelOwner {
 
 /// Reads the scene; writes out.corner_uv and the layout's statistics: the input's own UV set where
 /// it can hold a lightmap, else charts of gilt's own. Returns the groups and the buried faces.
-LightmapLayout lay_out_lightmap(const rc::Scene& scene, int size, Lightmap& out) {
+LightmapLayout lay_out_lightmap(const rc::scene::Scene& scene, int size, Lightmap& out) {
   LightmapLayout layout;
   const std::vector<uint32_t> baked_meshes = lightmap_meshes(scene);
   layout.buried.resize(scene.meshes.size());
   for (uint32_t m : baked_meshes) {
-    const rc::TriangleMesh& mesh = scene.meshes[m];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
     out.stats.faces += mesh.triangle_count();
     layout.buried[m] = input_faces_buried(scene, mesh.positions, mesh.indices);
     for (char b : layout.buried[m]) out.stats.buried_faces += size_t(b);
@@ -607,7 +608,7 @@ std::vector<TexelOwner> rasterise_owners(const LightmapLayout& layout, const Lig
   if (layout.one_group) {
     for (size_t g = 0; g < layout.groups.size(); ++g) rasterise(g);
   } else {
-    rc::parallel_for(layout.groups.size(), rasterise);
+    rc::util::parallel_for(layout.groups.size(), rasterise);
   }
   return owner;
 }
@@ -615,23 +616,23 @@ std::vector<TexelOwner> rasterise_owners(const LightmapLayout& layout, const Lig
 /// Reads the owners and out.corner_uv; writes out.image: each owned texel the mean of the solution
 /// at four points of its footprint, clamped onto its face. Returns which texels were filled.
 /// `report`: show the rows filled on stderr.
-std::vector<char> fill_texels(const rc::Scene& scene, const SolutionAtInput& at_input,
+std::vector<char> fill_texels(const rc::scene::Scene& scene, const SolutionAtInput& at_input,
                               const std::vector<TexelOwner>& owner, Lightmap& out, bool report) {
   const int size = out.size;
   std::vector<char> filled(owner.size(), 0);
-  rc::Progress progress("bake: lightmap", size_t(size), "rows", report);
-  rc::parallel_for(size_t(size), [&](size_t y) {
+  rc::util::Progress progress("bake: lightmap", size_t(size), "rows", report);
+  rc::util::parallel_for(size_t(size), [&](size_t y) {
     progress.advance(1);
     for (size_t x = 0; x < size_t(size); ++x) {
       const TexelOwner& o = owner[y * size_t(size) + x];
       if (o.mesh == UINT32_MAX) continue;
-      const rc::TriangleMesh& mesh = scene.meshes[o.mesh];
+      const rc::scene::TriangleMesh& mesh = scene.meshes[o.mesh];
       const std::vector<Vec2>& uv = out.corner_uv[o.mesh];
       const Vec2 t[3] = {uv[3 * o.face] * float(size), uv[3 * o.face + 1] * float(size), uv[3 * o.face + 2] * float(size)};
       const Vec3 &p0 = mesh.positions[mesh.indices[3 * o.face]], &p1 = mesh.positions[mesh.indices[3 * o.face + 1]],
                  &p2 = mesh.positions[mesh.indices[3 * o.face + 2]];
       const Vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-      const rc::Material& material = scene.materials[mesh.material];
+      const rc::scene::Material& material = scene.materials[mesh.material];
       Rgb sum(0.0f);
       int count = 0;
       for (int s = 0; s < 4; ++s) {
@@ -655,7 +656,7 @@ void pad_border(std::vector<char>& filled, Lightmap& out) {
   for (int round = 0; round < kLightmapPad; ++round) {
     std::vector<char> next = filled;
     std::vector<Rgb> pixels = out.image.pixels;
-    rc::parallel_for(size_t(size), [&](size_t y) {
+    rc::util::parallel_for(size_t(size), [&](size_t y) {
       for (size_t x = 0; x < size_t(size); ++x) {
         if (filled[y * size_t(size) + x]) continue;
         Rgb sum(0.0f);
@@ -679,7 +680,7 @@ void pad_border(std::vector<char>& filled, Lightmap& out) {
 
 }  // namespace
 
-Lightmap bake_lightmap(const rc::Scene& scene, const Solution& solution, Quantity quantity, int size,
+Lightmap bake_lightmap(const rc::scene::Scene& scene, const Solution& solution, Quantity quantity, int size,
                        BakeGather gather) {
   if (size < 16 || size > 16384)
     throw InputError("--lightmap " + std::to_string(size) + ": the atlas's size must be 16 to 16384 texels");

@@ -31,7 +31,7 @@
 #include "radiosity/bake/export.h"
 #include "radiosity/bake/onto_input.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 
 namespace gilt::radiosity::bake {
 
@@ -58,7 +58,7 @@ struct Lightmap {
   /// Per scene mesh: the atlas UV of each face corner (three per face, in index order), u to the
   /// right and v down from the image's top-left as glTF has it; empty for meshes not baked.
   std::vector<std::vector<rc::Vec2>> corner_uv;
-  rc::Image image;  ///< size × size, the quantity itself (HDR, linear)
+  rc::util::Image image;  ///< size × size, the quantity itself (HDR, linear)
   LightmapStats stats;
 
   /// The atlas read bilinearly at face `face` of scene mesh `mesh`, at barycentrics (u, v) of its
@@ -69,18 +69,18 @@ struct Lightmap {
 /// Lays out and bakes a size × size lightmap of the solution's `quantity` over the non-specular
 /// meshes read from the scene's model file (onto_input_file). Throws InputError when size is
 /// outside 16..16384.
-Lightmap bake_lightmap(const rc::Scene& scene, const solver::Solution& solution, Quantity quantity, int size,
-                       BakeGather gather = {});
+Lightmap bake_lightmap(const rc::scene::Scene& scene, const solver::Solution& solution, Quantity quantity,
+                       int size, BakeGather gather = {});
 
 /// Throws InputError when bake_lightmap could not lay out a size × size atlas for the scene
 /// (size outside 16..16384, nothing to bake, more charts than fit): called before solving.
-void check_lightmap_layout(const rc::Scene& scene, int size);
+void check_lightmap_layout(const rc::scene::Scene& scene, int size);
 
 /// The atlas's file for a model output: `<folder>/<stem>_lightmap.exr`.
 std::string lightmap_image_path(const std::string& model_output);
 
 /// Throws InputError unless write_lightmap can write `path` for the scene (called before solving).
-void check_lightmap_output(const std::string& path, const rc::Scene& scene);
+void check_lightmap_output(const std::string& path, const rc::scene::Scene& scene);
 
 /// Writes the atlas (lightmap_image_path, half float) and the model:
 /// - glTF in, glTF out, in the input's own UV set: the input unchanged but for the extras;
@@ -91,7 +91,7 @@ void check_lightmap_output(const std::string& path, const rc::Scene& scene);
 ///   quantity, exposure};
 /// - OBJ or PLY in: a glTF (.gltf or .glb) of the meshes as read (OBJ and PLY hold one UV set),
 ///   TEXCOORD_0 the input's own UVs where it has them, the lightmap's UV set after it.
-void write_lightmap(const std::string& path, const rc::Scene& scene, const Lightmap& lightmap,
+void write_lightmap(const std::string& path, const rc::scene::Scene& scene, const Lightmap& lightmap,
                     const ExportSettings& settings);
 
 }  // namespace gilt::radiosity::bake

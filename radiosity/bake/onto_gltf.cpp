@@ -25,9 +25,9 @@
 
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::radiosity::bake {
 
@@ -66,7 +66,7 @@ GltfFile read_gltf_file(const std::string& path) {
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   GltfFile file;
   std::string json_text = bytes;
-  if (rc::lower_extension(path) == ".glb") {
+  if (rc::io::lower_extension(path) == ".glb") {
     if (bytes.size() < 20 || read_u32(bytes, 0) != kGlbMagic || read_u32(bytes, 4) != 2)
       throw InputError(path + ": not a GLB 2.0 file");
     const size_t total = std::min<size_t>(read_u32(bytes, 8), bytes.size());
@@ -207,7 +207,7 @@ void pack_into_binary_chunk(GltfFile& file, const fs::path& in_folder, const std
     if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
     const std::string uri = image["uri"];
     if (!is_relative_uri(uri)) continue;
-    const std::string ext = rc::lower_extension(percent_decode(uri));
+    const std::string ext = rc::io::lower_extension(percent_decode(uri));
     const char* mime = ext == ".png"                      ? "image/png"
                        : ext == ".jpg" || ext == ".jpeg" ? "image/jpeg"
                        : ext == ".webp"                  ? "image/webp"
@@ -262,7 +262,7 @@ GltfOutput begin_output(const std::string& input, const std::string& output) {
   GltfOutput o;
   o.input = input;
   o.file = read_gltf_file(input);
-  o.glb = rc::lower_extension(output) == ".glb";
+  o.glb = rc::io::lower_extension(output) == ".glb";
   o.out_path = fs::absolute(output).lexically_normal();
   const fs::path in_folder = fs::absolute(input).lexically_normal().parent_path();
   if (o.glb) pack_into_binary_chunk(o.file, in_folder, input);
@@ -275,13 +275,13 @@ GltfOutput begin_output(const std::string& input, const std::string& output) {
 /// The scene meshes `covered` selects, by the node that placed them; a glTF mesh placed by
 /// several of those nodes is copied so that each node has its own (each instance is lit
 /// differently), and the copy's index is returned for each node.
-std::map<int32_t, std::vector<size_t>> split_instances(Json& j, const rc::Scene& scene, int32_t file,
+std::map<int32_t, std::vector<size_t>> split_instances(Json& j, const rc::scene::Scene& scene, int32_t file,
                                                        const std::function<bool(size_t)>& covered,
                                                        std::map<int32_t, int32_t>& mesh_of_node) {
   std::map<int32_t, std::vector<size_t>> scene_meshes_of_node;
   std::map<int32_t, std::vector<int32_t>> nodes_of_mesh;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const rc::MeshOrigin& o = scene.meshes[m].origin;
+    const rc::scene::MeshOrigin& o = scene.meshes[m].origin;
     if (o.file != file || !covered(m)) continue;
     auto& list = scene_meshes_of_node[o.node];
     if (list.empty()) {
@@ -323,7 +323,7 @@ void finish_output(GltfOutput& o, const std::string& output) {
   GltfFile& file = o.file;
   const std::vector<fs::path>& input_files = o.input_files;
   if (data.empty() && !extend_bin && !glb_out) {  // nothing new to store (a lightmap in the input's UVs)
-    rc::StagedFile(out_path, j.dump(2) + "\n").commit();
+    rc::util::StagedFile(out_path, j.dump(2) + "\n").commit();
     return;
   }
   size_t buffer_index = 0;
@@ -379,10 +379,10 @@ void finish_output(GltfOutput& o, const std::string& output) {
     append_u32(out, uint32_t(bin.size()));
     append_u32(out, kChunkBin);
     out += bin;
-    rc::StagedFile(out_path, out).commit();
+    rc::util::StagedFile(out_path, out).commit();
   } else {
-    rc::StagedFile bin_file(sidecar, bin);
-    rc::StagedFile gltf_file(out_path, j.dump(2) + "\n");
+    rc::util::StagedFile bin_file(sidecar, bin);
+    rc::util::StagedFile gltf_file(out_path, j.dump(2) + "\n");
     bin_file.commit();  // the .bin first: the .gltf never names a buffer that is not there
     gltf_file.commit();
   }
@@ -390,7 +390,7 @@ void finish_output(GltfOutput& o, const std::string& output) {
 
 }  // namespace
 
-void write_onto_gltf(const std::string& input, const std::string& output, const rc::Scene& scene,
+void write_onto_gltf(const std::string& input, const std::string& output, const rc::scene::Scene& scene,
                      const InputColours& colours, const ExportSettings& settings) {
   GltfOutput o = begin_output(input, output);
   Json& j = o.json();
@@ -526,9 +526,9 @@ Json& material_for(Json& j, Json& primitive) {
   return materials[size_t(primitive["material"].get<int64_t>())];
 }
 
-void write_lightmap_gltf(const std::string& input, const std::string& output, const rc::Scene& scene,
+void write_lightmap_gltf(const std::string& input, const std::string& output, const rc::scene::Scene& scene,
                          const Lightmap& lightmap, const ExportSettings& settings, const std::string& image_uri) {
-  const tinygltf::Model model = rc::read_gltf_file(input);
+  const tinygltf::Model model = rc::io::read_gltf_file(input);
   GltfOutput o = begin_output(input, output);
   Json& j = o.json();
   std::map<int32_t, int32_t> mesh_of_node;
@@ -539,7 +539,7 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
   for (const auto& [node, list] : scene_meshes_of_node) {
     Json& primitives = meshes[size_t(mesh_of_node.at(node))]["primitives"];
     for (size_t m : list) {
-      const rc::TriangleMesh& mesh = scene.meshes[m];
+      const rc::scene::TriangleMesh& mesh = scene.meshes[m];
       Json& primitive = primitives[size_t(mesh.origin.primitive)];
       const std::string what = input + ": mesh " + std::to_string(mesh.origin.mesh) + " primitive " +
                                std::to_string(mesh.origin.primitive);
@@ -617,10 +617,11 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
 }
 
 /// OBJ or PLY in: a new glTF of the meshes as read.
-void write_lightmap_converted(const std::string& output, const rc::Scene& scene, const Lightmap& lightmap,
-                              const ExportSettings& settings, const std::string& image_uri) {
+void write_lightmap_converted(const std::string& output, const rc::scene::Scene& scene,
+                              const Lightmap& lightmap, const ExportSettings& settings,
+                              const std::string& image_uri) {
   GltfOutput o;
-  o.glb = rc::lower_extension(output) == ".glb";
+  o.glb = rc::io::lower_extension(output) == ".glb";
   o.out_path = fs::absolute(output).lexically_normal();
   Json& j = o.json();
   const std::string& input = scene.model_files[size_t(lightmap.file)];
@@ -637,7 +638,7 @@ void write_lightmap_converted(const std::string& output, const rc::Scene& scene,
   bool emissive_strength = false;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     if (lightmap.corner_uv[m].empty()) continue;
-    const rc::TriangleMesh& mesh = scene.meshes[m];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
     const UvSplit split = split_by_uv(mesh.indices, lightmap.corner_uv[m]);
     Json primitive = {{"attributes", Json::object()}};
     std::string positions(split.xref.size() * 12, '\0');
@@ -666,7 +667,7 @@ void write_lightmap_converted(const std::string& output, const rc::Scene& scene,
     primitive["extras"]["gilt_lightmap"] = extras;
     auto [it, added] = material_index.try_emplace(mesh.material, j["materials"].size());
     if (added) {
-      const rc::Material& mat = scene.materials[mesh.material];
+      const rc::scene::Material& mat = scene.materials[mesh.material];
       Json material = {{"name", mat.name.empty() ? "material " + std::to_string(mesh.material) : mat.name},
                        {"pbrMetallicRoughness",
                         {{"baseColorFactor", {mat.albedo.r, mat.albedo.g, mat.albedo.b, 1.0f}},
@@ -695,9 +696,9 @@ void write_lightmap_converted(const std::string& output, const rc::Scene& scene,
 
 }  // namespace
 
-void check_lightmap_output(const std::string& path, const rc::Scene& scene) {
+void check_lightmap_output(const std::string& path, const rc::scene::Scene& scene) {
   const std::string& input = scene.model_files[size_t(onto_input_file(scene))];
-  const std::string out_ext = rc::lower_extension(path);
+  const std::string out_ext = rc::io::lower_extension(path);
   if (out_ext != ".gltf" && out_ext != ".glb")
     throw InputError("-o " + path + ": --lightmap writes glTF (.gltf or .glb), whose second UV set holds the " +
                      "lightmap's; the input is " + input);
@@ -710,14 +711,14 @@ void check_lightmap_output(const std::string& path, const rc::Scene& scene) {
   if (!fs::is_directory(folder, ec)) throw InputError("-o " + path + ": folder " + folder.string() + " does not exist");
 }
 
-void write_lightmap(const std::string& path, const rc::Scene& scene, const Lightmap& lightmap,
+void write_lightmap(const std::string& path, const rc::scene::Scene& scene, const Lightmap& lightmap,
                     const ExportSettings& settings) {
   check_lightmap_output(path, scene);
   const std::string& input = scene.model_files[size_t(lightmap.file)];
   const std::string image = lightmap_image_path(path);
-  rc::write_image(image, lightmap.image, 0.0f, /*half_float=*/true);
+  rc::util::write_image(image, lightmap.image, 0.0f, /*half_float=*/true);
   const std::string uri = fs::path(image).filename().string();
-  const std::string in_ext = rc::lower_extension(input);
+  const std::string in_ext = rc::io::lower_extension(input);
   if (in_ext == ".gltf" || in_ext == ".glb")
     write_lightmap_gltf(input, path, scene, lightmap, settings, uri);
   else

@@ -9,12 +9,12 @@
 
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/progress.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 
 namespace gilt::radiosity::bake {
@@ -27,7 +27,7 @@ using solver::Solution;
 namespace fs = std::filesystem;
 using rc::InputError;
 
-int32_t onto_input_file(const rc::Scene& scene) {
+int32_t onto_input_file(const rc::scene::Scene& scene) {
   if (scene.model_files.empty())
     throw InputError("--onto input writes onto the model file the scene was read from, and " + scene.name +
                      " has none (a built-in scene, or a JSON scene of spheres only): use --onto elements");
@@ -41,7 +41,7 @@ int32_t onto_input_file(const rc::Scene& scene) {
   return 0;
 }
 
-SolutionAtInput::SolutionAtInput(const rc::Scene& scene, const Solution& solution, Quantity quantity,
+SolutionAtInput::SolutionAtInput(const rc::scene::Scene& scene, const Solution& solution, Quantity quantity,
                                  BakeGather gather)
     : scene_(scene), solution_(solution), view_(scene, solution, ViewMode::mesh, /*ambient=*/false),
       quantity_(quantity), gather_(gather) {
@@ -49,16 +49,17 @@ SolutionAtInput::SolutionAtInput(const rc::Scene& scene, const Solution& solutio
   // so a sun patch or a sharp shadow falls as it does on the input's faces, not as the elements'
   // vertices caught it; the rest (sky, emitting surfaces, interreflection) is the solution's,
   // interpolated over the nearest element facing the same way.
-  for (const rc::Light& l : scene.punctual_lights)
-    if (l.kind != rc::LightKind::environment) delta_lights_.push_back(&l);
+  for (const rc::scene::Light& l : scene.punctual_lights)
+    if (l.kind != rc::scene::LightKind::environment) delta_lights_.push_back(&l);
   exact_direct_ = !delta_lights_.empty() && solution.vertex_punctual.size() == solution.mesh.vertex_count();
 }
 
-std::optional<Rgb> SolutionAtInput::operator()(const rc::Material& m, const Vec3& p, const Vec3& n) const {
+std::optional<Rgb> SolutionAtInput::operator()(const rc::scene::Material& m, const Vec3& p,
+                                               const Vec3& n) const {
   const std::optional<RadiosityView::Location> at = view_.locate(p, n);
   if (!at) return std::nullopt;
   const Rgb e = gather_.rays > 0 && std::chrono::steady_clock::now() < gather_.deadline ? gathered(p, n) : read(*at, p, n);
-  const Rgb radiosity = m.emission * rc::kPi + rc::diffuse_reflectance(m) * e;
+  const Rgb radiosity = m.emission * rc::kPi + rc::scene::diffuse_reflectance(m) * e;
   return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
 }
 
@@ -66,9 +67,11 @@ Rgb SolutionAtInput::gathered(const Vec3& p, const Vec3& n) const {
   ++gathered_;
   // The point's own sampler, keyed by its position and normal: the same for any thread order.
   const auto bits = [](float x) { return uint64_t(std::bit_cast<uint32_t>(x)); };
-  const uint64_t key = rc::mix64(bits(p.x) | bits(p.y) << 32) ^ rc::mix64(bits(p.z) | bits(n.x) << 32);
-  const uint64_t point = key ^ rc::mix64(bits(n.y) | bits(n.z) << 32);
-  rc::SampleContext ctx{rc::Sampler::for_pixel_sample(rc::SamplerKind::sobol, gather_.seed, point, 0), 0};
+  const uint64_t key =
+      rc::util::mix64(bits(p.x) | bits(p.y) << 32) ^ rc::util::mix64(bits(p.z) | bits(n.x) << 32);
+  const uint64_t point = key ^ rc::util::mix64(bits(n.y) | bits(n.z) << 32);
+  rc::render::SampleContext ctx{
+      rc::render::Sampler::for_pixel_sample(rc::render::SamplerKind::sobol, gather_.seed, point, 0), 0};
   return view_.gathered_irradiance(mesh_surface_point(p, n), gather_.rays, ctx);
 }
 
@@ -81,9 +84,9 @@ Rgb SolutionAtInput::read(const RadiosityView::Location& at, const Vec3& p, cons
   Rgb e = interpolate(solution_.vertex_irradiance);
   if (exact_direct_) {
     e = rc::clamp(e - interpolate(solution_.vertex_punctual), 0.0f, std::numeric_limits<float>::max());
-    const rc::SurfacePoint sp = mesh_surface_point(p, n);
-    for (const rc::Light* light : delta_lights_) {
-      const rc::LightSample ls = rc::sample_light(scene_, *light, sp, rc::Vec2(0.5f));
+    const rc::scene::SurfacePoint sp = mesh_surface_point(p, n);
+    for (const rc::scene::Light* light : delta_lights_) {
+      const rc::scene::LightSample ls = rc::scene::sample_light(scene_, *light, sp, rc::Vec2(0.5f));
       const float cos_theta = glm::dot(ls.wi, n);
       if (cos_theta > 0.0f && !ls.radiance.is_black() && !scene_.occluded(ls.shadow_ray)) e += ls.radiance * cos_theta;
     }
@@ -91,27 +94,29 @@ Rgb SolutionAtInput::read(const RadiosityView::Location& at, const Vec3& p, cons
   return e;
 }
 
-std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec3> positions,
+std::vector<char> input_faces_buried(const rc::scene::Scene& scene, std::span<const Vec3> positions,
                                      std::span<const uint32_t> indices) {
   std::vector<char> buried(indices.size() / 3, 0);
-  rc::parallel_for(buried.size(), [&](size_t f) {
+  rc::util::parallel_for(buried.size(), [&](size_t f) {
     buried[f] = input_triangle_buried(scene, positions[indices[3 * f]], positions[indices[3 * f + 1]],
                                       positions[indices[3 * f + 2]]);
   });
   return buried;
 }
 
-InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity,
+InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity,
                                BakeGather gather) {
   const auto start = std::chrono::steady_clock::now();
   InputColours out;
   out.file = onto_input_file(scene);
-  const std::string ext = rc::lower_extension(scene.model_files[size_t(out.file)]);
+  const std::string ext = rc::io::lower_extension(scene.model_files[size_t(out.file)]);
   const bool per_file_vertex = ext == ".obj" || ext == ".ply";
   const float spacing = 0.5f * solution.mesh_report.max_edge;
   const SolutionAtInput at_input(scene, solution, quantity, gather);
-  const auto value = [&](const rc::Material& m, const Vec3& p, const Vec3& n) { return at_input(m, p, n); };
-  const auto baked = [&](const rc::TriangleMesh& mesh) {
+  const auto value = [&](const rc::scene::Material& m, const Vec3& p, const Vec3& n) {
+    return at_input(m, p, n);
+  };
+  const auto baked = [&](const rc::scene::TriangleMesh& mesh) {
     return mesh.origin.file == out.file && !scene.materials[mesh.material].is_traced_through();
   };
 
@@ -124,15 +129,15 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
   if (!per_file_vertex) {  // glTF: each primitive instance on its own
     out.per_mesh.resize(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
-      const rc::TriangleMesh& mesh = scene.meshes[m];
+      const rc::scene::TriangleMesh& mesh = scene.meshes[m];
       if (!baked(mesh)) continue;
-      const rc::Material& material = scene.materials[mesh.material];
+      const rc::scene::Material& material = scene.materials[mesh.material];
       const std::vector<char> buried = buried_faces(mesh.positions, mesh.indices);
       const SurfaceField field = [&](const Vec3& p, const Vec3& n, size_t face) -> std::optional<Rgb> {
         if (buried[face]) return std::nullopt;
         return value(material, p, n);
       };
-      rc::Progress progress("bake: onto " + mesh.name, fit == VertexFit::point ? mesh.positions.size() : mesh.triangle_count(),
+      rc::util::Progress progress("bake: onto " + mesh.name, fit == VertexFit::point ? mesh.positions.size() : mesh.triangle_count(),
                             fit == VertexFit::point ? "vertices" : "faces", gather.progress);
       out.per_mesh[m] = fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats, &progress);
     }
@@ -140,7 +145,7 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
     std::vector<Vec3> positions;
     std::vector<uint32_t> indices;
     std::vector<uint32_t> face_material;
-    for (const rc::TriangleMesh& mesh : scene.meshes) {
+    for (const rc::scene::TriangleMesh& mesh : scene.meshes) {
       if (mesh.origin.file != out.file) continue;
       const auto file_vertex = [&mesh](uint32_t v) { return mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]; };
       for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
@@ -159,7 +164,7 @@ InputColours fit_input_colours(const rc::Scene& scene, const Solution& solution,
       if (buried[face]) return std::nullopt;
       return value(scene.materials[face_material[face]], p, n);
     };
-    rc::Progress progress("bake: onto the input", fit == VertexFit::point ? positions.size() : indices.size() / 3,
+    rc::util::Progress progress("bake: onto the input", fit == VertexFit::point ? positions.size() : indices.size() / 3,
                           fit == VertexFit::point ? "vertices" : "faces", gather.progress);
     out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats, &progress);
   }
@@ -177,14 +182,14 @@ std::vector<float> vertex_disk_radius(const RadiosityMesh& mesh) {
   return radius;
 }
 
-std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const RadiosityMesh& mesh, size_t v,
-                                              const Vec3& offset, float radius) {
+std::optional<InputPoint> input_surface_under(const rc::scene::Scene& scene, const RadiosityMesh& mesh,
+                                              size_t v, const Vec3& offset, float radius) {
   const Vec3 n = mesh.normals[v];
-  const rc::Ray ray{mesh.positions[v] + offset + radius * n, -n, 2.0f * radius};
-  const std::optional<rc::Hit> hit = scene.intersect(ray);
+  const rc::scene::Ray ray{mesh.positions[v] + offset + radius * n, -n, 2.0f * radius};
+  const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
   if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &scene.materials[mesh.vertex_material[v]])
     return std::nullopt;
-  const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+  const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
   if (glm::dot(si.ng, n) < kSameSideOfCrease) return std::nullopt;
   return InputPoint{ray, si};
 }
@@ -192,7 +197,7 @@ std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const Radi
 /// How many points of a vertex's disk gather_at_vertices may draw per sample it takes.
 constexpr uint32_t kDiskAttempts = 16;
 
-Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, BakeGather gather,
+Solution gather_at_vertices(const rc::scene::Scene& scene, const Solution& solution, BakeGather gather,
                             BakeGatherCount* count) {
   Solution out = solution;
   const RadiosityMesh& mesh = solution.mesh;
@@ -200,8 +205,8 @@ Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, Ba
   const std::vector<float> radius = vertex_disk_radius(mesh);
   const int rays = std::max(gather.rays, 1);
   std::atomic<uint64_t> gathered{0}, late{0};
-  rc::Progress progress("bake: final gather", mesh.vertex_count(), "vertices", gather.progress);
-  rc::parallel_for(mesh.vertex_count(), [&](size_t v) {
+  rc::util::Progress progress("bake: final gather", mesh.vertex_count(), "vertices", gather.progress);
+  rc::util::parallel_for(mesh.vertex_count(), [&](size_t v) {
     progress.advance(1);
     if (std::chrono::steady_clock::now() >= gather.deadline) {
       ++late;
@@ -212,18 +217,19 @@ Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, Ba
     // face normal is a poor sample of the facets the disk holds, and a third of the points
     // under a remeshed vertex lie on facets turned more than 30° from it.
     const rc::Frame frame = rc::Frame::from_normal(mesh.normals[v]);
-    rc::SampleContext ctx{rc::Sampler::for_pixel_sample(rc::SamplerKind::sobol, gather.seed, v, 0), 0};
+    rc::render::SampleContext ctx{
+        rc::render::Sampler::for_pixel_sample(rc::render::SamplerKind::sobol, gather.seed, v, 0), 0};
     // Points that miss the input under the disk, or land past a crease, are drawn again, up to
     // kDiskAttempts per sample: a vertex at a crease or a silhouette may have a small share of
     // its disk on its side (under 10 % for some of the bunny's), and its N samples would
     // otherwise be a handful.
     const uint32_t attempts = uint32_t(rays) * kDiskAttempts;
-    const rc::Sampler::SubSamples samples = ctx.sampler.split(attempts);
+    const rc::render::Sampler::SubSamples samples = ctx.sampler.split(attempts);
     Rgb sum(0.0f);
     int taken = 0;
     for (uint32_t j = 0; j < attempts && taken < rays; ++j) {
-      rc::SampleContext sub{samples[j], 0};
-      const rc::Vec2 u = rc::sample_uniform_disk(sub.sampler.uniform2()) * radius[v];
+      rc::render::SampleContext sub{samples[j], 0};
+      const rc::Vec2 u = rc::util::sample_uniform_disk(sub.sampler.uniform2()) * radius[v];
       const std::optional<InputPoint> under =
           input_surface_under(scene, mesh, v, frame.to_world(Vec3(u.x, u.y, 0.0f)), radius[v]);
       if (!under) continue;
@@ -245,9 +251,9 @@ Solution gather_at_vertices(const rc::Scene& scene, const Solution& solution, Ba
   return out;
 }
 
-void check_onto_output(const std::string& path, const rc::Scene& scene) {
+void check_onto_output(const std::string& path, const rc::scene::Scene& scene) {
   const std::string& input = scene.model_files[size_t(onto_input_file(scene))];
-  const std::string in_ext = rc::lower_extension(input), out_ext = rc::lower_extension(path);
+  const std::string in_ext = rc::io::lower_extension(input), out_ext = rc::io::lower_extension(path);
   const bool in_gltf = in_ext == ".gltf" || in_ext == ".glb", out_gltf = out_ext == ".gltf" || out_ext == ".glb";
   std::error_code ec;
   if (fs::equivalent(input, path, ec))
@@ -257,15 +263,15 @@ void check_onto_output(const std::string& path, const rc::Scene& scene) {
                      (in_gltf ? " (use .gltf or .glb)" : " (use " + in_ext + ")"));
 }
 
-void write_onto_input(const std::string& path, const rc::Scene& scene, const InputColours& colours,
+void write_onto_input(const std::string& path, const rc::scene::Scene& scene, const InputColours& colours,
                       const ExportSettings& settings) {
   check_onto_output(path, scene);
   if (colours.file < 0 || size_t(colours.file) >= scene.model_files.size())
     throw std::logic_error("write_onto_input: no model file");
   const std::string& input = scene.model_files[size_t(colours.file)];
-  if (rc::lower_extension(input) == ".obj")
+  if (rc::io::lower_extension(input) == ".obj")
     write_onto_obj(input, path, colours, settings);
-  else if (rc::lower_extension(input) == ".ply")
+  else if (rc::io::lower_extension(input) == ".ply")
     write_onto_ply(input, path, colours, settings);
   else
     write_onto_gltf(input, path, scene, colours, settings);

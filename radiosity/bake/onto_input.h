@@ -42,7 +42,7 @@ struct BakeGather {
   int rays = 0;       ///< samples per point (one shadow ray and one gather ray each); 0: read the solution
   uint64_t seed = 0;
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
-  bool progress = false;  ///< report the bake's long loops on stderr (rc::Progress)
+  bool progress = false;  ///< report the bake's long loops on stderr (rc::util::Progress)
 };
 
 /// Points a bake evaluated, by how.
@@ -67,7 +67,7 @@ struct InputColours {
 
 /// The model file `--onto input` writes onto: the scene's only model file. Throws InputError
 /// when the scene was not read from one, or from several.
-int32_t onto_input_file(const rc::Scene& scene);
+int32_t onto_input_file(const rc::scene::Scene& scene);
 
 /// The solution's `quantity` at a point of the input model: irradiance read from the nearest
 /// element facing the same way (RadiosityView::locate), with the direct light of point, spot and
@@ -82,21 +82,21 @@ int32_t onto_input_file(const rc::Scene& scene);
 /// thread count.
 class SolutionAtInput {
  public:
-  SolutionAtInput(const rc::Scene& scene, const solver::Solution& solution, Quantity quantity, BakeGather gather = {});
-  std::optional<Rgb> operator()(const rc::Material& m, const Vec3& p, const Vec3& n) const;
+  SolutionAtInput(const rc::scene::Scene& scene, const solver::Solution& solution, Quantity quantity, BakeGather gather = {});
+  std::optional<Rgb> operator()(const rc::scene::Material& m, const Vec3& p, const Vec3& n) const;
   BakeGatherCount gather_count() const { return {gathered_.load(), late_.load()}; }
 
  private:
   Rgb gathered(const Vec3& p, const Vec3& n) const;
   Rgb read(const RadiosityView::Location& at, const Vec3& p, const Vec3& n) const;
 
-  const rc::Scene& scene_;
+  const rc::scene::Scene& scene_;
   const solver::Solution& solution_;
   RadiosityView view_;
   Quantity quantity_;
   BakeGather gather_;
   mutable std::atomic<uint64_t> gathered_{0}, late_{0};
-  std::vector<const rc::Light*> delta_lights_;
+  std::vector<const rc::scene::Light*> delta_lights_;
   bool exact_direct_ = false;
 };
 
@@ -104,7 +104,7 @@ class SolutionAtInput {
 /// closed solid or under an object standing on it (input_triangle_buried). Bakes leave those out:
 /// no one sees them, and the nearest element facing their way belongs to another surface. (On
 /// Šibenik such points made 98 % of the check's squared error.)
-std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec3> positions,
+std::vector<char> input_faces_buried(const rc::scene::Scene& scene, std::span<const Vec3> positions,
                                      std::span<const uint32_t> indices);
 
 /// Fits the solution's `quantity` onto the vertices of every non-specular mesh read from the
@@ -112,7 +112,7 @@ std::vector<char> input_faces_buried(const rc::Scene& scene, std::span<const Vec
 /// solution's target edge. Each point's irradiance E is turned into the quantity by its face's
 /// material (B = π·Le + ρ·E, L = B/π) before fitting, so a vertex shared by two materials gets
 /// the colour nearest both.
-InputColours fit_input_colours(const rc::Scene& scene, const solver::Solution& solution, VertexFit fit, Quantity quantity,
+InputColours fit_input_colours(const rc::scene::Scene& scene, const solver::Solution& solution, VertexFit fit, Quantity quantity,
                                BakeGather gather = {});
 
 /// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings), so a point of
@@ -127,10 +127,10 @@ std::vector<float> vertex_disk_radius(const mesh::RadiosityMesh& mesh);
 /// first input face a ray straight down the vertex normal meets, from `radius` above to `radius`
 /// below, when it has the vertex's material and faces its side of any crease. With the ray.
 struct InputPoint {
-  rc::Ray ray;
-  rc::SurfaceInteraction si;
+  rc::scene::Ray ray;
+  rc::scene::SurfaceInteraction si;
 };
-std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const mesh::RadiosityMesh& mesh, size_t v,
+std::optional<InputPoint> input_surface_under(const rc::scene::Scene& scene, const mesh::RadiosityMesh& mesh, size_t v,
                                               const Vec3& offset, float radius);
 
 /// `gilt radiosity --onto elements --bake-gather N`: the solution with each vertex's irradiance the
@@ -141,17 +141,17 @@ std::optional<InputPoint> input_surface_under(const rc::Scene& scene, const mesh
 /// remeshed surface's smoothed normals and coarser silhouette move shadows and facing; the gather
 /// sees the input itself. Vertices with no input surface under them keep the solve's value;
 /// vertex_direct and vertex_punctual stay the solve's. For exports and checks, not for a view.
-solver::Solution gather_at_vertices(const rc::Scene& scene, const solver::Solution& solution, BakeGather gather,
+solver::Solution gather_at_vertices(const rc::scene::Scene& scene, const solver::Solution& solution, BakeGather gather,
                             BakeGatherCount* count = nullptr);
 
 /// Throws InputError unless write_onto_input can write `path` for the scene: called before
 /// solving, so a mistyped output does not cost a solve.
-void check_onto_output(const std::string& path, const rc::Scene& scene);
+void check_onto_output(const std::string& path, const rc::scene::Scene& scene);
 
 /// Writes the model file with the colours added; the format follows the output's extension and
 /// must be the input's (.gltf and .glb are interchangeable). Throws InputError for a format
 /// that does not match, or an output that would overwrite an input file.
-void write_onto_input(const std::string& path, const rc::Scene& scene, const InputColours& colours,
+void write_onto_input(const std::string& path, const rc::scene::Scene& scene, const InputColours& colours,
                       const ExportSettings& settings);
 
 /// OBJ writer behind write_onto_input (radiosity/bake/onto_obj.cpp): `v x y z r g b`, the quantity
@@ -168,7 +168,7 @@ void write_onto_ply(const std::string& input, const std::string& output, const I
                     const ExportSettings& settings);
 
 /// glTF writer behind write_onto_input (radiosity/bake/onto_gltf.cpp).
-void write_onto_gltf(const std::string& input, const std::string& output, const rc::Scene& scene,
+void write_onto_gltf(const std::string& input, const std::string& output, const rc::scene::Scene& scene,
                      const InputColours& colours, const ExportSettings& settings);
 
 }  // namespace gilt::radiosity::bake

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::radiosity::bake {
 
@@ -82,7 +82,7 @@ void write_onto_obj(const std::string& input, const std::string& output, const I
   }
   if (vertex < colours.per_file_vertex.size())
     throw std::logic_error("write_onto_obj: the file has fewer vertices than were read from it");
-  rc::StagedFile(output, out).commit();
+  rc::util::StagedFile(output, out).commit();
 }
 
 }  // namespace gilt::radiosity::bake

@@ -16,9 +16,9 @@
 #include <sstream>
 
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/ply_header.h"
-#include "raytrace_core/io/staged_file.h"
+#include "raytrace_core/util/staged_file.h"
 
 namespace gilt::radiosity::bake {
 
@@ -49,7 +49,7 @@ void append_float(std::string& out, float x, bool big_endian) {
 struct PlyRewrite {
   const std::string& input;
   std::string bytes;
-  rc::PlyHeader header;
+  rc::io::PlyHeader header;
   size_t body = 0;
   std::string quantity;
   float scale = 1.0f;
@@ -74,7 +74,7 @@ void rewrite_header(const PlyRewrite& ply, std::string& out) {
     for (const char* c : {"red", "green", "blue"}) out += "property float " + ply.quantity + "_" + c + "\n";
   };
   for (std::string line; std::getline(lines, line);) {
-    const std::vector<std::string> t = rc::tokens_of(line);
+    const std::vector<std::string> t = rc::io::tokens_of(line);
     if (!t.empty() && (t[0] == "element" || t[0] == "end_header") && element == "vertex") add_properties();
     if (!t.empty() && t[0] == "element") element = t.size() > 1 ? t[1] : "";
     if (!t.empty() && t[0] == "end_header") element.clear();
@@ -94,7 +94,7 @@ void rewrite_ascii_body(const PlyRewrite& ply, std::string& out) {
   const std::string& input = ply.input;
   std::istringstream lines(ply.bytes.substr(ply.body));
   std::string line;
-  for (const rc::PlyElement& e : ply.header.elements)
+  for (const rc::io::PlyElement& e : ply.header.elements)
     for (size_t item = 0; item < e.count; ++item) {
       do {
         if (!std::getline(lines, line)) throw InputError(input + ": " + e.name + " " + std::to_string(item) + ": the file ends early");
@@ -105,10 +105,10 @@ void rewrite_ascii_body(const PlyRewrite& ply, std::string& out) {
         out += '\n';
         continue;
       }
-      const std::vector<std::string> t = rc::tokens_of(line);
+      const std::vector<std::string> t = rc::io::tokens_of(line);
       size_t at = 0;
       std::string kept;
-      for (const rc::PlyProperty& p : e.properties) {
+      for (const rc::io::PlyProperty& p : e.properties) {
         size_t n = 1;
         if (!p.count_type.empty()) {
           if (at >= t.size()) throw InputError(input + ": vertex " + std::to_string(item) + ": too few values");
@@ -143,23 +143,23 @@ void rewrite_binary_body(const PlyRewrite& ply, std::string& out) {
   const auto need = [&](size_t n, const std::string& what) {
     if (n > bytes.size() - at) throw InputError(ply.input + ": " + what + ": the file ends early");
   };
-  for (const rc::PlyElement& e : ply.header.elements)
+  for (const rc::io::PlyElement& e : ply.header.elements)
     for (size_t item = 0; item < e.count; ++item) {
       const std::string what = e.name + " " + std::to_string(item);
       const size_t start = at;
-      for (const rc::PlyProperty& p : e.properties) {
+      for (const rc::io::PlyProperty& p : e.properties) {
         const size_t first = at;
         if (!p.count_type.empty()) {
-          const size_t count_size = rc::type_size(p.count_type);
+          const size_t count_size = rc::io::type_size(p.count_type);
           need(count_size, what);
           const uint64_t n = read_count(bytes, at, count_size, big);
           at += count_size;
-          const size_t item_size = rc::type_size(p.type);
+          const size_t item_size = rc::io::type_size(p.type);
           if (n > (bytes.size() - at) / item_size) throw InputError(ply.input + ": " + what + ": the file ends early");
           at += size_t(n) * item_size;
         } else {
-          need(rc::type_size(p.type), what);
-          at += rc::type_size(p.type);
+          need(rc::io::type_size(p.type), what);
+          at += rc::io::type_size(p.type);
         }
         if (e.name == "vertex" && !ply.replaced(p.name)) out.append(bytes, first, at - first);
       }
@@ -183,7 +183,7 @@ void write_onto_ply(const std::string& input, const std::string& output, const I
   PlyRewrite ply{input, std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}, {}, 0,
                  to_string(settings.quantity), std::exp2(settings.exposure), colours};
   std::istringstream header_stream(ply.bytes);
-  ply.header = rc::read_header(header_stream, input);
+  ply.header = rc::io::read_header(header_stream, input);
   ply.body = size_t(header_stream.tellg());
   std::string out;
   rewrite_header(ply, out);
@@ -191,7 +191,7 @@ void write_onto_ply(const std::string& input, const std::string& output, const I
     rewrite_ascii_body(ply, out);
   else
     rewrite_binary_body(ply, out);
-  rc::StagedFile(output, out).commit();
+  rc::util::StagedFile(output, out).commit();
 }
 
 }  // namespace gilt::radiosity::bake

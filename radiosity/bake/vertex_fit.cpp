@@ -17,7 +17,7 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
 
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace gilt::radiosity::bake {
 
@@ -77,7 +77,7 @@ FaceTerms face_terms(const Vec3& p0, const Vec3& p1, const Vec3& p2, size_t face
 }
 
 std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
-                               const SurfaceField& field, FitStats& stats, rc::Progress* progress) {
+                               const SurfaceField& field, FitStats& stats, rc::util::Progress* progress) {
   // The vertex's normal: its faces' normals weighted by area.
   std::vector<Vec3> normal(positions.size(), Vec3(0.0f));
   std::vector<size_t> face_of(positions.size(), 0);  // the largest face around the vertex
@@ -96,7 +96,7 @@ std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const 
   }
   std::vector<Rgb> out(positions.size(), Rgb(0.0f));
   std::vector<uint8_t> missing(positions.size(), 0);
-  rc::parallel_for(positions.size(), [&](size_t v) {
+  rc::util::parallel_for(positions.size(), [&](size_t v) {
     const float len = glm::length(normal[v]);
     if (!(len > 0.0f)) return;  // no face uses it, or only degenerate ones
     const std::optional<Rgb> f = field(positions[v], normal[v] / len, face_of[v]);
@@ -115,14 +115,14 @@ std::vector<Rgb> point_colours(std::span<const Vec3> positions, std::span<const 
 
 std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
                                     const SurfaceField& field, VertexFit fit, float spacing, FitStats* stats,
-                                    rc::Progress* progress) {
+                                    rc::util::Progress* progress) {
   FitStats local;
   FitStats& st = stats ? *stats : local;
   if (fit == VertexFit::point) return point_colours(positions, indices, field, st, progress);
 
   const size_t faces = indices.size() / 3;
   std::vector<FaceTerms> terms(faces);
-  rc::parallel_for(faces, [&](size_t f) {
+  rc::util::parallel_for(faces, [&](size_t f) {
     terms[f] = face_terms(positions[indices[3 * f]], positions[indices[3 * f + 1]], positions[indices[3 * f + 2]], f,
                           field, spacing);
     if (progress) progress->advance(1);

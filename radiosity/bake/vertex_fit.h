@@ -15,9 +15,9 @@
 #include <span>
 #include <vector>
 
-#include "raytrace_core/math.h"
-#include "raytrace_core/progress.h"
-#include "raytrace_core/rgb.h"
+#include "raytrace_core/util/math.h"
+#include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/rgb.h"
 
 namespace gilt::radiosity {
 namespace rc = gilt::raytrace_core;
@@ -67,6 +67,6 @@ struct FitStats {
 /// Advances `progress` (if any) by one per face sampled (per vertex for VertexFit::point).
 std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
                                     const SurfaceField& field, VertexFit fit, float spacing,
-                                    FitStats* stats = nullptr, rc::Progress* progress = nullptr);
+                                    FitStats* stats = nullptr, rc::util::Progress* progress = nullptr);
 
 }  // namespace gilt::radiosity::bake

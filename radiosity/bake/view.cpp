@@ -12,9 +12,9 @@
 #include <cmath>
 
 #include "radiosity/mesh/element_scene.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::bake {
 
@@ -36,21 +36,21 @@ SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
 namespace {
 
 /// Beer–Lambert attenuation of the segment `ray` travelled inside a dielectric to reach `si`.
-void absorb(const rc::Material& m, const rc::SurfaceInteraction& si, const rc::Hit& hit, const rc::Ray& ray,
-            Rgb& beta) {
-  if (m.kind == rc::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
+void absorb(const rc::scene::Material& m, const rc::scene::SurfaceInteraction& si, const rc::scene::Hit& hit,
+            const rc::scene::Ray& ray, Rgb& beta) {
+  if (m.kind == rc::scene::MaterialKind::dielectric && !si.front_face && !m.absorption.is_black())
     beta *= rc::exp(m.absorption * (-hit.t * glm::length(ray.direction)));
 }
 
 /// Continues a path through the mirror or glass at si (outgoing direction wo in `frame`):
 /// multiplies beta by the sample's weight and replaces `ray`. False when the path ends there.
-bool scatter_specular(const rc::Material& m, const rc::SurfaceInteraction& si, const rc::Frame& frame, const Vec3& wo,
-                      rc::Sampler& sampler, Rgb& beta, rc::Ray& ray) {
+bool scatter_specular(const rc::scene::Material& m, const rc::scene::SurfaceInteraction& si, const rc::Frame& frame, const Vec3& wo,
+                      rc::render::Sampler& sampler, Rgb& beta, rc::scene::Ray& ray) {
   const float u_lobe = sampler.uniform();
-  const auto bs = rc::bsdf_sample(m, wo, u_lobe, sampler.uniform2());
+  const auto bs = rc::scene::bsdf_sample(m, wo, u_lobe, sampler.uniform2());
   if (!bs || !(bs->pdf > 0.0f)) return false;
   beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-  ray = rc::spawn_ray(si, frame.to_world(bs->wi));
+  ray = rc::scene::spawn_ray(si, frame.to_world(bs->wi));
   return true;
 }
 
@@ -78,14 +78,15 @@ constexpr int kNearBounces = 8;
 /// mesher splits vertices at sharper creases, so a steeper element belongs to another side).
 constexpr float kFacing = 0.5f;
 
-RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, ViewMode mode, bool ambient)
+RadiosityView::RadiosityView(const rc::scene::Scene& scene, const Solution& solution, ViewMode mode,
+                             bool ambient)
     : scene_(scene), mode_(mode), elements_(solution.mesh.elements) {
   const RadiosityMesh& mesh = solution.mesh;
   const size_t nv = mesh.vertex_count();
   vertex_radiance_.resize(nv);
   vertex_indirect_.resize(nv);
   for (size_t v = 0; v < nv; ++v) {
-    const Rgb rho = v < solution.vertex_albedo.size() ? solution.vertex_albedo[v] : rc::diffuse_reflectance(scene.materials[mesh.vertex_material[v]]);
+    const Rgb rho = v < solution.vertex_albedo.size() ? solution.vertex_albedo[v] : rc::scene::diffuse_reflectance(scene.materials[mesh.vertex_material[v]]);
     vertex_radiance_[v] = solution.vertex_radiance(v);
     if (ambient) vertex_radiance_[v] += rho * solution.ambient * (1.0f / rc::kPi);
     Rgb indirect = solution.vertex_irradiance[v] - solution.vertex_direct[v];
@@ -94,11 +95,11 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   }
   positions_ = mesh.positions;
   element_direct_ = solution.element_direct;
-  sky_by_gather_ = rc::sky_left_to_bsdf_sampling(scene);
-  for (const rc::Light& l : scene.lights())
-    if (rc::is_constant_environment(l)) constant_sky_ += l.radiance;
+  sky_by_gather_ = rc::render::sky_left_to_bsdf_sampling(scene);
+  for (const rc::scene::Light& l : scene.lights())
+    if (rc::scene::is_constant_environment(l)) constant_sky_ += l.radiance;
   has_specular_ = std::any_of(scene.materials.begin(), scene.materials.end(),
-                              [](const rc::Material& m) { return m.is_traced_through(); });
+                              [](const rc::scene::Material& m) { return m.is_traced_through(); });
   // An input point lies within about an element's size of the element that stands for it
   // (elements are chords of a curved input); twice the target edge leaves room for bisection
   // and for input faces kept as they were.
@@ -108,17 +109,17 @@ RadiosityView::RadiosityView(const rc::Scene& scene, const Solution& solution, V
   display_ = element_scene(scene, mesh);
 }
 
-Rgb RadiosityView::radiance(const rc::Ray& ray, rc::SampleContext& ctx) const {
+Rgb RadiosityView::radiance(const rc::scene::Ray& ray, rc::render::SampleContext& ctx) const {
   return mode_ == ViewMode::mesh ? mesh_radiance(ray, ctx) : two_pass_radiance(ray, ctx);
 }
 
 std::optional<RadiosityView::Location> RadiosityView::locate(const Vec3& p, const Vec3& n) const {
-  const std::optional<rc::Hit> near = display_.nearest_triangle(0, p, reach_, n, kFacing);
+  const std::optional<rc::scene::Hit> near = display_.nearest_triangle(0, p, reach_, n, kFacing);
   if (!near) return std::nullopt;
   return Location{near->prim_id, near->u, near->v, near->t};
 }
 
-std::optional<RadiosityView::Location> RadiosityView::locate_on(const rc::SurfacePoint& p, const Vec3& n) const {
+std::optional<RadiosityView::Location> RadiosityView::locate_on(const rc::scene::SurfacePoint& p, const Vec3& n) const {
   const std::optional<Location> at = locate(p.p, n);
   if (!at) return std::nullopt;
   // Off the element, p may lie on a curved surface that the element is a chord of, or on another
@@ -159,49 +160,50 @@ Rgb RadiosityView::indirect_at(const Location& at) const {
   return vertex_indirect_[e[0]] * (1.0f - at.u - at.v) + vertex_indirect_[e[1]] * at.u + vertex_indirect_[e[2]] * at.v;
 }
 
-std::optional<Rgb> RadiosityView::indirect_irradiance(const rc::SurfacePoint& p, const Vec3& n) const {
+std::optional<Rgb> RadiosityView::indirect_irradiance(const rc::scene::SurfacePoint& p, const Vec3& n) const {
   const std::optional<Location> at = locate_on(p, n);
   if (!at) return std::nullopt;
   return indirect_at(*at);
 }
 
-Rgb RadiosityView::gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const {
+Rgb RadiosityView::gathered_irradiance(const rc::scene::SurfacePoint& p, int rays,
+                                       rc::render::SampleContext& ctx) const {
   Rgb sum(0.0f);
   // The rays are sub-samples of the point's sample: with the Sobol sampler, their shadow rays'
   // points on each light and their gather directions are each a stratified set.
-  const rc::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(std::max(rays, 1)));
+  const rc::render::Sampler::SubSamples samples = ctx.sampler.split(uint32_t(std::max(rays, 1)));
   for (int r = 0; r < rays; ++r) {
-    rc::SampleContext sub{samples[uint32_t(r)], 0};
+    rc::render::SampleContext sub{samples[uint32_t(r)], 0};
     sum += gathered_sample(p, sub);
     ctx.rays += sub.rays;
   }
   return sum / float(std::max(rays, 1));
 }
 
-Rgb RadiosityView::gathered_sample(const rc::SurfacePoint& p, rc::SampleContext& ctx) const {
+Rgb RadiosityView::gathered_sample(const rc::scene::SurfacePoint& p, rc::render::SampleContext& ctx) const {
   // A white Lambertian stands in for the surface: π times its reflected radiance is irradiance.
-  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
-  rc::SurfaceInteraction si;
-  static_cast<rc::SurfacePoint&>(si) = p;
+  static const rc::scene::Material white = rc::scene::Material::make_diffuse("irradiance probe", Rgb(1.0f));
+  rc::scene::SurfaceInteraction si;
+  static_cast<rc::scene::SurfacePoint&>(si) = p;
   si.ns = p.ng;
   const rc::Frame frame = rc::Frame::from_normal(p.ng);
   const Vec3 wo(0.0f, 0.0f, 1.0f);
   // A uniform sky comes by the gather ray when it escapes, rather than by a shadow ray of its own
   // (sky_left_to_bsdf_sampling): exact where the sky is open, and one ray fewer.
-  return rc::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays, !sky_by_gather_) * rc::kPi +
+  return rc::render::estimate_direct(scene_, si, white, frame, wo, true, ctx.sampler, ctx.rays, !sky_by_gather_) * rc::kPi +
          gather(si, frame, true, ctx, false, sky_by_gather_);
 }
 
-Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
-                          rc::SampleContext& ctx, bool via_specular_only, bool sky_on_escape) const {
+Rgb RadiosityView::gather(const rc::scene::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
+                          rc::render::SampleContext& ctx, bool via_specular_only, bool sky_on_escape) const {
   // One cosine-distributed ray on the lit side: its estimate of the irradiance is the radiance
   // it finds times π.
   const Vec3 side = wo_above ? si.ng : -si.ng;
-  Vec3 wi = frame.to_world(rc::sample_cosine_hemisphere(ctx.sampler.uniform2()));
+  Vec3 wi = frame.to_world(rc::util::sample_cosine_hemisphere(ctx.sampler.uniform2()));
   if (!wo_above) wi = -wi;                            // the frame's z is the front's shading normal
   if (glm::dot(wi, side) <= 0.0f) return Rgb(0.0f);  // the shading normal leans the ray through the surface
   Rgb beta(rc::kPi), out(0.0f);
-  rc::Ray ray = rc::spawn_ray(si, wi);
+  rc::scene::Ray ray = rc::scene::spawn_ray(si, wi);
   // Emitters and the sky are next-event estimation's after a diffuse bounce; through glass or a
   // mirror, shadow rays cannot see them, and the ray is their only way in.
   bool via_specular = false;
@@ -209,17 +211,17 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   int near_left = kNearBounces;
   for (int depth = 0; depth < 64; ++depth) {
     ++ctx.rays;
-    const std::optional<rc::Hit> hit = scene_.intersect(ray);
+    const std::optional<rc::scene::Hit> hit = scene_.intersect(ray);
     if (!hit) {
-      if (via_specular) return out + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+      if (via_specular) return out + beta * rc::scene::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
       return depth == 0 && sky_on_escape ? out + beta * constant_sky_ : out;
     }
-    const rc::SurfaceInteraction sj = scene_.surface(ray, *hit);
-    rc::Material textured;
-    const rc::Material& mj = scene_.shading_material(sj, textured);
+    const rc::scene::SurfaceInteraction sj = scene_.surface(ray, *hit);
+    rc::scene::Material textured;
+    const rc::scene::Material& mj = scene_.shading_material(sj, textured);
     const Vec3 wo_world = -glm::normalize(ray.direction);
     absorb(mj, sj, *hit, ray, beta);
-    if (via_specular && mj.is_emissive()) out += beta * rc::emitted_radiance(mj, sj.ng, wo_world);
+    if (via_specular && mj.is_emissive()) out += beta * rc::scene::emitted_radiance(mj, sj.ng, wo_world);
     const rc::Frame fj = rc::Frame::from_normal(sj.ns);
     const Vec3 wo = fj.to_local(wo_world);
     if (depth == 0 && via_specular_only && !mj.is_traced_through()) return Rgb(0.0f);
@@ -247,17 +249,17 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
       const std::optional<Location> at = locate_on(sj, lit);
       const bool near = at && near_hit(*at, hit->t * glm::length(ray.direction));
       if (at && !near && !element_direct_.empty())
-        return out + beta * rc::diffuse_reflectance(mj) * (element_direct_[at->element] + indirect_at(*at)) * (1.0f / rc::kPi);
-      out += beta * rc::estimate_direct(scene_, sj, mj, fj, wo, above, ctx.sampler, ctx.rays);
+        return out + beta * rc::scene::diffuse_reflectance(mj) * (element_direct_[at->element] + indirect_at(*at)) * (1.0f / rc::kPi);
+      out += beta * rc::render::estimate_direct(scene_, sj, mj, fj, wo, above, ctx.sampler, ctx.rays);
       if (at && !(near && near_left-- > 0))
-        return out + beta * rc::diffuse_reflectance(mj) * indirect_at(*at) * (1.0f / rc::kPi);
+        return out + beta * rc::scene::diffuse_reflectance(mj) * indirect_at(*at) * (1.0f / rc::kPi);
       // A near hit, or no element stands for this side of the surface: one more diffuse bounce.
       if (!at && diffuse_left-- == 0) return out;
-      Vec3 next = fj.to_world(rc::sample_cosine_hemisphere(ctx.sampler.uniform2()));
+      Vec3 next = fj.to_world(rc::util::sample_cosine_hemisphere(ctx.sampler.uniform2()));
       if (!above) next = -next;
       if (glm::dot(next, lit) <= 0.0f) return out;
-      beta *= rc::diffuse_reflectance(mj);  // Lambertian: f cos / pdf
-      ray = rc::spawn_ray(sj, next);
+      beta *= rc::scene::diffuse_reflectance(mj);  // Lambertian: f cos / pdf
+      ray = rc::scene::spawn_ray(sj, next);
       via_specular = false;
       continue;
     }
@@ -267,15 +269,16 @@ Rgb RadiosityView::gather(const rc::SurfaceInteraction& si, const rc::Frame& fra
   return out;
 }
 
-Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+Rgb RadiosityView::mesh_radiance(const rc::scene::Ray& camera_ray, rc::render::SampleContext& ctx) const {
   Rgb beta(1.0f);
-  rc::Ray ray = camera_ray;
+  rc::scene::Ray ray = camera_ray;
   for (int depth = 0; depth < 64; ++depth) {
     ctx.sampler.start_bounce(depth);
     ++ctx.rays;
-    const std::optional<rc::Hit> hit = display_.intersect(ray);
-    if (!hit) return beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
-    const rc::SurfaceInteraction si = display_.surface(ray, *hit);
+    const std::optional<rc::scene::Hit> hit = display_.intersect(ray);
+    if (!hit)
+      return beta * rc::scene::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+    const rc::scene::SurfaceInteraction si = display_.surface(ray, *hit);
     if (hit->geom_id == 0) {
       // Radiosity is solved for the element fronts; their backs are not part of the answer.
       if (!si.front_face) return Rgb(0.0f);
@@ -284,7 +287,7 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
                     vertex_radiance_[e[2]] * hit->v;
       return beta * l;
     }
-    const rc::Material& m = display_.materials[si.material];
+    const rc::scene::Material& m = display_.materials[si.material];
     absorb(m, si, *hit, ray, beta);
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     if (!scatter_specular(m, si, frame, frame.to_local(-glm::normalize(ray.direction)), ctx.sampler, beta, ray))
@@ -293,21 +296,21 @@ Rgb RadiosityView::mesh_radiance(const rc::Ray& camera_ray, rc::SampleContext& c
   return Rgb(0.0f);
 }
 
-Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContext& ctx) const {
+Rgb RadiosityView::two_pass_radiance(const rc::scene::Ray& camera_ray, rc::render::SampleContext& ctx) const {
   Rgb radiance(0.0f), beta(1.0f);
-  rc::Ray ray = camera_ray;
+  rc::scene::Ray ray = camera_ray;
   for (int depth = 0; depth < 64; ++depth) {
     ctx.sampler.start_bounce(depth);
     ++ctx.rays;
-    const std::optional<rc::Hit> hit = scene_.intersect(ray);
-    if (!hit) return radiance + beta * rc::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
-    const rc::SurfaceInteraction si = scene_.surface(ray, *hit);
-    rc::Material textured;
-    const rc::Material& m = scene_.shading_material(si, textured);
+    const std::optional<rc::scene::Hit> hit = scene_.intersect(ray);
+    if (!hit) return radiance + beta * rc::scene::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
+    const rc::scene::SurfaceInteraction si = scene_.surface(ray, *hit);
+    rc::scene::Material textured;
+    const rc::scene::Material& m = scene_.shading_material(si, textured);
     const Vec3 wo_world = -glm::normalize(ray.direction);
     absorb(m, si, *hit, ray, beta);
     // Only the camera and delta bounces lead here, so emission seen is never sampled twice.
-    if (m.is_emissive()) radiance += beta * rc::emitted_radiance(m, si.ng, wo_world);
+    if (m.is_emissive()) radiance += beta * rc::scene::emitted_radiance(m, si.ng, wo_world);
     const rc::Frame frame = rc::Frame::from_normal(si.ns);
     const Vec3 wo = frame.to_local(wo_world);
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f;
@@ -318,14 +321,15 @@ Rgb RadiosityView::two_pass_radiance(const rc::Ray& camera_ray, rc::SampleContex
       // solution where it lands. (Gathering everywhere hides the mesh one bounce away, at the
       // price of its noise: on Šibenik's nave at 60 s its relMSE was 1.5 times the reading's,
       // on the Cornell box at 1,600 elements its error 1.2 times.)
-      radiance += beta * rc::estimate_direct(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
+      radiance +=
+          beta * rc::render::estimate_direct(scene_, si, m, frame, wo, wo_above, ctx.sampler, ctx.rays);
       if (const std::optional<Rgb> e = indirect_irradiance(si, wo_above ? si.ng : -si.ng)) {
         // The solution's light comes from diffuse surfaces in view (mirrors and glass block it);
         // what arrives through them, the gather ray brings.
         const Rgb through = has_specular_ ? gather(si, frame, wo_above, ctx, true) : Rgb(0.0f);
-        return radiance + beta * rc::diffuse_reflectance(m) * (*e + through) * (1.0f / rc::kPi);
+        return radiance + beta * rc::scene::diffuse_reflectance(m) * (*e + through) * (1.0f / rc::kPi);
       }
-      return radiance + beta * rc::diffuse_reflectance(m) * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
+      return radiance + beta * rc::scene::diffuse_reflectance(m) * gather(si, frame, wo_above, ctx) * (1.0f / rc::kPi);
     }
     if (!scatter_specular(m, si, frame, wo, ctx.sampler, beta, ray)) return radiance;
   }

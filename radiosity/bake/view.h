@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/render.h"
 
 namespace gilt::radiosity::bake {
 
@@ -37,17 +37,17 @@ inline constexpr double kTwoPassLinkTolerance = 2e-5;
 /// a tolerance is set; the mesh view shows the vertices as they are and needs them all.
 solver::SolverSettings solver_settings_for(ViewMode mode, solver::SolverSettings settings);
 
-/// Display of a solution; radiance() is a RadianceFunction for raytrace_core::render_image.
+/// Display of a solution; radiance() is a RadianceFunction for raytrace_core::render::render_image.
 class RadiosityView {
  public:
   /// Builds the display scenes. Both arguments must outlive the view. With `ambient`, a partial
   /// solution is shown with each vertex's reflectance times the solution's ambient term added
   /// (display only).
-  RadiosityView(const rc::Scene& scene, const solver::Solution& solution, ViewMode mode = ViewMode::two_pass,
-                bool ambient = true);
+  RadiosityView(const rc::scene::Scene& scene, const solver::Solution& solution,
+                ViewMode mode = ViewMode::two_pass, bool ambient = true);
 
   /// Radiance along a camera ray, through any chain of mirror and glass bounces (at most 64).
-  Rgb radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
+  Rgb radiance(const rc::scene::Ray& ray, rc::render::SampleContext& ctx) const;
 
   /// Irradiance (W·m⁻²) the solution gives a point of the input at p whose lit side faces along
   /// the unit normal n from other surfaces' reflections (the direct light left out): interpolated
@@ -56,7 +56,7 @@ class RadiosityView {
   /// the element is a chord of could. Nothing where no element does:
   /// the back of a one-sided surface, the inside of an open shell, a face removed as buried, a
   /// mirror or glass.
-  std::optional<Rgb> indirect_irradiance(const rc::SurfacePoint& p, const Vec3& n) const;
+  std::optional<Rgb> indirect_irradiance(const rc::scene::SurfacePoint& p, const Vec3& n) const;
 
   /// Where irradiance() reads the solution for a point of the input at p with lit side along n:
   /// the element's index and the barycentrics of its second and third vertex.
@@ -69,17 +69,17 @@ class RadiosityView {
 
   /// Irradiance (W·m⁻²) at a point p of the input whose lit side faces along its unit geometric
   /// normal p.ng, estimated from `rays` samples, each one shadow ray's direct light
-  /// (rc::estimate_direct, as the two-pass view takes it at a pixel) and one cosine-distributed
+  /// (rc::render::estimate_direct, as the two-pass view takes it at a pixel) and one cosine-distributed
   /// gather ray that reads the solution where it lands (its element's direct light and reflected
   /// light, through mirrors and glass). The final gather of a bake: what a point sees is traced,
   /// so light does not leak across a roof line or a wall that no element edge follows, and the
   /// solution's own error enters one bounce later, damped by the reflectance there. A gather ray
   /// that lands closer than twice its element's size bounces on (up to 8 times) instead of reading
   /// it: in a crevice or a contact shadow the elements smear the light that the point sees.
-  Rgb gathered_irradiance(const rc::SurfacePoint& p, int rays, rc::SampleContext& ctx) const;
+  Rgb gathered_irradiance(const rc::scene::SurfacePoint& p, int rays, rc::render::SampleContext& ctx) const;
   /// One sample of gathered_irradiance: one shadow ray and one gather ray, drawn from ctx's
   /// sampler as it stands (a sub-sample of a set the caller split).
-  Rgb gathered_sample(const rc::SurfacePoint& p, rc::SampleContext& ctx) const;
+  Rgb gathered_sample(const rc::scene::SurfacePoint& p, rc::render::SampleContext& ctx) const;
 
  private:
   /// Radiance reflected by other surfaces towards a diffuse point si, estimated by one
@@ -87,24 +87,25 @@ class RadiosityView {
   /// element's mean direct light (or a shadow ray's) and the reflected light interpolated.
   /// With via_specular_only, only what the ray brings through a mirror or glass it meets first.
   /// With sky_on_escape, a ray that escapes straight away brings the uniform sky's radiance
-  /// (the caller's direct light left it out: rc::sky_left_to_bsdf_sampling).
-  Rgb gather(const rc::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above, rc::SampleContext& ctx,
-             bool via_specular_only = false, bool sky_on_escape = false) const;
+  /// (the caller's direct light left it out: rc::render::sky_left_to_bsdf_sampling).
+  Rgb gather(const rc::scene::SurfaceInteraction& si, const rc::Frame& frame, bool wo_above,
+             rc::render::SampleContext& ctx, bool via_specular_only = false,
+             bool sky_on_escape = false) const;
   /// locate(), unless p lies farther from the element than a curved surface the element is a
   /// chord of could (see indirect_irradiance); seen from behind its face (n against p.ng), within
   /// the sagitta of the element's own size.
-  std::optional<Location> locate_on(const rc::SurfacePoint& p, const Vec3& n) const;
+  std::optional<Location> locate_on(const rc::scene::SurfacePoint& p, const Vec3& n) const;
   Rgb indirect_at(const Location& at) const;
   float longest_edge(uint32_t element) const;
   /// Whether a gather ray that met the surface `distance` from its origin, where `at` locates
   /// it, is too close to read the solution there (kNearHit).
   bool near_hit(const Location& at, float distance) const;
-  Rgb mesh_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
-  Rgb two_pass_radiance(const rc::Ray& ray, rc::SampleContext& ctx) const;
+  Rgb mesh_radiance(const rc::scene::Ray& ray, rc::render::SampleContext& ctx) const;
+  Rgb two_pass_radiance(const rc::scene::Ray& ray, rc::render::SampleContext& ctx) const;
 
-  const rc::Scene& scene_;
+  const rc::scene::Scene& scene_;
   ViewMode mode_;
-  rc::Scene display_;                        ///< the elements (geometry 0) and the specular surfaces
+  rc::scene::Scene display_;                        ///< the elements (geometry 0) and the specular surfaces
   std::vector<Rgb> vertex_radiance_;         ///< mesh view: W·sr⁻¹·m⁻²
   std::vector<Rgb> vertex_indirect_;         ///< two-pass view: W·m⁻² from reflections, ambient term included
   std::vector<Vec3> positions_;              ///< of the elements' vertices

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::mesh {
 
@@ -12,7 +12,7 @@ namespace {
 
 /// Texture coordinates at the point of triangle `prim` of `mesh` whose barycentrics are those
 /// of x projected into the triangle's plane (x may lie outside the triangle: the map is affine).
-rc::Vec2 uv_at(const rc::TriangleMesh& mesh, uint32_t prim, const Vec3& x) {
+rc::Vec2 uv_at(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x) {
   const uint32_t* c = &mesh.indices[3 * size_t(prim)];
   const Vec3 p0 = mesh.positions[c[0]], e1 = mesh.positions[c[1]] - p0, e2 = mesh.positions[c[2]] - p0;
   const Vec3 d = x - p0;
@@ -26,20 +26,20 @@ rc::Vec2 uv_at(const rc::TriangleMesh& mesh, uint32_t prim, const Vec3& x) {
 
 }  // namespace
 
-std::vector<rc::Rgb> element_reflectance(const rc::Scene& scene, const RadiosityMesh& mesh) {
+std::vector<rc::Rgb> element_reflectance(const rc::scene::Scene& scene, const RadiosityMesh& mesh) {
   const size_t ne = mesh.element_count();
   std::vector<rc::Rgb> out(ne);
-  const rc::TextureSet* textures = scene.texture_set();
-  rc::parallel_for((ne + 255) / 256, [&](size_t chunk) {
+  const rc::scene::TextureSet* textures = scene.texture_set();
+  rc::util::parallel_for((ne + 255) / 256, [&](size_t chunk) {
     for (size_t e = chunk * 256; e < std::min(ne, chunk * 256 + 256); ++e) {
-      const rc::Material& m = scene.materials[mesh.element_material[e]];
+      const rc::scene::Material& m = scene.materials[mesh.element_material[e]];
       const uint32_t s = mesh.element_surface[e];
       if (!m.albedo_texture.valid() || !textures || s >= scene.meshes.size()) {
-        out[e] = rc::diffuse_reflectance(m);  // untextured, or a sphere (whose texture has no seam-free UVs here)
+        out[e] = rc::scene::diffuse_reflectance(m);  // untextured, or a sphere (whose texture has no seam-free UVs here)
         continue;
       }
-      const rc::TriangleMesh& input = scene.meshes[s];
-      const rc::TextureRef& t = m.albedo_texture;
+      const rc::scene::TriangleMesh& input = scene.meshes[s];
+      const rc::scene::TextureRef& t = m.albedo_texture;
       const auto& el = mesh.elements[e];
       const Vec3 p0 = mesh.positions[el[0]], p1 = mesh.positions[el[1]], p2 = mesh.positions[el[2]];
       const float reach = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
@@ -49,9 +49,10 @@ std::vector<rc::Rgb> element_reflectance(const rc::Scene& scene, const Radiosity
       int found = 0;
       for (int i = 0; i < kSide; ++i)
         for (int j = 0; j < kSide; ++j) {
-          const rc::Vec2 w = rc::sample_uniform_triangle({(i + 0.5f) / kSide, (j + 0.5f) / kSide});
+          const rc::Vec2 w = rc::util::sample_uniform_triangle({(i + 0.5f) / kSide, (j + 0.5f) / kSide});
           const Vec3 x = (1.0f - w.x - w.y) * p0 + w.x * p1 + w.y * p2;
-          const std::optional<rc::Hit> h = scene.nearest_triangle(s, x, reach, mesh.element_normal[e], 0.5f);
+          const std::optional<rc::scene::Hit> h =
+              scene.nearest_triangle(s, x, reach, mesh.element_normal[e], 0.5f);
           if (!h) continue;
           // The footprint: this point's share of the element, as the found triangle maps it.
           const rc::Vec2 uv = uv_at(input, h->prim_id, x);
@@ -60,10 +61,10 @@ std::vector<rc::Rgb> element_reflectance(const rc::Scene& scene, const Radiosity
           ++found;
         }
       if (found > 0) {
-        out[e] = rc::diffuse_reflectance(m) * sum * (1.0f / float(found));
+        out[e] = rc::scene::diffuse_reflectance(m) * sum * (1.0f / float(found));
       } else {
         // No input face near (should not happen): the image's mean, from its coarsest level.
-        out[e] = rc::diffuse_reflectance(m) * textures->lookup(t.image, rc::Vec2(0.5f), rc::Vec2(1.0f, 0.0f), rc::Vec2(0.0f, 1.0f)).rgb;
+        out[e] = rc::scene::diffuse_reflectance(m) * textures->lookup(t.image, rc::Vec2(0.5f), rc::Vec2(1.0f, 0.0f), rc::Vec2(0.0f, 1.0f)).rgb;
       }
     }
   });

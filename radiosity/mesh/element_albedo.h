@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::mesh {
 
@@ -15,6 +15,6 @@ namespace gilt::radiosity::mesh {
 /// element as the input triangle maps it into the image. Remeshed elements cross the input's UV
 /// seams freely, which is why each point finds its own input triangle rather than the element
 /// carrying UVs. Deterministic and independent of the thread count.
-std::vector<rc::Rgb> element_reflectance(const rc::Scene& scene, const RadiosityMesh& mesh);
+std::vector<rc::Rgb> element_reflectance(const rc::scene::Scene& scene, const RadiosityMesh& mesh);
 
 }  // namespace gilt::radiosity::mesh

@@ -5,8 +5,8 @@
 // geometry the radiosity world does not have (the Stanford bunny came out in black blotches).
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/ray.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/ray.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::mesh {
 
@@ -14,14 +14,14 @@ namespace gilt::radiosity::mesh {
 /// element is a light), followed by the input's mirror and glass meshes and spheres as they
 /// are, which the solver treats as opaque and the view ray traces. Materials are the input's,
 /// plus the elements' at the end.
-rc::Scene element_scene(const rc::Scene& scene, const RadiosityMesh& mesh);
+rc::scene::Scene element_scene(const rc::scene::Scene& scene, const RadiosityMesh& mesh);
 
 /// A point of the mesh for spawning rays at p on a surface with unit normal n; the error bound
 /// allows for rounding in meshing (γ(16)·|p|).
-inline rc::SurfacePoint mesh_surface_point(const Vec3& p, const Vec3& n) {
-  rc::SurfacePoint sp;
+inline rc::scene::SurfacePoint mesh_surface_point(const Vec3& p, const Vec3& n) {
+  rc::scene::SurfacePoint sp;
   sp.p = p;
-  sp.p_error = rc::error_gamma(16) * rc::abs(p);
+  sp.p_error = rc::scene::error_gamma(16) * rc::abs(p);
   sp.ng = n;
   return sp;
 }

@@ -23,7 +23,7 @@
 #include <CGAL/box_intersection_d.h>
 #include <glm/geometric.hpp>
 
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace gilt::radiosity::mesh::detail {
 namespace {
@@ -348,7 +348,7 @@ std::vector<std::vector<Segment>> contact_segments(const TriangleSoup& surface, 
   for (const auto& [f, t] : pairs) ++first[f + 1];
   for (size_t f = 0; f < n; ++f) first[f + 1] += first[f];
   std::vector<std::vector<Segment>> segments(n);
-  rc::parallel_for(n, [&](size_t f) {
+  rc::util::parallel_for(n, [&](size_t f) {
     const Triangle corner = face_of(surface, f);
     for (size_t i = first[f]; i < first[f + 1]; ++i) {
       Segment s;
@@ -413,7 +413,7 @@ std::span<const EdgePoint> points_on(const std::vector<EdgePoint>& edge_points, 
 /// into (a corner, when it is one), and drops segments that shrink to a point.
 void snap_segment_ends(const TriangleSoup& surface, const std::vector<EdgePoint>& edge_points,
                        std::vector<std::vector<Segment>>& segments) {
-  rc::parallel_for(segments.size(), [&](size_t f) {
+  rc::util::parallel_for(segments.size(), [&](size_t f) {
     const auto& t = surface.triangles[f];
     for (Segment& s : segments[f])
       for (LinePoint* p : {&s.a, &s.b}) {
@@ -445,7 +445,7 @@ void cut_faces(const TriangleSoup& surface, const std::vector<EdgePoint>& edge_p
   }
   cuts.assign(n, CutFace{});
   lost.assign(n, 0);
-  rc::parallel_for(n, [&](size_t f) {
+  rc::util::parallel_for(n, [&](size_t f) {
     if (!cut[f]) return;
     const auto& t = surface.triangles[f];
     const Triangle corner = face_of(surface, f);

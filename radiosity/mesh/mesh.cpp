@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh_detail.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::radiosity::mesh {
 namespace detail {
@@ -203,18 +203,19 @@ SplitSurface split_sharp_vertices(const TriangleSoup& soup, double sharp_angle_d
 
 namespace {
 
-bool is_meshed(const rc::Material& material) {
+bool is_meshed(const rc::scene::Material& material) {
   return !material.is_traced_through();  // diffuse, glossy and metallic-roughness: their diffuse part
 }
 
-const rc::Material& material_of(const rc::Scene& scene, uint32_t material, const std::string& what) {
+const rc::scene::Material& material_of(const rc::scene::Scene& scene, uint32_t material,
+                                       const std::string& what) {
   if (material >= scene.materials.size())
     throw rc::InputError(what + " refers to material " + std::to_string(material) + " but there are " +
                          std::to_string(scene.materials.size()));
   return scene.materials[material];
 }
 
-std::string mesh_label(const rc::TriangleMesh& mesh, size_t index) {
+std::string mesh_label(const rc::scene::TriangleMesh& mesh, size_t index) {
   return "mesh '" + (mesh.name.empty() ? std::to_string(index) : mesh.name) + "'";
 }
 
@@ -277,10 +278,10 @@ void warn_counts(MeshReport& report, const std::string& label, const RepairCount
   warn(c.not_remeshed, "pieces keep their input triangles: --time left no time to remesh them");
 }
 
-double meshed_area(const rc::Scene& scene) {
+double meshed_area(const rc::scene::Scene& scene) {
   double area = 0.0;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const rc::TriangleMesh& mesh = scene.meshes[m];
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
     if (!is_meshed(material_of(scene, mesh.material, mesh_label(mesh, m)))) continue;
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
       const DVec3 a(mesh.positions.at(mesh.indices[3 * t])), b(mesh.positions.at(mesh.indices[3 * t + 1])),
@@ -289,7 +290,7 @@ double meshed_area(const rc::Scene& scene) {
     }
   }
   for (size_t s = 0; s < scene.spheres.size(); ++s) {
-    const rc::Sphere& sphere = scene.spheres[s];
+    const rc::scene::Sphere& sphere = scene.spheres[s];
     if (!is_meshed(material_of(scene, sphere.material, "sphere " + std::to_string(s)))) continue;
     area += 4.0 * 3.14159265358979323846 * double(sphere.radius) * double(sphere.radius);
   }
@@ -298,7 +299,7 @@ double meshed_area(const rc::Scene& scene) {
 
 /// For each mesh of the scene, the other meshes whose bounding boxes meet its own (grown by a
 /// millionth of the scene's size): the only ones that can touch it.
-std::vector<std::vector<size_t>> touching_meshes(const rc::Scene& scene) {
+std::vector<std::vector<size_t>> touching_meshes(const rc::scene::Scene& scene) {
   std::vector<rc::Bounds3> boxes(scene.meshes.size());
   rc::Bounds3 all;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
@@ -338,21 +339,22 @@ constexpr double kMaxBuriedShare = 0.25;
 
 /// Whether every test ray from `at` over its front hemisphere (see burial_directions) first
 /// hits the back of an opaque surface, and the camera cannot see the point.
-bool enclosed(const rc::Scene& scene, const rc::SurfacePoint& at) {
+bool enclosed(const rc::scene::Scene& scene, const rc::scene::SurfacePoint& at) {
   static const std::vector<DVec3> dirs = burial_directions();
   const rc::Frame frame = rc::Frame::from_normal(at.ng);
   for (const DVec3& dir : dirs) {
-    const rc::Ray ray = rc::spawn_ray(at, frame.to_world(Vec3(dir)));
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const rc::scene::Ray ray = rc::scene::spawn_ray(at, frame.to_world(Vec3(dir)));
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     if (!hit) return false;
-    const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+    const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
     // Open, or enclosed by glass that lets light in.
-    if (si.front_face || scene.materials[si.material].kind == rc::MaterialKind::dielectric) return false;
+    if (si.front_face || scene.materials[si.material].kind == rc::scene::MaterialKind::dielectric)
+      return false;
   }
   // A room modelled inside out (its walls facing outwards) encloses what is in it just as a
   // block encloses the floor under it; the camera inside tells the two apart where it looks.
   const Vec3 camera = scene.effective_camera().look_from;
-  return !(glm::dot(camera - at.p, at.ng) > 0.0f && !scene.occluded(rc::spawn_shadow_ray(at, camera)));
+  return !(glm::dot(camera - at.p, at.ng) > 0.0f && !scene.occluded(rc::scene::spawn_shadow_ray(at, camera)));
 }
 
 /// The points of a triangle at which burial is tested: its centroid and three points near its
@@ -363,13 +365,13 @@ std::array<DVec3, 4> burial_points(const DVec3& a, const DVec3& b, const DVec3& 
 
 /// Whether the triangle (a, b, d) is buried: all its burial_points are enclosed, seen from its
 /// front.
-bool triangle_buried(const rc::Scene& scene, const DVec3& a, const DVec3& b, const DVec3& d) {
+bool triangle_buried(const rc::scene::Scene& scene, const DVec3& a, const DVec3& b, const DVec3& d) {
   const DVec3 cross = glm::cross(b - a, d - a);
   if (!(glm::dot(cross, cross) > 0.0)) return false;
   for (const DVec3& p : burial_points(a, b, d)) {
-    rc::SurfacePoint at;
+    rc::scene::SurfacePoint at;
     at.p = Vec3(p);
-    at.p_error = rc::error_gamma(16) * rc::abs(at.p);
+    at.p_error = rc::scene::error_gamma(16) * rc::abs(at.p);
     at.ng = Vec3(glm::normalize(cross));
     if (!enclosed(scene, at)) return false;
   }
@@ -389,12 +391,12 @@ double triangle_area(const DVec3& a, const DVec3& b, const DVec3& d) { return 0.
 /// and facing it (a closed box's base on the floor) is not found and is kept: it receives
 /// nothing and costs only its own elements. Triangles not begun by `deadline` are kept, and
 /// counted in `untested`. Returns the buried area.
-double mark_buried(const rc::Scene& scene, const TriangleSoup& surface, std::vector<char>& buried,
+double mark_buried(const rc::scene::Scene& scene, const TriangleSoup& surface, std::vector<char>& buried,
                    std::chrono::steady_clock::time_point deadline, std::atomic<size_t>& untested) {
   buried.assign(surface.triangles.size(), 0);
   // In parallel over triangles (a furnished room's furniture is one mesh of most of its faces),
   // the area summed afterwards in triangle order, so it does not depend on the thread count.
-  rc::parallel_for(surface.triangles.size(), [&](size_t t) {
+  rc::util::parallel_for(surface.triangles.size(), [&](size_t t) {
     if (std::chrono::steady_clock::now() >= deadline) {
       ++untested;
       return;
@@ -411,10 +413,12 @@ double mark_buried(const rc::Scene& scene, const TriangleSoup& surface, std::vec
 }
 
 /// Whether p lies on input mesh `mesh_index` to within `tolerance` along the normal n.
-bool on_input(const rc::Scene& scene, const DVec3& p, const DVec3& n, uint32_t mesh_index, double tolerance) {
+bool on_input(const rc::scene::Scene& scene, const DVec3& p, const DVec3& n, uint32_t mesh_index,
+              double tolerance) {
   for (const double side : {1.0, -1.0}) {
-    const rc::Ray ray{Vec3(p + side * tolerance * n), Vec3(-side * n), static_cast<float>(2.0 * tolerance)};
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const rc::scene::Ray ray{Vec3(p + side * tolerance * n), Vec3(-side * n),
+                             static_cast<float>(2.0 * tolerance)};
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     if (hit && hit->geom_id == mesh_index) return true;
   }
   return false;
@@ -426,11 +430,11 @@ bool on_input(const rc::Scene& scene, const DVec3& p, const DVec3& n, uint32_t m
 /// a rim of the input and lie inside it (one on the milk truck's cab did, and was removed though
 /// in view). It finds what imprinting left whole: a floor under an object that stands a rounding
 /// error above it, or one that intersects itself and so imprints nothing. Returns the area.
-double mark_buried_flat(const rc::Scene& scene, const SplitSurface& surface, uint32_t mesh_index,
+double mark_buried_flat(const rc::scene::Scene& scene, const SplitSurface& surface, uint32_t mesh_index,
                         std::vector<char>& buried, std::chrono::steady_clock::time_point deadline,
                         std::atomic<size_t>& untested) {
   buried.assign(surface.corners.size(), 0);
-  rc::parallel_for(surface.corners.size(), [&](size_t t) {  // as mark_buried
+  rc::util::parallel_for(surface.corners.size(), [&](size_t t) {  // as mark_buried
     if (std::chrono::steady_clock::now() >= deadline) {
       ++untested;
       return;
@@ -445,7 +449,7 @@ double mark_buried_flat(const rc::Scene& scene, const SplitSurface& surface, uin
     bool on_surface = true;
     for (const DVec3& p : burial_points(a, b, d))
       on_surface = on_surface && on_input(scene, p, n, mesh_index,
-                                          1e-4 * size + double(rc::error_gamma(16)) * glm::length(p));
+                                          1e-4 * size + double(rc::scene::error_gamma(16)) * glm::length(p));
     buried[t] = on_surface && triangle_buried(scene, a, b, d);
   });
   double area = 0.0;
@@ -483,7 +487,7 @@ size_t remove_triangles(SplitSurface& surface, const std::vector<char>& remove) 
 // build_mesh's passes, over one MeshingState. Each mesh's slot is written by its own task, so the
 // passes run over meshes in parallel and give the same result for any thread count.
 struct MeshingState {
-  const rc::Scene& scene;
+  const rc::scene::Scene& scene;
   const MeshSettings& settings;
   MeshReport& rep;
   float edge_length = 0.0f;
@@ -502,7 +506,8 @@ struct MeshingState {
   std::vector<double> buried_element_area;
   std::chrono::steady_clock::time_point stage_start = std::chrono::steady_clock::now();
 
-  MeshingState(const rc::Scene& s, const MeshSettings& m, MeshReport& r) : scene(s), settings(m), rep(r) {}
+  MeshingState(const rc::scene::Scene& s, const MeshSettings& m, MeshReport& r)
+      : scene(s), settings(m), rep(r) {}
 
   /// Records the seconds since the last stage ended under `name`.
   void end_stage(const char* name) {
@@ -531,7 +536,7 @@ struct MeshingState {
 /// mended (every mesh that is meshed or touches one that is: the meshed ones are remeshed from
 /// it, and all of them imprint their neighbours). False when there is nothing to mesh.
 bool plan_meshing(MeshingState& st) {
-  const rc::Scene& scene = st.scene;
+  const rc::scene::Scene& scene = st.scene;
   if (!(st.settings.sharp_angle_degrees >= 0.0f && st.settings.sharp_angle_degrees <= 180.0f))
     throw rc::InputError("mesh: sharp_angle_degrees must lie in [0, 180]");
   if (st.settings.remesh_iterations < 0) throw rc::InputError("mesh: remesh_iterations must be ≥ 0");
@@ -564,8 +569,8 @@ bool plan_meshing(MeshingState& st) {
 
 /// Reads `repair`; mends those meshes into `repaired`.
 void repair_pass(MeshingState& st, RepairedMeshes& repaired) {
-  rc::Progress progress("mesh: repairing", st.faces_of(st.repair), "faces", st.settings.progress);
-  rc::parallel_for(st.mesh_count, [&](size_t m) {
+  rc::util::Progress progress("mesh: repairing", st.faces_of(st.repair), "faces", st.settings.progress);
+  rc::util::parallel_for(st.mesh_count, [&](size_t m) {
     if (!st.repair[m]) return;
     repaired.repair(m, st.scene.meshes[m], st.settings.deadline);
     progress.advance(st.scene.meshes[m].indices.size() / 3);
@@ -578,15 +583,15 @@ void repair_pass(MeshingState& st, RepairedMeshes& repaired) {
 void imprint_pass(MeshingState& st, RepairedMeshes& repaired) {
   std::vector<TriangleSoup> imprinted(st.mesh_count);
   {
-    rc::Progress progress("mesh: imprinting contact lines", st.faces_of(st.meshed), "faces", st.settings.progress);
-    rc::parallel_for(st.mesh_count, [&](size_t m) {
+    rc::util::Progress progress("mesh: imprinting contact lines", st.faces_of(st.meshed), "faces", st.settings.progress);
+    rc::util::parallel_for(st.mesh_count, [&](size_t m) {
       if (st.meshed[m])
         imprinted[m] = repaired.imprint(m, st.touching[m], &st.counts[m], &progress, st.settings.deadline);
     });
   }
   st.end_stage("imprint");
   st.imprinted_faces.assign(st.mesh_count, 0);
-  rc::parallel_for(st.mesh_count, [&](size_t m) {
+  rc::util::parallel_for(st.mesh_count, [&](size_t m) {
     st.imprinted_faces[m] = imprinted[m].triangles.size();
     if (st.meshed[m] && st.scene.committed())
       st.buried_area[m] = mark_buried(st.scene, imprinted[m], st.buried[m], st.settings.deadline, st.untested);
@@ -606,15 +611,15 @@ void imprint_pass(MeshingState& st, RepairedMeshes& repaired) {
 /// Reads `buried`; remeshes each meshed mesh without its buried faces into `surfaces` and marks
 /// its flat elements that are buried, and tessellates each meshed sphere.
 void remesh_pass(MeshingState& st, RepairedMeshes& repaired) {
-  const rc::Scene& scene = st.scene;
+  const rc::scene::Scene& scene = st.scene;
   const RemeshParams params{kRemeshTargetScale * st.edge_length, st.settings.sharp_angle_degrees,
                             st.settings.remesh_iterations};
   st.buried_elements.resize(st.mesh_count);
   st.buried_element_area.assign(st.mesh_count, 0.0);
-  rc::Progress remeshing("mesh: remeshing",
+  rc::util::Progress remeshing("mesh: remeshing",
                          std::accumulate(st.imprinted_faces.begin(), st.imprinted_faces.end(), uint64_t{0}), "faces",
                          st.settings.progress);
-  rc::parallel_for(st.surface_count, [&](size_t s) {
+  rc::util::parallel_for(st.surface_count, [&](size_t s) {
     if (s < st.mesh_count) {
       if (!st.meshed[s]) return;
       TriangleSoup soup = repaired.remesh(s, st.buried[s], params, &st.counts[s], &remeshing, st.settings.deadline);
@@ -625,7 +630,7 @@ void remesh_pass(MeshingState& st, RepairedMeshes& repaired) {
             mark_buried_flat(scene, st.surfaces[s], static_cast<uint32_t>(s), st.buried_elements[s],
                              st.settings.deadline, st.untested);
     } else {
-      const rc::Sphere& sphere = scene.spheres[s - st.mesh_count];
+      const rc::scene::Sphere& sphere = scene.spheres[s - st.mesh_count];
       if (!is_meshed(scene.materials[sphere.material])) return;
       const DVec3 center(sphere.center);
       TriangleSoup soup = tessellate_sphere(center, sphere.radius, sphere_frequency(sphere.radius, st.edge_length));
@@ -675,19 +680,19 @@ void assemble_pass(MeshingState& st, RadiosityMesh& out) {
 }  // namespace
 }  // namespace detail
 
-bool input_triangle_buried(const rc::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c) {
+bool input_triangle_buried(const rc::scene::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c) {
   return detail::triangle_buried(scene, rc::DVec3(a), rc::DVec3(b), rc::DVec3(c));
 }
 
-bool input_point_buried(const rc::Scene& scene, const Vec3& p, const Vec3& n) {
-  rc::SurfacePoint at;
+bool input_point_buried(const rc::scene::Scene& scene, const Vec3& p, const Vec3& n) {
+  rc::scene::SurfacePoint at;
   at.p = p;
-  at.p_error = rc::error_gamma(16) * rc::abs(p);
+  at.p_error = rc::scene::error_gamma(16) * rc::abs(p);
   at.ng = n;
   return detail::enclosed(scene, at);
 }
 
-float target_edge_length(const rc::Scene& scene, const MeshSettings& settings) {
+float target_edge_length(const rc::scene::Scene& scene, const MeshSettings& settings) {
   if (!std::isfinite(settings.max_edge) || settings.max_edge < 0.0f)
     throw rc::InputError("mesh: max_edge must be a finite length ≥ 0, not " +
                          std::to_string(settings.max_edge));
@@ -700,7 +705,7 @@ float target_edge_length(const rc::Scene& scene, const MeshSettings& settings) {
   return static_cast<float>(std::sqrt(area / (detail::kUnitEquilateralArea * elements)));
 }
 
-RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report) {
+RadiosityMesh build_mesh(const rc::scene::Scene& scene, const MeshSettings& settings, MeshReport* report) {
   using namespace detail;
   MeshReport local_report;
   MeshReport& rep = report ? *report : local_report;
@@ -716,7 +721,7 @@ RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, M
   repair_pass(st, repaired);
   st.end_stage("repair");
   {
-    rc::Progress progress("mesh: finding contacts", 0, "pairs of pieces", settings.progress);
+    rc::util::Progress progress("mesh: finding contacts", 0, "pairs of pieces", settings.progress);
     repaired.find_contacts(&progress, settings.deadline);
   }
   st.end_stage("contacts");

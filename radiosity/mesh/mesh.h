@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 // Every room of radiosity (mesh, solver, bake) builds on the ray core and names its vectors and
 // colours alike.
@@ -84,7 +84,8 @@ struct MeshReport {
 /// The parts of the input buried inside or under other surfaces (the floor under a block) are
 /// removed before remeshing, and flat elements found buried after it; those tests cast rays, so
 /// they run only when the scene is committed.
-RadiosityMesh build_mesh(const rc::Scene& scene, const MeshSettings& settings, MeshReport* report = nullptr);
+RadiosityMesh build_mesh(const rc::scene::Scene& scene, const MeshSettings& settings,
+                         MeshReport* report = nullptr);
 
 /// Splits the longest edge of each listed element at its midpoint (at most once per element per
 /// call; elements whose longest edge is shorter than `min_edge` are left alone). Every element on
@@ -98,13 +99,13 @@ size_t split_longest_edges(RadiosityMesh& mesh, const std::vector<uint32_t>& ele
 /// is buried as build_mesh removes input faces: from its centroid and three points near its
 /// corners, every test ray over the front hemisphere first hits the back of an opaque surface (it
 /// lies inside a closed solid or under an object standing on it), and the camera does not see it.
-bool input_triangle_buried(const rc::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c);
+bool input_triangle_buried(const rc::scene::Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c);
 
 /// The same test at one point p of a surface whose front faces n: for a face that is only partly
 /// inside a solid (a wall running down under a roof), the part no one can see.
-bool input_point_buried(const rc::Scene& scene, const Vec3& p, const Vec3& n);
+bool input_point_buried(const rc::scene::Scene& scene, const Vec3& p, const Vec3& n);
 
 /// The edge length `settings` asks for on this scene (resolving `elements` and the default).
-float target_edge_length(const rc::Scene& scene, const MeshSettings& settings);
+float target_edge_length(const rc::scene::Scene& scene, const MeshSettings& settings);
 
 }  // namespace gilt::radiosity::mesh

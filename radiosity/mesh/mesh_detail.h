@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/math.h"
+#include "raytrace_core/util/math.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 class Progress;
 }
 
@@ -68,14 +68,14 @@ class RepairedMeshes {
 
   /// Mends mesh m; calls for different m may run in parallel. Counting each piece's
   /// self-intersections, a warning only, stops at `deadline` (counts->self_intersections_uncounted).
-  void repair(size_t m, const rc::TriangleMesh& mesh,
+  void repair(size_t m, const rc::scene::TriangleMesh& mesh,
               std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   /// Finds which faces of which pieces meet, over every repaired mesh, so call it after every
   /// repair(); imprint() calls it on first use. `progress`, when given, counts pairs of pieces
   /// searched; pairs not begun by `deadline` are left out, and their pieces counted as not
   /// imprinted (they keep the contacts that were found).
-  void find_contacts(rc::Progress* progress = nullptr,
+  void find_contacts(rc::util::Progress* progress = nullptr,
                      std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   /// Imprints on mesh m the lines where the `touching` meshes (repaired too) and its own pieces
@@ -87,7 +87,7 @@ class RepairedMeshes {
   /// order of their contact faces, most first; those not begun by `deadline` are left as they
   /// were (counts->not_imprinted).
   TriangleSoup imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
-                       rc::Progress* progress = nullptr,
+                       rc::util::Progress* progress = nullptr,
                        std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   /// Mesh m as imprinted, without the triangles of the imprinted surface that `remove` marks,
@@ -97,7 +97,7 @@ class RepairedMeshes {
   /// `progress`, when given, advances by each piece's faces as it is done.
   /// Pieces not begun by `deadline` keep their imprinted triangles (counts->not_remeshed).
   TriangleSoup remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params, RepairCounts* counts,
-                      rc::Progress* progress = nullptr,
+                      rc::util::Progress* progress = nullptr,
                       std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
  private:

@@ -35,8 +35,8 @@
 
 #include "radiosity/mesh/mesh_detail.h"
 #include "radiosity/mesh/imprint.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/progress.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/progress.h"
 
 namespace gilt::radiosity::mesh::detail {
 namespace {
@@ -115,7 +115,7 @@ void restore_input_fronts(const std::vector<Point>& points, std::vector<Polygon>
 }
 
 /// Builds a consistently oriented, manifold triangle mesh from the input, counting repairs.
-SurfaceMesh repair(const rc::TriangleMesh& input, RepairCounts& counts) {
+SurfaceMesh repair(const rc::scene::TriangleMesh& input, RepairCounts& counts) {
   std::vector<Point> points;
   points.reserve(input.positions.size());
   for (const rc::Vec3& p : input.positions) points.emplace_back(p.x, p.y, p.z);
@@ -334,7 +334,7 @@ std::vector<Part> split_parts(const SurfaceMesh& mesh, std::chrono::steady_clock
     }
     if (k == 3) out.add_face(corners[0], corners[1], corners[2]);
   }
-  rc::parallel_for(parts.size(), [&](size_t i) {
+  rc::util::parallel_for(parts.size(), [&](size_t i) {
     parts[i].box = PMP::bbox(parts[i].mesh);
     parts[i].self_intersecting = count_self_intersections(parts[i].mesh, deadline, parts[i].counted);
   });
@@ -734,7 +734,7 @@ bool remesh_by_patches(SurfaceMesh& mesh, const RemeshParams& params, Constraine
   }
 
   std::vector<char> ok(count, 1);
-  rc::parallel_for(count, [&](std::size_t p) {
+  rc::util::parallel_for(count, [&](std::size_t p) {
     SurfaceMesh& patch = patches[p];
     Constrained marks = patch.property_map<edge_descriptor, bool>("e:gilt_constrained").first;
     auto fixed = patch.add_property_map<vertex_descriptor, bool>("v:gilt_fixed", false).first;
@@ -859,7 +859,7 @@ struct RepairedMeshes::Impl {
   std::vector<std::vector<char>> searched_in_part;
   std::once_flag contacts_found;
 
-  void find_contacts(rc::Progress* progress, std::chrono::steady_clock::time_point deadline);
+  void find_contacts(rc::util::Progress* progress, std::chrono::steady_clock::time_point deadline);
 };
 
 namespace {
@@ -964,14 +964,14 @@ std::vector<std::array<uint32_t, 2>> meeting_faces(const PieceFaces& a, const st
 /// indices (mesh, piece, face), so the result does not depend on memory addresses or the thread
 /// count. Piece pairs are searched largest first; those not begun by `deadline` are left out, and
 /// their pieces marked as searched only in part.
-void RepairedMeshes::Impl::find_contacts(rc::Progress* progress, std::chrono::steady_clock::time_point deadline) {
+void RepairedMeshes::Impl::find_contacts(rc::util::Progress* progress, std::chrono::steady_clock::time_point deadline) {
   // Pieces numbered in (mesh, piece) order.
   std::vector<std::array<uint32_t, 2>> pieces;
   for (size_t m = 0; m < parts.size(); ++m)
     for (size_t p = 0; p < parts[m].size(); ++p) pieces.push_back({uint32_t(m), uint32_t(p)});
   const auto part = [&](uint32_t i) -> const Part& { return parts[pieces[i][0]][pieces[i][1]]; };
   std::vector<PieceFaces> faces(pieces.size());
-  rc::parallel_for(pieces.size(), [&](size_t i) { faces[i] = piece_faces(part(uint32_t(i)).mesh); });
+  rc::util::parallel_for(pieces.size(), [&](size_t i) { faces[i] = piece_faces(part(uint32_t(i)).mesh); });
 
   // 1. Pieces whose boxes meet.
   std::vector<FaceBox> piece_boxes;
@@ -989,7 +989,7 @@ void RepairedMeshes::Impl::find_contacts(rc::Progress* progress, std::chrono::st
   std::vector<std::vector<uint32_t>> neighbours(pieces.size());
   for (const auto& [i, j] : pairs) neighbours[i].push_back(j), neighbours[j].push_back(i);
   std::vector<std::vector<std::vector<uint32_t>>> crop(pieces.size());
-  rc::parallel_for(pieces.size(), [&](size_t i) {
+  rc::util::parallel_for(pieces.size(), [&](size_t i) {
     std::vector<CGAL::Bbox_3> boxes;
     for (uint32_t j : neighbours[i]) boxes.push_back(part(j).box);
     if (!boxes.empty()) crop[i] = faces_in_boxes(faces[i], boxes);
@@ -1011,7 +1011,7 @@ void RepairedMeshes::Impl::find_contacts(rc::Progress* progress, std::chrono::st
   std::vector<std::vector<std::array<uint32_t, 2>>> met(pairs.size());
   std::vector<char> skipped(pairs.size(), 0);
   if (progress) progress->set_total(pairs.size());
-  rc::parallel_for(order.size(), [&](size_t k) {
+  rc::util::parallel_for(order.size(), [&](size_t k) {
     const size_t q = order[k];
     const auto [i, j] = pairs[q];
     if (std::chrono::steady_clock::now() >= deadline) {
@@ -1045,7 +1045,7 @@ void RepairedMeshes::Impl::find_contacts(rc::Progress* progress, std::chrono::st
   }
   contacts.assign(parts.size(), {});
   for (size_t m = 0; m < parts.size(); ++m) contacts[m].resize(parts[m].size());
-  rc::parallel_for(found.size(), [&](size_t i) {
+  rc::util::parallel_for(found.size(), [&](size_t i) {
     std::vector<std::array<uint32_t, 4>>& tools = found[i];
     std::sort(tools.begin(), tools.end());
     std::vector<ToolContact>& list = contacts[pieces[i][0]][pieces[i][1]];
@@ -1068,17 +1068,19 @@ RepairedMeshes::RepairedMeshes(size_t mesh_count) : impl_(std::make_unique<Impl>
 
 RepairedMeshes::~RepairedMeshes() = default;
 
-void RepairedMeshes::find_contacts(rc::Progress* progress, std::chrono::steady_clock::time_point deadline) {
+void RepairedMeshes::find_contacts(rc::util::Progress* progress,
+                                   std::chrono::steady_clock::time_point deadline) {
   std::call_once(impl_->contacts_found, [&] { impl_->find_contacts(progress, deadline); });
 }
 
-void RepairedMeshes::repair(size_t m, const rc::TriangleMesh& mesh, std::chrono::steady_clock::time_point deadline) {
+void RepairedMeshes::repair(size_t m, const rc::scene::TriangleMesh& mesh, std::chrono::steady_clock::time_point deadline) {
   const SurfaceMesh repaired = detail::repair(mesh, impl_->counts[m]);
   if (repaired.number_of_faces() > 0) impl_->parts[m] = split_parts(repaired, deadline);
 }
 
 TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching, RepairCounts* counts,
-                                     rc::Progress* progress, std::chrono::steady_clock::time_point deadline) {
+                                     rc::util::Progress* progress,
+                                     std::chrono::steady_clock::time_point deadline) {
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
   c = impl_->counts[m];
@@ -1108,7 +1110,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
   std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
   });
-  rc::parallel_for(order.size(), [&](size_t k) {
+  rc::util::parallel_for(order.size(), [&](size_t k) {
     const size_t i = order[k].second;
     Part& part = imprinted[i];
     auto constrained = part.mesh.add_property_map<edge_descriptor, bool>("e:gilt_constrained", false).first;
@@ -1150,7 +1152,7 @@ TriangleSoup RepairedMeshes::imprint(size_t m, std::span<const size_t> touching,
 }
 
 TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, const RemeshParams& params,
-                                    RepairCounts* counts, rc::Progress* progress,
+                                    RepairCounts* counts, rc::util::Progress* progress,
                                     std::chrono::steady_clock::time_point deadline) {
   RepairCounts local;
   RepairCounts& c = counts ? *counts : local;
@@ -1161,7 +1163,7 @@ TriangleSoup RepairedMeshes::remesh(size_t m, const std::vector<char>& remove, c
   for (size_t i = 0; i < imprinted.size(); ++i) first[i + 1] = first[i] + imprinted[i].mesh.number_of_faces();
   std::vector<TriangleSoup> soups(imprinted.size());
   std::vector<RepairCounts> piece_counts(imprinted.size());
-  rc::parallel_for(imprinted.size(), [&](size_t i) {
+  rc::util::parallel_for(imprinted.size(), [&](size_t i) {
     SurfaceMesh& mesh = imprinted[i].mesh;
     const size_t faces = mesh.number_of_faces();
     std::vector<face_descriptor> removed;

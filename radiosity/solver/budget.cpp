@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "raytrace_core/processes.h"
+#include "raytrace_core/util/processes.h"
 
 namespace gilt::radiosity::solver {
 
@@ -15,7 +15,8 @@ double fitted_elements(size_t pilot_elements, double pilot_seconds, double secon
   return std::min(double(pilot_elements) * std::sqrt(seconds / pilot_seconds), most);
 }
 
-Solution solve_within(const rc::Scene& scene, SolverSettings settings, double seconds, BudgetFit* fit) {
+Solution solve_within(const rc::scene::Scene& scene, SolverSettings settings, double seconds,
+                      BudgetFit* fit) {
   BudgetFit local;
   BudgetFit& f = fit ? *fit : local;
   f = BudgetFit{};
@@ -37,7 +38,7 @@ Solution solve_within(const rc::Scene& scene, SolverSettings settings, double se
   // 0's, so that every process meshes alike.
   const double most = double(f.pilot_elements) * double(kDefaultElements) / double(kPilotElements);
   const double n =
-      rc::processes().broadcast_value(converged ? fitted_elements(f.pilot_elements, pilot.seconds, left, most) : 0.0);
+      rc::util::processes().broadcast_value(converged ? fitted_elements(f.pilot_elements, pilot.seconds, left, most) : 0.0);
   char line[200];
   if (!(n > 1.25 * double(f.pilot_elements))) {
     std::snprintf(line, sizeof line, "radiosity: %zu elements, solved in %.3g s of a %.3g-s solve budget%s", f.pilot_elements,

@@ -43,6 +43,6 @@ double fitted_elements(size_t pilot_elements, double pilot_seconds, double secon
 /// 0.93 %). The pilot is kept when n is within 1.25 times its own count, or when it did not
 /// converge itself. Otherwise one solve as asked, stopped at the budget. Under MPI the count is
 /// rank 0's.
-Solution solve_within(const rc::Scene& scene, SolverSettings settings, double seconds, BudgetFit* fit = nullptr);
+Solution solve_within(const rc::scene::Scene& scene, SolverSettings settings, double seconds, BudgetFit* fit = nullptr);
 
 }  // namespace gilt::radiosity::solver

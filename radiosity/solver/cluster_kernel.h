@@ -2,7 +2,7 @@
 // The geometric kernel between two clusters of surface, averaged over their extent, for the
 // far links of hierarchical radiosity (hierarchical.cpp), which read it at the clusters' centres.
 
-#include "raytrace_core/math.h"
+#include "raytrace_core/util/math.h"
 
 namespace gilt::radiosity::solver {
 

@@ -6,11 +6,11 @@
 #include <numeric>
 
 #include "radiosity/mesh/element_scene.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::solver {
 
@@ -40,16 +40,16 @@ int element_grid_scale(float area, double mean_area) {
 
 }  // namespace
 
-std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry,
+std::vector<Rgb> element_punctual_irradiance(const rc::scene::Scene& scene, const rc::scene::Scene& geometry,
                                              const RadiosityMesh& mesh, int samples, uint64_t seed,
-                                             uint64_t& rays, rc::Progress* progress) {
+                                             uint64_t& rays, rc::util::Progress* progress) {
   const size_t ne = mesh.element_count();
   std::vector<Rgb> out(ne, Rgb(0.0f));
   if (scene.punctual_lights.empty()) return out;
   const int base_side = element_grid_side(samples);
   const double mean_area = mean_element_area(mesh);
   std::atomic<uint64_t> traced{0};
-  rc::parallel_for_owned((ne + 255) / 256, [&](size_t chunk) {
+  rc::util::parallel_for_owned((ne + 255) / 256, [&](size_t chunk) {
     uint64_t count = 0;
     std::vector<int> pairing;
     for (size_t e = chunk * 256; e < std::min(ne, chunk * 256 + 256); ++e) {
@@ -60,8 +60,8 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
       const rc::Frame frame = rc::Frame::from_normal(n);
       Rgb sum(0.0f);
       for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
-        const rc::Light& light = scene.punctual_lights[li];
-        rc::Rng rng = rc::Rng::for_item(seed, e, 0xb000000000ull + li);
+        const rc::scene::Light& light = scene.punctual_lights[li];
+        rc::util::Rng rng = rc::util::Rng::for_item(seed, e, 0xb000000000ull + li);
         // Points stratified over the element and directions (sky) over the hemisphere, their
         // strata paired at random.
         std::iota(pairing.begin(), pairing.end(), 0);
@@ -69,19 +69,19 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
           std::swap(pairing[k - 1], pairing[std::min(k - 1, size_t(rng.uniform() * float(k)))]);
         for (int i = 0; i < side; ++i)
           for (int j = 0; j < side; ++j) {
-            const rc::Vec2 b = rc::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
+            const rc::Vec2 b = rc::util::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
             const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] +
                            b.y * mesh.positions[el[2]];
-            const rc::SurfacePoint at = mesh_surface_point(q, n);
+            const rc::scene::SurfacePoint at = mesh_surface_point(q, n);
             ++count;
-            if (light.kind == rc::LightKind::environment) {
+            if (light.kind == rc::scene::LightKind::environment) {
               const int k = pairing[size_t(i * side + j)];
               const rc::Vec2 u((k / side + rng.uniform()) / side, (k % side + rng.uniform()) / side);
-              const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(u));
-              if (!geometry.occluded(rc::spawn_shadow_ray_to_infinity(at, w))) sum += rc::environment_radiance(light, w) * kPi;
+              const Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(u));
+              if (!geometry.occluded(rc::scene::spawn_shadow_ray_to_infinity(at, w))) sum += rc::scene::environment_radiance(light, w) * kPi;
               continue;
             }
-            const rc::LightSample ls = rc::sample_light(scene, light, at, rng.uniform2());
+            const rc::scene::LightSample ls = rc::scene::sample_light(scene, light, at, rng.uniform2());
             const float cos_theta = glm::dot(ls.wi, n);
             if (!(cos_theta > 0.0f) || ls.radiance.is_black()) continue;
             if (!geometry.occluded(ls.shadow_ray)) sum += ls.radiance * cos_theta;
@@ -92,8 +92,8 @@ std::vector<Rgb> element_punctual_irradiance(const rc::Scene& scene, const rc::S
     traced += count;
     if (progress) progress->advance(std::min(ne, chunk * 256 + 256) - chunk * 256);
   });
-  rc::join_ranges(std::span(out), 256);
-  rays += rc::processes().total(traced);
+  rc::util::join_ranges(std::span(out), 256);
+  rays += rc::util::processes().total(traced);
   return out;
 }
 

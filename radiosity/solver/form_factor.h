@@ -7,7 +7,7 @@
 #include <span>
 #include <vector>
 
-#include "raytrace_core/math.h"
+#include "raytrace_core/util/math.h"
 
 namespace gilt::radiosity::solver {
 

@@ -45,12 +45,12 @@
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/ladder_forecast.h"
 #include "radiosity/solver/probe_fraction.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/progress.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::solver {
 
@@ -397,8 +397,8 @@ float towards(const Node& node, float total, const Vec3& moment, const Vec3& ome
 /// cluster holding a bright roof and a dark plate under it must not be seen through the plate.
 /// Children that both weigh nothing are taken by area. Uniform by area within the element.
 template <class Weight>
-rc::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint32_t s, Weight weight,
-                              rc::Rng& rng) {
+rc::scene::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint32_t s, Weight weight,
+                              rc::util::Rng& rng) {
   while (!tree.nodes[s].leaf()) {
     const uint32_t a = s + 1, b = tree.nodes[s].right;
     float wa = weight(a), wb = weight(b);
@@ -406,7 +406,7 @@ rc::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint3
     s = rng.uniform() * (wa + wb) < wa ? a : b;
   }
   const uint32_t e = tree.element(tree.nodes[s]);
-  const rc::Vec2 b = rc::sample_uniform_triangle(rng.uniform2());
+  const rc::Vec2 b = rc::util::sample_uniform_triangle(rng.uniform2());
   const auto& el = mesh.elements[e];
   const Vec3 q =
       (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
@@ -467,7 +467,7 @@ size_t count_as_one_process(const Items& items, std::span<const int> owner) {
   if (owner.empty()) return items.size();
   const size_t shared =
       size_t(std::count_if(items.begin(), items.end(), [&](const auto& x) { return owner[x.receiver] < 0; }));
-  return shared + size_t(rc::processes().total(items.size() - shared));
+  return shared + size_t(rc::util::processes().total(items.size() - shared));
 }
 
 class Linker {
@@ -507,7 +507,7 @@ class Linker {
   }
 
   /// Reports link()'s chunks of pairs as they finish (null: none).
-  Linker& reporting(rc::Progress* progress) {
+  Linker& reporting(rc::util::Progress* progress) {
     progress_ = progress;
     return *this;
   }
@@ -545,7 +545,7 @@ class Linker {
   std::optional<LinkLevel> link(std::span<const OpenPair> start) {
     LinkLevel level;
     if (tree_.nodes.empty()) return level;
-    const rc::Processes& group = rc::processes();
+    const rc::util::Processes& group = rc::util::processes();
     const uint64_t rays_before = counters_.rays, form_factors_before = counters_.form_factors;
     // Under several processes each refines only the pairs whose receiver is its own or above
     // the cut (see owners_of), and keeps only the links and pairs that land there. A pair's
@@ -567,7 +567,7 @@ class Linker {
     std::vector<LinkLevel> parts(per_chunk == 0 ? 0 : (frontier.size() + per_chunk - 1) / per_chunk);
     std::atomic<bool> stopped{false};
     if (progress_) progress_->set_total(parts.size());
-    rc::parallel_for(parts.size(), [&](size_t i) {
+    rc::util::parallel_for(parts.size(), [&](size_t i) {
       // The clock is read as each chunk starts and every 1,024 pairs within it, often enough to
       // stop within milliseconds even where a chunk holds few pairs, and the flag at every pair,
       // so chunks started after the stop end at once.
@@ -721,7 +721,7 @@ class Linker {
     both.extend(S.box);
     float visible = 1.0f;
     if (in_.may_be_blocked(both)) {
-      rc::Rng rng = rc::Rng::for_item(settings_.seed, r, stream + s);
+      rc::util::Rng rng = rc::util::Rng::for_item(settings_.seed, r, stream + s);
       const int n = std::max(1, settings_.link_rays);
       int open = 0;
       // The receiving end by what it faces towards the source, the source by what it sends.
@@ -731,9 +731,9 @@ class Linker {
       };
       auto sends = [&](uint32_t c) { return towards(tree_.nodes[c], power_[c], moment_[c], -w); };
       for (int i = 0; i < n; ++i) {
-        const rc::SurfacePoint a = sample_point(tree_, in_.mesh, r, receives, rng);
-        const rc::SurfacePoint b = sample_point(tree_, in_.mesh, s, sends, rng);
-        open += !in_.geometry.occluded(rc::spawn_shadow_ray(a, b));
+        const rc::scene::SurfacePoint a = sample_point(tree_, in_.mesh, r, receives, rng);
+        const rc::scene::SurfacePoint b = sample_point(tree_, in_.mesh, s, sends, rng);
+        open += !in_.geometry.occluded(rc::scene::spawn_shadow_ray(a, b));
       }
       count_for(r).rays += uint64_t(n);
       visible = float(open) / float(n);
@@ -780,7 +780,7 @@ class Linker {
   int rank_ = 0;
   bool keep_open_ = false;
   double keep_back_ = 0.0;
-  rc::Progress* progress_ = nullptr;
+  rc::util::Progress* progress_ = nullptr;
 };
 
 /// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
@@ -890,7 +890,7 @@ struct TreeWalk {
   const std::vector<Rgb>& power;
   const std::vector<Moments>& moment;
 
-  Rgb irradiance(size_t v, double epsilon, int rays, rc::Rng& rng, std::vector<uint32_t>& stack,
+  Rgb irradiance(size_t v, double epsilon, int rays, rc::util::Rng& rng, std::vector<uint32_t>& stack,
                  WalkCounts& counts) const {
     const RadiosityMesh& mesh = in.mesh;
     const Vec3 p = in.vertex_point[v].p, n = mesh.normals[v];
@@ -946,8 +946,9 @@ struct TreeWalk {
           // The vertex's visibility origins in turn, from a random one.
           const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
           for (int i = 0; i < count; ++i) {
-            const rc::SurfacePoint& at = in.visibility_origin[kVisibilityOrigins * v + (first + size_t(i)) % kVisibilityOrigins];
-            hits += !in.geometry.occluded(rc::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
+            const rc::scene::SurfacePoint& at = in.visibility_origin[kVisibilityOrigins * v + (first + size_t(i)) % kVisibilityOrigins];
+            hits += !in.geometry.occluded(
+                rc::scene::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
           }
           counts.rays += uint64_t(count);
           return hits;
@@ -1045,7 +1046,7 @@ struct HierarchicalSolve {
   const RadiosityMesh& mesh;
   const size_t ne, nv;
   // Under several processes rank 0's clock decides for all, so that they stay in step.
-  const rc::Processes& group = rc::processes();
+  const rc::util::Processes& group = rc::util::processes();
   Counters counters;
   std::chrono::steady_clock::time_point last_lap = std::chrono::steady_clock::now();
 
@@ -1217,10 +1218,10 @@ struct HierarchicalSolve {
       for (; g < to; ++g) above.push_back(g);
       if (c < parts.size()) g = first_at(parts[c].end);
     }
-    rc::parallel_for((above.size() + 63) / 64, [&](size_t chunk) {
+    rc::util::parallel_for((above.size() + 63) / 64, [&](size_t chunk) {
       for (size_t i = chunk * 64; i < std::min(above.size(), chunk * 64 + 64); ++i) gather_receivers(above[i], above[i] + 1);
     });
-    rc::parallel_for_owned(parts.size(), [&](size_t c) { gather_receivers(first_at(parts[c].root), first_at(parts[c].end)); });
+    rc::util::parallel_for_owned(parts.size(), [&](size_t c) { gather_receivers(first_at(parts[c].root), first_at(parts[c].end)); });
   }
 
   Rgb leaf_irradiance(size_t i) const {
@@ -1235,7 +1236,7 @@ struct HierarchicalSolve {
     packed.pack(tree, power, moment);
     std::fill(gathered.begin(), gathered.end(), Gathered{});
     if (group.count() == 1) {
-      rc::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
+      rc::util::parallel_for((receivers.size() + 63) / 64, [&](size_t chunk) {
         gather_receivers(chunk * 64, std::min(receivers.size(), chunk * 64 + 64));
       });
     } else {
@@ -1256,11 +1257,11 @@ struct HierarchicalSolve {
     }
     const std::vector<Subtree>& parts = cut.subtrees;
     std::vector<std::vector<Rgb>> values(parts.size());
-    rc::parallel_for_owned(parts.size(), [&](size_t c) {
+    rc::util::parallel_for_owned(parts.size(), [&](size_t c) {
       for (uint32_t i = parts[c].root; i < parts[c].end; ++i)
         if (tree.nodes[i].leaf()) values[c].push_back(leaf_irradiance(i));
     });
-    rc::join_chunks(values);
+    rc::util::join_chunks(values);
     for (size_t c = 0; c < parts.size(); ++c) {
       size_t k = 0;
       for (uint32_t i = parts[c].root; i < parts[c].end; ++i)
@@ -1409,7 +1410,7 @@ struct HierarchicalSolve {
     result.tail_added = false;
     // The count of gathers is not known ahead (the iteration stops at the tolerance): the
     // progress counts them against the most there may be.
-    rc::Progress progress("radiosity: iterating", uint64_t(std::max(0, settings.max_iterations - result.iterations)),
+    rc::util::Progress progress("radiosity: iterating", uint64_t(std::max(0, settings.max_iterations - result.iterations)),
                           "gathers", settings.progress);
     while (result.iterations < settings.max_iterations) {
       if (out_of_time()) break;
@@ -1611,7 +1612,7 @@ struct HierarchicalSolve {
     Linker linker = linker_at(plan.tolerance);
     char label[64];
     std::snprintf(label, sizeof label, "radiosity: linking at tolerance %.3g", plan.tolerance);
-    rc::Progress progress(label, 0, "chunks of pairs", settings.progress);
+    rc::util::Progress progress(label, 0, "chunks of pairs", settings.progress);
     linker.owned_by(cut.owner, group.rank()).keeping_open_pairs(!plan.last).keeping_back(plan.reserve).reporting(&progress);
     const auto link_start = std::chrono::steady_clock::now();
     std::optional<LinkLevel> made = linker.link(plan.expanded ? std::span<const OpenPair>(plan.start)
@@ -1698,11 +1699,11 @@ struct HierarchicalSolve {
   /// gathered_at; adds to the counters. False when time ran out first on any process, or when
   /// fewer than `keep_back` seconds were left (0: none kept back).
   bool gather_at(const TreeWalk& walker, const std::vector<uint32_t>& list, double keep_back = 0.0,
-                 rc::Progress* progress = nullptr) {
+                 rc::util::Progress* progress = nullptr) {
     std::atomic<bool> stopped{false};
     const uint64_t rays_before = counters.rays, nodes_before = counters.gather_nodes,
                    form_factors_before = counters.form_factors;
-    rc::parallel_for_owned((list.size() + 63) / 64, [&](size_t chunk) {
+    rc::util::parallel_for_owned((list.size() + 63) / 64, [&](size_t chunk) {
       if (stopped.load(std::memory_order_relaxed) || (in.out_of_time && in.out_of_time()) ||
           (keep_back > 0.0 && in.seconds_left && in.seconds_left() < keep_back)) {
         stopped = true;
@@ -1714,7 +1715,7 @@ struct HierarchicalSolve {
         const uint32_t v = list[i];
         const double epsilon = settings.gather_tolerance *
                                std::max(double(result.vertex_irradiance[v].average()), 0.05 * mean_indirect);
-        rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5200000000ull);
+        rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, v, 0x5200000000ull);
         gathered_at[v] = walker.irradiance(v, epsilon, 1, rng, stack, walk);
       }
       counters.rays += walk.rays;
@@ -1725,7 +1726,7 @@ struct HierarchicalSolve {
     if (group.count() == 1) return !stopped;
     std::vector<Rgb> values(list.size());
     for (size_t i = 0; i < list.size(); ++i) values[i] = gathered_at[list[i]];
-    rc::join_ranges(std::span(values), 64);
+    rc::util::join_ranges(std::span(values), 64);
     for (size_t i = 0; i < list.size(); ++i) gathered_at[list[i]] = values[i];
     counters.rays = rays_before + group.total(counters.rays - rays_before);
     counters.gather_nodes = nodes_before + group.total(counters.gather_nodes - nodes_before);
@@ -1785,7 +1786,7 @@ struct HierarchicalSolve {
       result.final_gather_note = note;
       complete = false;
     } else if (complete) {
-      rc::Progress progress("radiosity: final gather", rest.size(), "vertices", settings.progress);
+      rc::util::Progress progress("radiosity: final gather", rest.size(), "vertices", settings.progress);
       complete = gather_at(walker, rest, 0.0, &progress);
       result.final_gather = complete;
       result.final_gather_note = complete ? "at every vertex" : "stopped by --time";
@@ -1830,17 +1831,17 @@ std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const
   const double epsilon = settings.gather_tolerance * total / area;
   std::atomic<uint64_t> ray_count{0};
   const size_t count = nv - first_vertex;
-  rc::parallel_for_owned((count + 63) / 64, [&](size_t chunk) {
+  rc::util::parallel_for_owned((count + 63) / 64, [&](size_t chunk) {
     WalkCounts walk;
     std::vector<uint32_t> stack;
     for (size_t v = first_vertex + chunk * 64; v < std::min(nv, first_vertex + chunk * 64 + 64); ++v) {
-      rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x5300000000ull);
+      rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, v, 0x5300000000ull);
       out[v] = walker.irradiance(v, epsilon, rays, rng, stack, walk);
     }
     ray_count += walk.rays;
   });
-  rc::join_ranges(std::span(out), 64, first_vertex);
-  if (shadow_rays) *shadow_rays += rc::processes().total(ray_count);
+  rc::util::join_ranges(std::span(out), 64, first_vertex);
+  if (shadow_rays) *shadow_rays += rc::util::processes().total(ray_count);
   return out;
 }
 

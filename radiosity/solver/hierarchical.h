@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/rgb.h"
+#include "raytrace_core/util/rgb.h"
 
 namespace gilt::radiosity::solver {
 
@@ -48,7 +48,7 @@ struct HierarchicalSettings {
   /// vertex takes the area-weighted mean of its elements' gathered irradiance.
   FinalGather final_gather = FinalGather::automatic;
   uint64_t seed = 0;
-  bool progress = false;  ///< report linking, iterating and the final gather on stderr (rc::Progress)
+  bool progress = false;  ///< report linking, iterating and the final gather on stderr (rc::util::Progress)
 };
 
 /// How many points each vertex's visibility rays start from (see visibility_origins in solver.h).
@@ -59,9 +59,10 @@ inline constexpr size_t kVisibilityOrigins = 4;
 /// vertex's direct irradiance.
 struct HierarchicalInput {
   const mesh::RadiosityMesh& mesh;
-  const rc::Scene& geometry;
-  std::span<const rc::SurfacePoint> vertex_point;  ///< per vertex: receiver point (see receiver_points)
-  std::span<const rc::SurfacePoint> visibility_origin;  ///< kVisibilityOrigins per vertex (see visibility_origins)
+  const rc::scene::Scene& geometry;
+  std::span<const rc::scene::SurfacePoint>
+      vertex_point;  ///< per vertex: receiver point (see receiver_points)
+  std::span<const rc::scene::SurfacePoint> visibility_origin;  ///< kVisibilityOrigins per vertex (see visibility_origins)
   std::span<const Rgb> albedo;                     ///< per element
   std::span<const Rgb> direct_irradiance;          ///< per vertex, W·m⁻²
   /// Whether a segment between the two boxes' contents may be blocked at all (false: no rays).

@@ -25,14 +25,14 @@
 #include "radiosity/solver/element_direct.h"
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/probe_fraction.h"
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/processes.h"
-#include "raytrace_core/progress.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/processes.h"
+#include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::solver {
 
@@ -72,8 +72,8 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> element_fans(const Radio
 /// close lies behind part of the mesh around it.
 /// Probing stops once `enough` backs are seen (the callers only compare the count with the
 /// fewest so far, or with zero).
-int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach, int enough) {
-  const rc::SurfacePoint at = surface_point(p, n);
+int backs_seen(const rc::scene::Scene& scene, const Vec3& p, const Vec3& n, float reach, int enough) {
+  const rc::scene::SurfacePoint at = surface_point(p, n);
   const rc::Frame frame = rc::Frame::from_normal(n);
   static const std::array<Vec3, 5> dirs = {Vec3(0.0f, 0.0f, 1.0f), Vec3(0.8660254f, 0.0f, 0.5f),
                                            Vec3(-0.8660254f, 0.0f, 0.5f), Vec3(0.0f, 0.8660254f, 0.5f),
@@ -81,9 +81,9 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
   int backs = 0;
   for (const Vec3& d : dirs) {
     if (backs >= enough) break;
-    rc::Ray ray = rc::spawn_ray(at, frame.to_world(d));
+    rc::scene::Ray ray = rc::scene::spawn_ray(at, frame.to_world(d));
     ray.tmax = reach;
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     backs += hit && !scene.surface(ray, *hit).front_face;
   }
   return backs;
@@ -104,11 +104,11 @@ int backs_seen(const rc::Scene& scene, const Vec3& p, const Vec3& n, float reach
 /// (backs_seen, reaching twice the element's size) meet no back is taken, or else the one that
 /// meets fewest. (Traced against the input instead of the elements, the milk truck's rounded
 /// roof edge came out as a ragged black band.)
-std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh& mesh, rc::Progress* progress) {
+std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const RadiosityMesh& mesh, rc::util::Progress* progress) {
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<Vec3> origin(mesh.positions);
-  rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
+  rc::util::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
     for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
       const Vec3 p = mesh.positions[v], n = mesh.normals[v];
       int fewest = std::numeric_limits<int>::max();
@@ -134,16 +134,16 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const RadiosityMesh
     }
     if (progress) progress->advance(std::min(nv, chunk * 256 + 256) - chunk * 256);
   });
-  rc::join_ranges(std::span(origin), 256);
+  rc::util::join_ranges(std::span(origin), 256);
   return origin;
 }
 
-std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, const RadiosityMesh& mesh,
-                                                 std::span<const Vec3> receivers, rc::Progress* progress) {
+std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& geometry, const RadiosityMesh& mesh,
+                                                 std::span<const Vec3> receivers, rc::util::Progress* progress) {
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
-  std::vector<rc::SurfacePoint> out(kVisibilityOrigins * nv);
-  rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
+  std::vector<rc::scene::SurfacePoint> out(kVisibilityOrigins * nv);
+  rc::util::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
     for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
       const Vec3 p = mesh.positions[v];
       const size_t count = offsets[v + 1] - offsets[v];
@@ -170,7 +170,7 @@ std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, cons
     }
     if (progress) progress->advance(std::min(nv, chunk * 256 + 256) - chunk * 256);
   });
-  rc::join_ranges(std::span(out), 256 * kVisibilityOrigins);
+  rc::util::join_ranges(std::span(out), 256 * kVisibilityOrigins);
   return out;
 }
 
@@ -181,7 +181,7 @@ namespace {
 /// boundary planes, so elements lying on a plane that has every mesh vertex on its front (a wall
 /// of the room) never block anything; what remains are the blocks, spheres and other objects
 /// inside, plus every mirror and dielectric (meshed or not, they are opaque to the solver).
-std::vector<rc::Bounds3> occluder_boxes(const rc::Scene& scene, const RadiosityMesh& mesh) {
+std::vector<rc::Bounds3> occluder_boxes(const rc::scene::Scene& scene, const RadiosityMesh& mesh) {
   // Distinct element planes: a box has six, however finely it is meshed.
   const float scale = std::max(1e-30f, scene.bounds().radius());
   const float eps = 1e-4f * scale;
@@ -215,13 +215,13 @@ std::vector<rc::Bounds3> occluder_boxes(const rc::Scene& scene, const RadiosityM
   }
   std::vector<rc::Bounds3> boxes;
   for (auto& [surface, b] : by_surface) boxes.push_back(b);
-  for (const rc::TriangleMesh& m : scene.meshes) {
+  for (const rc::scene::TriangleMesh& m : scene.meshes) {
     if (!scene.materials[m.material].is_traced_through()) continue;
     rc::Bounds3 b;
     for (uint32_t i : m.indices) b.extend(m.positions[i]);
     if (!b.empty()) boxes.push_back(b);
   }
-  for (const rc::Sphere& sp : scene.spheres)
+  for (const rc::scene::Sphere& sp : scene.spheres)
     if (scene.materials[sp.material].is_traced_through()) boxes.push_back({sp.center - Vec3(sp.radius), sp.center + Vec3(sp.radius)});
   // Grow each box by the rounding slack so the test stays conservative.
   for (rc::Bounds3& b : boxes) {
@@ -316,11 +316,11 @@ Patches build_patches(const RadiosityMesh& mesh, int patch_elements) {
 
 /// Irradiance at a vertex with unit normal n from a punctual or environment light of `scene`,
 /// with visibility traced against `geometry` from the vertex's visibility origins `from`.
-Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const rc::Light& light,
-                        std::span<const rc::SurfacePoint> from, const Vec3& n, rc::Rng& rng, int samples,
-                        uint64_t& rays) {
+Rgb punctual_irradiance(const rc::scene::Scene& scene, const rc::scene::Scene& geometry,
+                        const rc::scene::Light& light, std::span<const rc::scene::SurfacePoint> from,
+                        const Vec3& n, rc::util::Rng& rng, int samples, uint64_t& rays) {
   const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));  // rays take the origins in turn
-  if (light.kind == rc::LightKind::environment) {
+  if (light.kind == rc::scene::LightKind::environment) {
     // E = ∫ L V cos dω, by cosine-weighted stratified directions: π times the mean of L over
     // the unblocked ones (π L times the fraction unblocked for a constant sky).
     const rc::Frame frame = rc::Frame::from_normal(n);
@@ -330,13 +330,13 @@ Rgb punctual_irradiance(const rc::Scene& scene, const rc::Scene& geometry, const
       for (int j = 0; j < side; ++j) {
         const rc::Vec2 u((i + rng.uniform()) / side, (j + rng.uniform()) / side);
         ++rays;
-        const rc::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
-        const Vec3 w = frame.to_world(rc::sample_cosine_hemisphere(u));
-        if (!geometry.occluded(rc::spawn_shadow_ray_to_infinity(at, w))) open += rc::environment_radiance(light, w);
+        const rc::scene::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
+        const Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(u));
+        if (!geometry.occluded(rc::scene::spawn_shadow_ray_to_infinity(at, w))) open += rc::scene::environment_radiance(light, w);
       }
     return open * (kPi / float(side * side));
   }
-  const rc::LightSample ls = rc::sample_light(scene, light, from[first], rng.uniform2());
+  const rc::scene::LightSample ls = rc::scene::sample_light(scene, light, from[first], rng.uniform2());
   const float cos_theta = glm::dot(ls.wi, n);
   if (!(cos_theta > 0.0f) || ls.radiance.is_black()) return Rgb(0.0f);
   ++rays;
@@ -411,31 +411,33 @@ struct Counts {
 
 /// What receives light: the mesh with the points its vertices receive at, and the occluders.
 struct Receivers {
-  const rc::Scene& scene;                   ///< the input: its lights
+  const rc::scene::Scene& scene;                   ///< the input: its lights
   const RadiosityMesh& mesh;
-  rc::Scene geometry;                       ///< what visibility rays are traced against (element_scene)
+  rc::scene::Scene geometry;                ///< what visibility rays are traced against (element_scene)
   std::vector<Vec3> origin;                 ///< per vertex, see receiver_points
-  std::vector<rc::SurfacePoint> point;      ///< per vertex: origin as a surface point
-  std::vector<rc::SurfacePoint> spread;     ///< kVisibilityOrigins per vertex, where its shadow rays start
+  std::vector<rc::scene::SurfacePoint> point;      ///< per vertex: origin as a surface point
+  std::vector<rc::scene::SurfacePoint>
+      spread;  ///< kVisibilityOrigins per vertex, where its shadow rays start
   std::vector<rc::Bounds3> occluders;
 
   bool progress = false;                    ///< report placing the receivers on stderr
 
-  Receivers(const rc::Scene& s, const RadiosityMesh& m, bool report)
+  Receivers(const rc::scene::Scene& s, const RadiosityMesh& m, bool report)
       : scene(s), mesh(m), occluders(occluder_boxes(s, m)), progress(report) {
     update();
   }
   void update() {
     geometry = element_scene(scene, mesh);
-    rc::Progress placing("radiosity: placing receivers", 2 * mesh.vertex_count(), "vertices", progress);
+    rc::util::Progress placing("radiosity: placing receivers", 2 * mesh.vertex_count(), "vertices", progress);
     origin = receiver_points(geometry, mesh, &placing);
     point.resize(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) point[v] = surface_point(origin[v], mesh.normals[v]);
     spread = visibility_origins(geometry, mesh, origin, &placing);
   }
   /// Vertex v's visibility origins.
-  std::span<const rc::SurfacePoint> origins(size_t v) const {
-    return std::span<const rc::SurfacePoint>(spread).subspan(kVisibilityOrigins * v, kVisibilityOrigins);
+  std::span<const rc::scene::SurfacePoint> origins(size_t v) const {
+    return std::span<const rc::scene::SurfacePoint>(spread).subspan(kVisibilityOrigins * v,
+                                                                    kVisibilityOrigins);
   }
 
   /// A patch's shares of what a vertex receives, per element, as a running sum for sampling
@@ -475,9 +477,9 @@ struct Receivers {
   /// shadow rays: points on the patch, each drawn in proportion to what its element sends to v,
   /// a ray from one of v's origins (taken in turn) to the point at u of the patch's sample
   /// square, whose u.x picks the element by the running sum and is then stretched back to [0, 1).
-  Rgb visible(const ShootingPatch& src, size_t v, const Shares& shares, const Rgb& gathered, rc::Rng& rng,
-              Counts& counts) const {
-    const std::span<const rc::SurfacePoint> from = origins(v);
+  Rgb visible(const ShootingPatch& src, size_t v, const Shares& shares, const Rgb& gathered,
+              rc::util::Rng& rng, Counts& counts) const {
+    const std::span<const rc::scene::SurfacePoint> from = origins(v);
     const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
     size_t ray_index = 0;
     const auto& cdf = shares.cdf;
@@ -487,13 +489,13 @@ struct Receivers {
       k = std::min(k, shares.last);
       const float lo = k ? cdf[k - 1] : 0.0f;
       ux = std::clamp((ux - lo) / std::max(cdf[k] - lo, 1e-30f), 0.0f, rc::kOneMinusEpsilon);
-      const rc::Vec2 bary = rc::sample_uniform_triangle({ux, uy});
+      const rc::Vec2 bary = rc::util::sample_uniform_triangle({ux, uy});
       const auto& el = mesh.elements[src.elements[k]];
       const Vec3 q = (1.0f - bary.x - bary.y) * mesh.positions[el[0]] + bary.x * mesh.positions[el[1]] +
                      bary.y * mesh.positions[el[2]];
       ++counts.rays;
-      const rc::SurfacePoint& at = from[(first + ray_index++) % kVisibilityOrigins];
-      return geometry.occluded(rc::spawn_shadow_ray(at, surface_point(q, mesh.element_normal[src.elements[k]]))) ? 0 : 1;
+      const rc::scene::SurfacePoint& at = from[(first + ray_index++) % kVisibilityOrigins];
+      return geometry.occluded(rc::scene::spawn_shadow_ray(at, surface_point(q, mesh.element_normal[src.elements[k]]))) ? 0 : 1;
     };
     // A point drawn uniformly in quarter j of the square (x by bit 0, y by bit 1).
     auto open_in_quarter = [&](int j) {
@@ -532,7 +534,7 @@ struct Receivers {
   /// factor times its radiosity, times the patch's visible fraction seen from v. `kept`, when
   /// given, holds the patch's form factors at v (one per element): read when `known`, else
   /// computed and stored there.
-  Rgb receive(const ShootingPatch& src, size_t v, rc::Rng& rng, Counts& counts, float* kept = nullptr,
+  Rgb receive(const ShootingPatch& src, size_t v, rc::util::Rng& rng, Counts& counts, float* kept = nullptr,
               bool known = false) const {
     const Vec3& p = origin[v];
     const Vec3& n = mesh.normals[v];
@@ -592,13 +594,13 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 /// Meshes the scene (solve's first step). Reads the settings; writes sol.mesh, its report and
 /// sol.mesh_seconds.
-void mesh_scene(const rc::Scene& scene, const SolverSettings& settings, std::chrono::steady_clock::time_point start,
+void mesh_scene(const rc::scene::Scene& scene, const SolverSettings& settings, std::chrono::steady_clock::time_point start,
                 Solution& sol) {
   MeshSettings mesh_settings = settings.mesh;
   mesh_settings.progress = settings.progress;
   // Under --time, imprinting and remeshing end at meshing's share of the budget; the pieces not
   // begun by then are left as they were. Processes must all mesh alike, so several never cut it short.
-  if (settings.time_limit > 0.0 && rc::processes().count() == 1)
+  if (settings.time_limit > 0.0 && rc::util::processes().count() == 1)
     mesh_settings.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                          std::chrono::duration<double>(kMeshShare * settings.time_limit));
   sol.mesh = build_mesh(scene, mesh_settings, &sol.mesh_report);
@@ -624,7 +626,7 @@ struct Shooting {
 
 /// The state of one solve (below), on the mesh it made, which its passes read and write in turn.
 struct SolveState {
-  SolveState(const rc::Scene& s, const SolverSettings& st, Solution& so, std::chrono::steady_clock::time_point t)
+  SolveState(const rc::scene::Scene& s, const SolverSettings& st, Solution& so, std::chrono::steady_clock::time_point t)
       : scene(s), settings(st), sol(so), start(t), mesh(so.mesh), receivers(s, so.mesh, st.progress),
         strata(std::max(1, int(std::round(std::sqrt(double(st.visibility_samples)))))) {
     sol.convex_enclosure = receivers.occluders.empty();
@@ -637,7 +639,7 @@ struct SolveState {
     hs.progress = settings.progress;
   }
 
-  const rc::Scene& scene;
+  const rc::scene::Scene& scene;
   const SolverSettings& settings;
   Solution& sol;
   const std::chrono::steady_clock::time_point start;
@@ -648,7 +650,7 @@ struct SolveState {
   // Under several processes (mpirun) each computes the chunks of vertices or elements it owns
   // and the results are joined, so every process holds one process's arrays. The counts of such
   // a loop are summed over the processes, and rank 0's clock makes every decision about time.
-  const rc::Processes& group = rc::processes();
+  const rc::util::Processes& group = rc::util::processes();
   bool hierarchical = false;
   HierarchicalSettings hs;
   std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
@@ -657,7 +659,7 @@ struct SolveState {
   double direct_rays_per_second = 0.0;  // the last gather_direct's shadow rays per second (0: none)
 
   double elapsed() const { return seconds_since(start); }
-  auto albedo(uint32_t material) const { return rc::diffuse_reflectance(scene.materials[material]); }
+  auto albedo(uint32_t material) const { return rc::scene::diffuse_reflectance(scene.materials[material]); }
   auto emitted(uint32_t material) const { return scene.materials[material].emission * kPi; }  // B0 = π Le
   bool is_emitter(uint32_t e) const { return !scene.materials[mesh.element_material[e]].emission.is_black(); }
   void add_counts(const Counts& c) {
@@ -735,28 +737,29 @@ struct SolveState {
     const size_t count = nv_now - first_vertex;
     const uint64_t rays_before = rays, form_factors_before = form_factors, skipped_before = skipped;
     const double seconds_before = elapsed();
-    rc::Progress progress("radiosity: direct light", count, "vertices", settings.progress);
-    rc::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
+    rc::util::Progress progress("radiosity: direct light", count, "vertices", settings.progress);
+    rc::util::parallel_for_owned((count + 127) / 128, [&](size_t chunk) {
       Counts counts;
       for (size_t v = first_vertex + chunk * 128; v < std::min(nv_now, first_vertex + chunk * 128 + 128); ++v) {
         for (size_t li = 0; li < scene.punctual_lights.size(); ++li) {
-          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
-          const rc::Light& light = scene.punctual_lights[li];
+          rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, v, 0x9000000000ull + li);
+          const rc::scene::Light& light = scene.punctual_lights[li];
           const Rgb e = punctual_irradiance(scene, receivers.geometry, light, receivers.origins(v), mesh.normals[v], rng,
                                             settings.visibility_samples, counts.rays);
           direct_punctual[v] += e;
-          if (light.kind != rc::LightKind::environment) direct_delta[v] += e;
+          if (light.kind != rc::scene::LightKind::environment) direct_delta[v] += e;
         }
         for (size_t q = 0; q < emitters.size(); ++q) {
           // Keyed by the emitter's first element, which refinement never renumbers.
-          rc::Rng rng = rc::Rng::for_item(settings.seed, v, 0xa000000000ull + emitters[q].elements[0]);
+          rc::util::Rng rng =
+              rc::util::Rng::for_item(settings.seed, v, 0xa000000000ull + emitters[q].elements[0]);
           direct_emitted[v] += receivers.receive(emitters[q], v, rng, counts);
         }
       }
       add_counts(counts);
       progress.advance(std::min(nv_now, first_vertex + chunk * 128 + 128) - (first_vertex + chunk * 128));
     });
-    for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::join_ranges(std::span(*values), 128, first_vertex);
+    for (auto* values : {&direct_punctual, &direct_delta, &direct_emitted}) rc::util::join_ranges(std::span(*values), 128, first_vertex);
     joined_counts(rays_before, form_factors_before, skipped_before);
     const double seconds = elapsed() - seconds_before;
     if (rays > rays_before && seconds > 0.0) direct_rays_per_second = double(rays - rays_before) / seconds;
@@ -913,15 +916,15 @@ struct SolveState {
       shot.cached_bytes += row_bytes;
     }
     std::vector<Rgb>& received = shot.received;
-    rc::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
+    rc::util::parallel_for_owned((nv + 255) / 256, [&](size_t chunk) {
       Counts counts;
       for (size_t v = chunk * 256; v < std::min(nv, chunk * 256 + 256); ++v) {
-        rc::Rng rng = rc::Rng::for_item(settings.seed, v, shot_index);
+        rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, v, shot_index);
         received[v] = receivers.receive(shot.source, v, rng, counts, row.empty() ? nullptr : &row[v * width], known);
       }
       add_counts(counts);
     });
-    rc::join_ranges(std::span(received), 256);
+    rc::util::join_ranges(std::span(received), 256);
     joined_counts(rays_before, form_factors_before, skipped_before);
     // Vertex irradiance → element unshot radiosity: ρ_e times the mean of its vertices' gain.
     for (size_t v = 0; v < nv; ++v) sol.vertex_irradiance[v] += received[v];
@@ -956,7 +959,7 @@ struct SolveState {
     Shooting shot;
     start_shooting(shot);
     // Progress in per mille of the way from the emitted power down to tolerance × emitted, on a log scale.
-    rc::Progress progress("radiosity", 1000, "‰", settings.progress);
+    rc::util::Progress progress("radiosity", 1000, "‰", settings.progress);
     uint64_t shown = 0;
     shot.received.assign(nv, Rgb(0.0f));
     while (shot.emitted_power > 0.0) {
@@ -1035,7 +1038,7 @@ struct SolveState {
     // What each element reflects of the direct light: its own mean of the lights' irradiance,
     // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
     uint64_t element_rays = 0;
-    rc::Progress progress("radiosity: direct light on elements", ne, "elements", settings.progress);
+    rc::util::Progress progress("radiosity: direct light on elements", ne, "elements", settings.progress);
     std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh, element_direct_samples(),
                                                                   settings.seed, element_rays, &progress);
     progress.finish();
@@ -1110,7 +1113,7 @@ SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::s
   return SolverKind::progressive;
 }
 
-SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
+SolvePlan plan_solve(const rc::scene::Scene& scene, const SolverSettings& settings) {
   if (!scene.committed()) throw std::logic_error("radiosity::solver::plan_solve: the scene was not committed");
   SolvePlan plan;
   MeshReport report;
@@ -1130,12 +1133,12 @@ SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings) {
   plan.convex_enclosure = plan.occluder_boxes == 0;
   plan.punctual_lights = scene.punctual_lights.size();
   plan.solver = choose_solver(settings, plan.elements, &plan.solver_reason);
-  for (const rc::TriangleMesh& m : scene.meshes) plan.specular_surfaces += scene.materials[m.material].is_traced_through();
-  for (const rc::Sphere& s : scene.spheres) plan.specular_surfaces += scene.materials[s.material].is_traced_through();
+  for (const rc::scene::TriangleMesh& m : scene.meshes) plan.specular_surfaces += scene.materials[m.material].is_traced_through();
+  for (const rc::scene::Sphere& s : scene.spheres) plan.specular_surfaces += scene.materials[s.material].is_traced_through();
   return plan;
 }
 
-Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
+Solution solve(const rc::scene::Scene& scene, const SolverSettings& settings) {
   if (!scene.committed()) throw std::logic_error("radiosity::solver::solve: the scene was not committed");
   if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance))
     throw rc::InputError("--tolerance must be a positive number");
@@ -1144,7 +1147,7 @@ Solution solve(const rc::Scene& scene, const SolverSettings& settings) {
   if (!(settings.subdivision_threshold > 0.0) || !std::isfinite(settings.subdivision_threshold))
     throw rc::InputError("the subdivision threshold must be a positive number");
   const auto start = std::chrono::steady_clock::now();
-  const rc::ThreadLimit limit(settings.threads);
+  const rc::util::ThreadLimit limit(settings.threads);
 
   Solution sol;
   mesh_scene(scene, settings, start, sol);

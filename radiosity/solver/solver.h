@@ -14,8 +14,8 @@
 
 #include "radiosity/solver/hierarchical.h"
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/progress.h"
-#include "raytrace_core/rgb.h"
+#include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/rgb.h"
 
 namespace gilt::radiosity::solver {
 
@@ -127,8 +127,8 @@ struct Solution {
 /// Where each vertex of the mesh receives light: just inside one of its elements and in front of
 /// the mesh's other elements (see solver.cpp). `geometry` is element_scene() of the mesh, whose
 /// rays place the points. Advances `progress` (if any) by one per vertex.
-std::vector<Vec3> receiver_points(const rc::Scene& geometry, const mesh::RadiosityMesh& mesh,
-                                  rc::Progress* progress = nullptr);
+std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const mesh::RadiosityMesh& mesh,
+                                  rc::util::Progress* progress = nullptr);
 
 /// Where each vertex's visibility rays start: kVisibilityOrigins points per vertex (vertex v's at
 /// [v · kVisibilityOrigins, (v + 1) · kVisibilityOrigins)), towards the centroids of elements
@@ -138,8 +138,8 @@ std::vector<Vec3> receiver_points(const rc::Scene& geometry, const mesh::Radiosi
 /// on Šibenik, vertices where a moulding meets a wall saw every light through the wall's edge
 /// and came out black while the surface on either side was lit. Advances `progress` (if any)
 /// by one per vertex.
-std::vector<rc::SurfacePoint> visibility_origins(const rc::Scene& geometry, const mesh::RadiosityMesh& mesh,
-                                                 std::span<const Vec3> receivers, rc::Progress* progress = nullptr);
+std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& geometry, const mesh::RadiosityMesh& mesh,
+                                                 std::span<const Vec3> receivers, rc::util::Progress* progress = nullptr);
 
 /// The solver `settings` asks for on a mesh of `elements` elements, and why.
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why = nullptr);
@@ -149,7 +149,7 @@ SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::s
 double seconds_kept_back(const SolverSettings& settings, size_t elements);
 
 /// Meshes and solves the committed scene.
-Solution solve(const rc::Scene& scene, const SolverSettings& settings);
+Solution solve(const rc::scene::Scene& scene, const SolverSettings& settings);
 
 /// What solve() will do on a scene, found by meshing it without solving.
 struct SolvePlan {
@@ -168,6 +168,6 @@ struct SolvePlan {
   std::string solver_reason;
   std::vector<std::pair<std::string, double>> mesh_stage_seconds;  ///< see MeshReport::stage_seconds
 };
-SolvePlan plan_solve(const rc::Scene& scene, const SolverSettings& settings);
+SolvePlan plan_solve(const rc::scene::Scene& scene, const SolverSettings& settings);
 
 }  // namespace gilt::radiosity::solver

@@ -11,7 +11,7 @@
 #include <draco/core/draco_types.h>
 #include <tiny_gltf.h>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 namespace {
 
@@ -315,4 +315,4 @@ std::string DracoLog::first_problem(const tinygltf::Model& model) const {
   return {};
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

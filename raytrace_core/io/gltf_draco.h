@@ -23,7 +23,7 @@ class Value;
 struct Primitive;
 }  // namespace tinygltf
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 /// Decodes one primitive's KHR_draco_mesh_compression `extension` into `model` (see above).
 /// Called by tinygltf while it parses the mesh holding `primitive`, which is therefore not yet in
@@ -56,4 +56,4 @@ class DracoLog {
   DracoLog* outer_;
 };
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

@@ -3,11 +3,11 @@
 #include <cctype>
 #include <sstream>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/gltf_draco.h"
 #include "raytrace_core/io/loaders.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 namespace {
 
 // tinygltf hands every image's encoded bytes to this callback, which would normally decode them.
@@ -83,4 +83,4 @@ bool gltf_extension_supported(const std::string& name) {
          name == "KHR_texture_transform" || name == "KHR_draco_mesh_compression";
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

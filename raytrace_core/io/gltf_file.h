@@ -14,7 +14,7 @@
 
 #include <tiny_gltf.h>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 /// The model in `file` (.glb read as binary, anything else as text). tinygltf's warnings, one
 /// per line, are appended to *warnings when given, except its notes on image files it cannot
@@ -28,4 +28,4 @@ tinygltf::Model read_gltf_file(const std::string& file, std::vector<std::string>
 /// True for the glTF extensions gilt reads, the ones a file may list in extensionsRequired.
 bool gltf_extension_supported(const std::string& name);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

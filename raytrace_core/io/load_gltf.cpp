@@ -13,7 +13,7 @@
 //   m = 1, r² ≤ kMinGgxAlpha, untextured     → mirror, reflectance base
 //   m = 0, KHR_materials_specular's specularFactor = 0 → diffuse (F0 = 0: exactly Lambertian)
 //   otherwise                               → metallic_roughness (the specification's appendix B,
-//       raytrace_core/bsdf.cpp), ior from KHR_materials_ior for the dielectric's F0
+//       raytrace_core/scene/bsdf.cpp), ior from KHR_materials_ior for the dielectric's F0
 //   emission = emissiveFactor × KHR_materials_emissive_strength; doubleSided → two-sided emission
 // Photometric light units are read as radiometric: point/spot intensity (cd) as W·sr⁻¹,
 // directional illuminance (lx) as W·m⁻², i.e. no 683 lm/W factor.
@@ -48,11 +48,11 @@
 #include "raytrace_core/io/gltf_file.h"
 #include <glm/gtc/quaternion.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/microfacet.h"
+#include "raytrace_core/scene/microfacet.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 namespace fs = std::filesystem;
 
@@ -133,23 +133,23 @@ bool file_holds(const fs::path& path, const unsigned char* bytes, size_t size) {
 }
 
 /// The texture wrap mode of a glTF sampler's wrapS or wrapT value.
-bool wrap_mode(int gl_wrap, TextureWrap& out) {
+bool wrap_mode(int gl_wrap, scene::TextureWrap& out) {
   switch (gl_wrap) {
     case TINYGLTF_TEXTURE_WRAP_REPEAT:
-      out = TextureWrap::repeat;
+      out = scene::TextureWrap::repeat;
       return true;
     case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
-      out = TextureWrap::clamp;
+      out = scene::TextureWrap::clamp;
       return true;
     case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
-      out = TextureWrap::mirror;
+      out = scene::TextureWrap::mirror;
       return true;
     default:
       return false;
   }
 }
 
-Material convert_material(const tinygltf::Material& gm, const std::string& name) {
+scene::Material convert_material(const tinygltf::Material& gm, const std::string& name) {
   const tinygltf::PbrMetallicRoughness& pbr = gm.pbrMetallicRoughness;
   const Rgb base = clamp(rgb_or(pbr.baseColorFactor, Rgb(1.0f)), 0.0f, 1.0f);
   const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
@@ -159,7 +159,7 @@ Material convert_material(const tinygltf::Material& gm, const std::string& name)
   float ior = float(number_or(extension(gm.extensions, "KHR_materials_ior"), "ior", 1.5));
   if (!(ior >= 1.0f) || !std::isfinite(ior)) ior = 1.5f;  // the extension allows ior = 0 ("infinite"): not glass
 
-  Material m;
+  scene::Material m;
   if (transmission > 0.5) {
     Rgb absorption(0.0f);
     const tinygltf::Value& volume = extension(gm.extensions, "KHR_materials_volume");
@@ -169,20 +169,20 @@ Material convert_material(const tinygltf::Material& gm, const std::string& name)
       for (int c = 0; c < 3; ++c)
         absorption[c] = float(-std::log(std::clamp(color.Get(c).GetNumberAsDouble(), 1e-4, 1.0)) / distance);
     }
-    m = Material::make_dielectric(name, ior, absorption);
+    m = scene::Material::make_dielectric(name, ior, absorption);
     // The base colour tints what the surface transmits. Without KHR_materials_volume (or with a
     // thickness of zero) the surface is thin-walled: light passes through unbent.
     m.transmission_tint = base;
     m.roughness = roughness;  // the extension's transmission is as rough as the surface
     m.thin_walled = !volume.IsObject() || !(number_or(volume, "thicknessFactor", 0.0) > 0.0);
     if (m.thin_walled) m.absorption = Rgb(0.0f);
-  } else if (metallic == 1.0f && roughness * roughness <= kMinGgxAlpha && pbr.metallicRoughnessTexture.index < 0) {
-    m = Material::make_mirror(name, base);  // narrower than the GGX lobe can be: a delta lobe
+  } else if (metallic == 1.0f && roughness * roughness <= scene::kMinGgxAlpha && pbr.metallicRoughnessTexture.index < 0) {
+    m = scene::Material::make_mirror(name, base);  // narrower than the GGX lobe can be: a delta lobe
   } else if (metallic == 0.0f &&
              number_or(extension(gm.extensions, "KHR_materials_specular"), "specularFactor", 1.0) == 0.0) {
-    m = Material::make_diffuse(name, base);  // F0 = 0: the specification's BRDF is exactly Lambertian
+    m = scene::Material::make_diffuse(name, base);  // F0 = 0: the specification's BRDF is exactly Lambertian
   } else {
-    m = Material::make_metallic_roughness(name, base, metallic, roughness, ior);
+    m = scene::Material::make_metallic_roughness(name, base, metallic, roughness, ior);
   }
   const float strength =
       float(number_or(extension(gm.extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0));
@@ -194,7 +194,7 @@ Material convert_material(const tinygltf::Material& gm, const std::string& name)
 /// One glTF file being appended to a scene.
 class GltfLoader {
  public:
-  GltfLoader(const tinygltf::Model& model, std::string file, Scene& scene)
+  GltfLoader(const tinygltf::Model& model, std::string file, scene::Scene& scene)
       : model_(model), file_(std::move(file)), scene_(scene), on_path_(model.nodes.size(), false) {}
 
   /// A driver over named passes (below): check the required extensions, convert the materials
@@ -247,16 +247,16 @@ class GltfLoader {
   /// One texture of a material (`where` names it, `key` the texture) through texture_ref, or an
   /// invalid reference when it reads another UV set than the material's earlier textures, with
   /// a warning. Reads and writes `uv_set`: the material's set so far (−1: none yet).
-  TextureRef material_texture(const tinygltf::TextureInfo& info, const std::string& where, const std::string& key,
+  scene::TextureRef material_texture(const tinygltf::TextureInfo& info, const std::string& where, const std::string& key,
                               bool srgb, int& uv_set) {
     int set = 0;
-    TextureRef ref = texture_ref(info, where + "." + key, set, srgb);
+    scene::TextureRef ref = texture_ref(info, where + "." + key, set, srgb);
     if (!ref.valid()) return ref;
     if (uv_set >= 0 && set != uv_set) {
       scene_.warnings.push_back(file_ + ": " + where + "." + key + " reads texture coordinate set " +
                                 std::to_string(set) + " but the material's other textures read set " +
                                 std::to_string(uv_set) + "; it is ignored");
-      return TextureRef{};
+      return scene::TextureRef{};
     }
     uv_set = set;
     return ref;
@@ -265,7 +265,7 @@ class GltfLoader {
   /// Pass 2a, for material gm (`where` names it). Reads its base colour, metallic-roughness,
   /// emissive and normal textures; writes m's textures (and normal scale), the kinds it leaves
   /// out to `ignored`; returns the material's UV set: its first texture's (0 when it has none).
-  int read_material_textures(const tinygltf::Material& gm, const std::string& where, Material& m,
+  int read_material_textures(const tinygltf::Material& gm, const std::string& where, scene::Material& m,
                              std::vector<std::string>& ignored) {
     int uv_set = -1;  // one UV set per material: the first texture's; a texture on another is left out
     // A mirror's or glass's base colour tints what it reflects or transmits, which a texture on
@@ -277,7 +277,7 @@ class GltfLoader {
                                           "pbrMetallicRoughness.baseColorTexture", true, uv_set);
     const bool has_mr_texture = gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
     // Rough glass reads the texture's roughness (green); its metalness has no meaning there.
-    const bool reads_mr = m.kind == MaterialKind::metallic_roughness || m.is_rough_dielectric();
+    const bool reads_mr = m.kind == scene::MaterialKind::metallic_roughness || m.is_rough_dielectric();
     if (has_mr_texture && reads_mr)
       m.metallic_roughness_texture = material_texture(gm.pbrMetallicRoughness.metallicRoughnessTexture, where,
                                                       "pbrMetallicRoughness.metallicRoughnessTexture", false, uv_set);
@@ -299,9 +299,9 @@ class GltfLoader {
   /// Pass 2b, for material gm (`where` names it). Reads its alphaMode, alphaCutoff and base
   /// colour alpha; writes m's coverage: baseColorFactor's alpha times the base colour texture's.
   /// Fails on an unknown mode or a cutoff outside [0, 1].
-  void read_alpha_mode(const tinygltf::Material& gm, const std::string& where, Material& m) const {
+  void read_alpha_mode(const tinygltf::Material& gm, const std::string& where, scene::Material& m) const {
     if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
-      m.alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::mask : AlphaMode::blend;
+      m.alpha_mode = gm.alphaMode == "MASK" ? scene::AlphaMode::mask : scene::AlphaMode::blend;
       const auto& factor = gm.pbrMetallicRoughness.baseColorFactor;
       m.alpha = factor.size() == 4 ? std::clamp(float(factor[3]), 0.0f, 1.0f) : 1.0f;
       if (!(gm.alphaCutoff >= 0.0 && gm.alphaCutoff <= 1.0)) fail(where + ".alphaCutoff: must lie in [0, 1]");
@@ -317,7 +317,7 @@ class GltfLoader {
   /// that gilt does not read to `ignored`.
   void add_material(size_t i, Ignored& ignored) {
     const tinygltf::Material& gm = model_.materials[i];
-    Material m = convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name);
+    scene::Material m = convert_material(gm, gm.name.empty() ? "material " + std::to_string(i) : gm.name);
     const std::string where = "materials[" + std::to_string(i) + "]";
     uv_set_of_material_.push_back(read_material_textures(gm, where, m, ignored.textures));
     read_alpha_mode(gm, where, m);
@@ -326,7 +326,7 @@ class GltfLoader {
     for (const auto& [name, value] : gm.extensions) {
       const bool read = name == "KHR_materials_transmission" || name == "KHR_materials_ior" ||
                         name == "KHR_materials_volume" || name == "KHR_materials_emissive_strength" ||
-                        (name == "KHR_materials_specular" && m.kind == MaterialKind::diffuse);
+                        (name == "KHR_materials_specular" && m.kind == scene::MaterialKind::diffuse);
       note_ignored(ignored.extensions, !read, name);
     }
     scene_.materials.push_back(std::move(m));
@@ -378,11 +378,11 @@ class GltfLoader {
 
   /// The reference a base colour textureInfo (at JSON path `where`) makes, or an invalid one when
   /// its image cannot be had; `uv_set` is set to the TEXCOORD set it reads.
-  TextureRef texture_ref(const tinygltf::TextureInfo& info, const std::string& where, int& uv_set, bool srgb) {
+  scene::TextureRef texture_ref(const tinygltf::TextureInfo& info, const std::string& where, int& uv_set, bool srgb) {
     if (size_t(info.index) >= model_.textures.size())
       fail(where + ".index: texture " + std::to_string(info.index) + " does not exist");
     uv_set = info.texCoord;
-    TextureRef ref;
+    scene::TextureRef ref;
     const tinygltf::Value& transform = extension(info.extensions, "KHR_texture_transform");
     if (transform.IsObject())
       ref.map = texture_transform(transform, where + ".extensions.KHR_texture_transform", uv_set);
@@ -396,13 +396,13 @@ class GltfLoader {
         scene_.warnings.push_back(file_ + ": " + texture_where +
                                   " has no image gilt can read; its materials are untextured");
       }
-      return TextureRef{};
+      return scene::TextureRef{};
     }
     if (size_t(texture.source) >= model_.images.size())
       fail(texture_where + ".source: image " + std::to_string(texture.source) + " does not exist");
-    TextureImage image;
+    scene::TextureImage image;
     image.file = image_file(texture.source);
-    if (image.file.empty()) return TextureRef{};
+    if (image.file.empty()) return scene::TextureRef{};
     image.srgb = srgb;  // glTF stores colours (base, emissive) sRGB-encoded, data linear
     if (texture.sampler >= 0) {
       if (size_t(texture.sampler) >= model_.samplers.size())
@@ -417,7 +417,7 @@ class GltfLoader {
     // Textures sharing a file and wrap modes share one opened image (the Cesium truck's body and
     // wheels read one atlas through two textures).
     for (size_t i = 0; i < scene_.textures.size() && !ref.valid(); ++i) {
-      const TextureImage& t = scene_.textures[i];
+      const scene::TextureImage& t = scene_.textures[i];
       if (t.file == image.file && t.srgb == image.srgb && t.wrap_s == image.wrap_s &&
           t.wrap_t == image.wrap_t)
         ref.image = int32_t(i);
@@ -520,7 +520,7 @@ class GltfLoader {
     char name[64];
     std::snprintf(name, sizeof name, "gltf-%016llx-%zu",
                   static_cast<unsigned long long>(content_hash(bytes, size)), size);
-    const fs::path folder = texture_cache_folder();
+    const fs::path folder = scene::texture_cache_folder();
     const fs::path target = folder / (name + ext);
     if (file_holds(target, bytes, size)) return target.string();
     std::error_code ec;
@@ -587,7 +587,7 @@ class GltfLoader {
         add_primitive(mesh.primitives[p], world, name + "#" + std::to_string(p),
                       "mesh '" + name + "' primitive " + std::to_string(p));
         if (scene_.meshes.size() > before) {
-          MeshOrigin& origin = scene_.meshes.back().origin;
+          scene::MeshOrigin& origin = scene_.meshes.back().origin;
           origin.file = file_index_;
           origin.node = index;
           origin.mesh = node.mesh;
@@ -703,7 +703,7 @@ class GltfLoader {
     }
     if (default_material_ < 0) {  // glTF's default (white metal) would be a perfect reflector; use grey
       default_material_ = int(scene_.materials.size());
-      scene_.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
+      scene_.materials.push_back(scene::Material::make_diffuse("default", Rgb(0.8f)));
     }
     return uint32_t(default_material_);
   }
@@ -718,7 +718,7 @@ class GltfLoader {
     if (mode > TINYGLTF_MODE_TRIANGLE_FAN) fail(what + ": unknown primitive mode " + std::to_string(mode));
     const auto position = prim.attributes.find("POSITION");
     if (position == prim.attributes.end()) fail(what + ": no POSITION attribute");
-    TriangleMesh mesh;
+    scene::TriangleMesh mesh;
     mesh.name = name;
     mesh.positions = read_floats<3>(position->second, what + " POSITION");
     const size_t n = mesh.positions.size();
@@ -769,8 +769,8 @@ class GltfLoader {
     // The file's tangents serve the normal texture when it reads the UVs as they are (a
     // KHR_texture_transform would turn the frame they were made in); else commit() makes them.
     if (const auto it = prim.attributes.find("TANGENT"); it != prim.attributes.end() && !mesh.uvs.empty()) {
-      const TextureRef& normal = scene_.materials[mesh.material].normal_texture;
-      if (normal.valid() && normal.map == TextureRef{}.map) {
+      const scene::TextureRef& normal = scene_.materials[mesh.material].normal_texture;
+      if (normal.valid() && normal.map == scene::TextureRef{}.map) {
         mesh.tangents = read_floats<4>(it->second, what + " TANGENT");
         if (mesh.tangents.size() != n) fail(what + ": TANGENT and POSITION counts differ");
       }
@@ -788,9 +788,9 @@ class GltfLoader {
     const Vec3 up(world * glm::vec4(0.0f, 1.0f, 0.0f, 0.0f));
     if (!(glm::length(forward) > 0.0f) || !(glm::length(up) > 0.0f))
       fail("camera node has a singular transform");
-    NamedCamera named;
+    scene::NamedCamera named;
     named.name = !c.name.empty() ? c.name : !node_name.empty() ? node_name : "camera " + std::to_string(scene_.cameras.size());
-    Camera& camera = named.camera;
+    scene::Camera& camera = named.camera;
     camera.look_from = Vec3(world[3]);
     camera.look_at = camera.look_from + glm::normalize(forward);
     camera.up = glm::normalize(up);
@@ -824,20 +824,20 @@ class GltfLoader {
       fail("KHR_lights_punctual light " + std::to_string(index) + " does not exist");
     const tinygltf::Light& gl = model_.lights[size_t(index)];
     const Rgb value = rgb_or(gl.color, Rgb(1.0f)) * float(gl.intensity);
-    Light light;
+    scene::Light light;
     light.position = Vec3(world[3]);
     const Vec3 axis(world * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));  // lights shine down the node's −z
     light.direction = glm::length(axis) > 0.0f ? glm::normalize(axis) : axis;
     if (gl.type == "point") {
-      light.kind = LightKind::point;
+      light.kind = scene::LightKind::point;
       light.intensity = value;
     } else if (gl.type == "spot") {
-      light.kind = LightKind::spot;
+      light.kind = scene::LightKind::spot;
       light.intensity = value;
       light.cos_inner = float(std::cos(gl.spot.innerConeAngle));
       light.cos_outer = float(std::cos(gl.spot.outerConeAngle));
     } else if (gl.type == "directional") {
-      light.kind = LightKind::directional;
+      light.kind = scene::LightKind::directional;
       light.irradiance = value;
     } else {
       scene_.warnings.push_back(file_ + ": light " + std::to_string(index) + " of unknown type '" + gl.type +
@@ -850,7 +850,7 @@ class GltfLoader {
 
   const tinygltf::Model& model_;
   std::string file_;
-  Scene& scene_;
+  scene::Scene& scene_;
   std::vector<bool> on_path_;  // nodes on the current root-to-node path, to catch cycles
   uint32_t first_material_ = 0;
   std::vector<int> uv_set_of_material_;  // TEXCOORD set each glTF material's base colour texture reads
@@ -863,10 +863,10 @@ class GltfLoader {
 
 }  // namespace
 
-void load_gltf(const fs::path& path, Scene& scene) {
+void load_gltf(const fs::path& path, scene::Scene& scene) {
   const std::string file = path.string();
   const tinygltf::Model model = read_gltf_file(file, &scene.warnings);
   GltfLoader(model, file, scene).load();
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

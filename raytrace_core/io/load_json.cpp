@@ -12,11 +12,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 #include "raytrace_core/io/scene_io.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 namespace fs = std::filesystem;
 
@@ -34,7 +34,8 @@ std::string at(const std::string& pointer, size_t index) { return pointer + "/" 
 
 class JsonSceneReader {
  public:
-  JsonSceneReader(const fs::path& path, Scene& scene) : path_(path), file_(path.string()), scene_(scene) {}
+  JsonSceneReader(const fs::path& path, scene::Scene& scene)
+      : path_(path), file_(path.string()), scene_(scene) {}
 
   void read(const Json& root) {
     object(root, "", {"materials", "meshes", "shapes", "lights", "camera", "render"});
@@ -144,29 +145,30 @@ class JsonSceneReader {
       const std::string p = at("/materials", name);
       if (!j.is_object()) fail(p, "expected an object");
       const std::string kind = field(j, "kind") ? string(j, "kind", p) : "diffuse";
-      Material m;
+      scene::Material m;
       if (kind == "diffuse") {
         object(j, p, {"kind", "albedo", "emission", "two_sided"});
-        m = Material::make_diffuse(name, reflectance(j, "albedo", p, Rgb(0.8f)));
+        m = scene::Material::make_diffuse(name, reflectance(j, "albedo", p, Rgb(0.8f)));
       } else if (kind == "glossy") {
         object(j, p, {"kind", "albedo", "specular", "exponent", "emission", "two_sided"});
-        m = Material::make_glossy(name, reflectance(j, "albedo", p, Rgb(0.5f)),
+        m = scene::Material::make_glossy(name, reflectance(j, "albedo", p, Rgb(0.5f)),
                                   reflectance(j, "specular", p, Rgb(0.3f)), number(j, "exponent", p, 100.0f));
         if (m.exponent < 0.0f) fail(at(p, "exponent"), "must not be negative");
         if ((m.albedo + m.specular).max_component() > 1.0f)
           fail(p, "albedo + specular exceeds 1: energy is not conserved");
       } else if (kind == "mirror") {
         object(j, p, {"kind", "specular", "emission", "two_sided"});
-        m = Material::make_mirror(name, reflectance(j, "specular", p, Rgb(1.0f)));
+        m = scene::Material::make_mirror(name, reflectance(j, "specular", p, Rgb(1.0f)));
       } else if (kind == "dielectric") {
         object(j, p, {"kind", "ior", "absorption", "roughness", "emission", "two_sided"});
-        m = Material::make_dielectric(name, number(j, "ior", p, 1.5f), colour(j, "absorption", p, Rgb(0.0f)));
+        m = scene::Material::make_dielectric(name, number(j, "ior", p, 1.5f),
+                                             colour(j, "absorption", p, Rgb(0.0f)));
         m.roughness = number(j, "roughness", p, 0.0f);
         if (!(m.ior > 0.0f)) fail(at(p, "ior"), "must be positive");
         if (!(m.roughness >= 0.0f && m.roughness <= 1.0f)) fail(at(p, "roughness"), "must lie in [0, 1]");
       } else if (kind == "metallic_roughness") {
         object(j, p, {"kind", "albedo", "metallic", "roughness", "ior", "emission", "two_sided"});
-        m = Material::make_metallic_roughness(name, reflectance(j, "albedo", p, Rgb(0.8f)), number(j, "metallic", p, 0.0f),
+        m = scene::Material::make_metallic_roughness(name, reflectance(j, "albedo", p, Rgb(0.8f)), number(j, "metallic", p, 0.0f),
                                               number(j, "roughness", p, 0.5f), number(j, "ior", p, 1.5f));
         if (!(m.metallic >= 0.0f && m.metallic <= 1.0f)) fail(at(p, "metallic"), "must lie in [0, 1]");
         if (!(m.roughness >= 0.0f && m.roughness <= 1.0f)) fail(at(p, "roughness"), "must lie in [0, 1]");
@@ -218,7 +220,7 @@ class JsonSceneReader {
     const glm::mat4 transform =
         field(j, "transform") ? read_transform(j["transform"], at(p, "transform")) : glm::mat4(1.0f);
 
-    Scene part;
+    scene::Scene part;
     try {
       part = load_scene_file(mesh_path.string());
     } catch (const InputError& e) {
@@ -228,22 +230,22 @@ class JsonSceneReader {
     if (!override_material) {
       // The file's images join the scene's, its materials' references shifted past those there.
       const auto texture_offset = int32_t(scene_.textures.size());
-      for (TextureImage& t : part.textures) scene_.textures.push_back(std::move(t));
-      for (Material& m : part.materials) {
-        for (TextureRef* t : m.texture_refs())
+      for (scene::TextureImage& t : part.textures) scene_.textures.push_back(std::move(t));
+      for (scene::Material& m : part.materials) {
+        for (scene::TextureRef* t : m.texture_refs())
           if (t->valid()) t->image += texture_offset;
         scene_.materials.push_back(std::move(m));
       }
     }
     const auto file_offset = int32_t(scene_.model_files.size());
     for (std::string& f : part.model_files) scene_.model_files.push_back(std::move(f));
-    for (TriangleMesh& mesh : part.meshes) {
+    for (scene::TriangleMesh& mesh : part.meshes) {
       if (mesh.origin.file >= 0) mesh.origin.file += file_offset;
       mesh.material = override_material ? material : mesh.material + offset;
       transform_mesh(mesh, transform);
       scene_.meshes.push_back(std::move(mesh));
     }
-    for (Light light : part.punctual_lights) {
+    for (scene::Light light : part.punctual_lights) {
       light.position = Vec3(transform * glm::vec4(light.position, 1.0f));
       const Vec3 direction = glm::mat3(transform) * light.direction;
       if (glm::length(direction) > 0.0f) light.direction = glm::normalize(direction);
@@ -252,7 +254,7 @@ class JsonSceneReader {
     // The first included file's camera frames the scene, moved with the file, unless the JSON has
     // its own; its image size (a glTF camera's aspect ratio) comes with it.
     // Every camera of the file is kept, moved with it, for --camera to choose from.
-    const auto moved = [&transform](Camera camera) {
+    const auto moved = [&transform](scene::Camera camera) {
       camera.look_from = Vec3(transform * glm::vec4(camera.look_from, 1.0f));
       camera.look_at = Vec3(transform * glm::vec4(camera.look_at, 1.0f));
       const Vec3 up = glm::mat3(transform) * camera.up;
@@ -262,7 +264,7 @@ class JsonSceneReader {
       }
       return camera;
     };
-    for (NamedCamera named : part.cameras) {
+    for (scene::NamedCamera named : part.cameras) {
       named.camera = moved(named.camera);
       scene_.cameras.push_back(std::move(named));
     }
@@ -306,7 +308,7 @@ class JsonSceneReader {
       scene_.meshes.back().name = "shapes:" + scene_.materials[material].name;
       scene_.meshes.back().material = material;
     }
-    TriangleMesh& mesh = scene_.meshes[it->second];
+    scene::TriangleMesh& mesh = scene_.meshes[it->second];
     const auto base = static_cast<uint32_t>(mesh.positions.size());
     for (size_t i = 0; i < corners; ++i)
       mesh.positions.push_back(vec3((*vertices)[i], at(at(p, "vertices"), i)));
@@ -317,15 +319,15 @@ class JsonSceneReader {
   void read_light(const Json& j, const std::string& p) {
     if (!j.is_object()) fail(p, "expected an object");
     const std::string type = string(j, "type", p);
-    Light light;
+    scene::Light light;
     if (type == "point") {
       object(j, p, {"type", "position", "intensity"});
-      light.kind = LightKind::point;
+      light.kind = scene::LightKind::point;
       light.position = vec3(j, "position", p, std::nullopt);
       light.intensity = colour(j, "intensity", p, std::nullopt);
     } else if (type == "spot") {
       object(j, p, {"type", "position", "direction", "intensity", "inner_angle_deg", "outer_angle_deg"});
-      light.kind = LightKind::spot;
+      light.kind = scene::LightKind::spot;
       light.position = vec3(j, "position", p, std::nullopt);
       light.direction = vec3(j, "direction", p, std::nullopt);
       light.intensity = colour(j, "intensity", p, std::nullopt);
@@ -337,7 +339,7 @@ class JsonSceneReader {
       light.cos_outer = std::cos(glm::radians(outer));
     } else if (type == "directional") {
       object(j, p, {"type", "direction", "irradiance", "angular_radius_deg"});
-      light.kind = LightKind::directional;
+      light.kind = scene::LightKind::directional;
       light.direction = vec3(j, "direction", p, std::nullopt);
       light.irradiance = colour(j, "irradiance", p, std::nullopt);
       // A disk rather than a point at infinity (the sun's is 0.27°): soft shadows, and seen.
@@ -346,7 +348,7 @@ class JsonSceneReader {
       light.cos_angle = radius > 0.0f ? std::cos(glm::radians(radius)) : 1.0f;
     } else if (type == "environment") {
       object(j, p, {"type", "radiance", "file", "scale", "rotate_deg"});
-      light.kind = LightKind::environment;
+      light.kind = scene::LightKind::environment;
       if (field(j, "file")) {  // an image: its texels times `scale`, tinted by `radiance` (default 1)
         const fs::path relative = string(j, "file", p);
         const fs::path image = relative.is_absolute() ? relative : path_.parent_path() / relative;
@@ -355,7 +357,7 @@ class JsonSceneReader {
         const float scale = number(j, "scale", p, 1.0f), rotate = number(j, "rotate_deg", p, 0.0f);
         if (!(scale >= 0.0f)) fail(at(p, "scale"), "must not be negative");
         light.radiance = colour(j, "radiance", p, Rgb(1.0f));
-        light.map = EnvironmentMap::load(image.string(), scale, rotate);
+        light.map = scene::EnvironmentMap::load(image.string(), scale, rotate);
       } else {
         for (const char* key : {"scale", "rotate_deg"})
           if (field(j, key)) fail(at(p, key), "needs \"file\" (an environment image)");
@@ -373,7 +375,7 @@ class JsonSceneReader {
   void read_camera(const Json& j) {
     const std::string p = "/camera";
     object(j, p, {"name", "look_from", "look_at", "up", "vfov", "aperture_radius", "focus_distance", "orthographic_height"});
-    Camera camera;
+    scene::Camera camera;
     camera.look_from = vec3(j, "look_from", p, std::nullopt);
     camera.look_at = vec3(j, "look_at", p, std::nullopt);
     camera.up = vec3(j, "up", p, Vec3(0.0f, 1.0f, 0.0f));
@@ -392,7 +394,7 @@ class JsonSceneReader {
     }
     scene_.camera = camera;
     // The scene's own camera comes first among those --camera chooses from.
-    scene_.cameras.insert(scene_.cameras.begin(), NamedCamera{j.contains("name") ? string(j, "name", p) : "scene", camera, 0.0f});
+    scene_.cameras.insert(scene_.cameras.begin(), scene::NamedCamera{j.contains("name") ? string(j, "name", p) : "scene", camera, 0.0f});
   }
 
   void read_render(const Json& j) {
@@ -413,14 +415,14 @@ class JsonSceneReader {
   fs::path path_;
   std::string file_;
   bool own_camera_ = false;  // the JSON names its own camera, which wins over its files'
-  Scene& scene_;
+  scene::Scene& scene_;
   std::map<std::string, uint32_t> material_index_;
   std::map<uint32_t, size_t> shape_mesh_of_material_;
 };
 
 }  // namespace
 
-void load_json(const fs::path& path, Scene& scene) {
+void load_json(const fs::path& path, scene::Scene& scene) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(file + ": cannot open file");
@@ -453,4 +455,4 @@ void load_json(const fs::path& path, Scene& scene) {
   }
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

@@ -36,10 +36,10 @@
 
 #include <tiny_obj_loader.h>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 namespace fs = std::filesystem;
 
@@ -359,9 +359,9 @@ std::string find_texture_file(const fs::path& folder, const std::string& name) {
 
 /// Index of `image` in the scene's textures, added when no equal entry is there yet, so that
 /// materials sharing a file (sibenik's walls all read kamen.png) open and cache it once.
-int32_t texture_index(std::vector<TextureImage>& textures, const TextureImage& image) {
+int32_t texture_index(std::vector<scene::TextureImage>& textures, const scene::TextureImage& image) {
   for (size_t i = 0; i < textures.size(); ++i) {
-    const TextureImage& t = textures[i];
+    const scene::TextureImage& t = textures[i];
     if (t.file == image.file && t.srgb == image.srgb && t.wrap_s == image.wrap_s && t.wrap_t == image.wrap_t)
       return int32_t(i);
   }
@@ -372,8 +372,8 @@ int32_t texture_index(std::vector<TextureImage>& textures, const TextureImage& i
 /// The texture reference of a map_Kd: the image, and the map from OBJ's (u, v) to OpenImageIO's
 /// (s, t). The -s and -o options act on (u, v) first (u' = scale·u + offset, as most MTL
 /// readers take them), then v' is flipped because OBJ's v runs up the image and t runs down it.
-TextureRef diffuse_texture_ref(int32_t image, const DiffuseMap& map) {
-  TextureRef ref;
+scene::TextureRef diffuse_texture_ref(int32_t image, const DiffuseMap& map) {
+  scene::TextureRef ref;
   ref.image = image;
   ref.map = {map.scale[0], 0.0f, map.offset[0], 0.0f, map.scale[1], map.offset[1]};
   return ref.then({1.0f, 0.0f, 0.0f, 0.0f, -1.0f, 1.0f});
@@ -412,14 +412,14 @@ bool is_one_of(int value, std::initializer_list<int> set) {
   return false;
 }
 
-Material convert_material(const tinyobj::material_t& mtl, const std::string& file,
+scene::Material convert_material(const tinyobj::material_t& mtl, const std::string& file,
                           std::vector<std::string>& warnings) {
   const std::string where = file + ": material '" + mtl.name + "'";
   Rgb kd = clamp(rgb(mtl.diffuse), 0.0f, 1.0f);
   Rgb ks = clamp(rgb(mtl.specular), 0.0f, 1.0f);
   const Rgb tf = rgb(mtl.transmittance);
   const float ns = std::max(0.0f, float(mtl.shininess));
-  Material m;
+  scene::Material m;
 
   if (is_one_of(mtl.illum, {4, 6, 7, 9}) || mtl.dissolve < 1.0f) {
     float ior = float(mtl.ior);
@@ -430,13 +430,13 @@ Material convert_material(const tinyobj::material_t& mtl, const std::string& fil
     Rgb absorption(0.0f);
     if (!tf.is_black() && !(tf == Rgb(1.0f)))
       for (int c = 0; c < 3; ++c) absorption[c] = -std::log(std::clamp(tf[c], 1e-4f, 1.0f));
-    m = Material::make_dielectric(mtl.name, ior, absorption);
+    m = scene::Material::make_dielectric(mtl.name, ior, absorption);
   } else if (is_one_of(mtl.illum, {3, 5, 8}) && ks.max_component() >= 0.5f) {
     if (!kd.is_black())
       warnings.push_back(where + ": mirror (illum " + std::to_string(mtl.illum) + ") ignores Kd");
-    m = Material::make_mirror(mtl.name, ks);
+    m = scene::Material::make_mirror(mtl.name, ks);
   } else if (!ks.is_black() && ns >= 1000.0f && kd.is_black()) {
-    m = Material::make_mirror(mtl.name, ks);
+    m = scene::Material::make_mirror(mtl.name, ks);
   } else if (!ks.is_black()) {
     bool scaled = false;
     for (int c = 0; c < 3; ++c) {
@@ -448,9 +448,9 @@ Material convert_material(const tinyobj::material_t& mtl, const std::string& fil
       }
     }
     if (scaled) warnings.push_back(where + ": Kd + Ks exceeds 1; both scaled down to conserve energy");
-    m = Material::make_glossy(mtl.name, kd, ks, ns);
+    m = scene::Material::make_glossy(mtl.name, kd, ks, ns);
   } else {
-    m = Material::make_diffuse(mtl.name, kd);
+    m = scene::Material::make_diffuse(mtl.name, kd);
   }
   m.emission = Rgb(std::max(0.0f, float(mtl.emission[0])), std::max(0.0f, float(mtl.emission[1])),
                    std::max(0.0f, float(mtl.emission[2])));
@@ -510,17 +510,18 @@ fs::path material_folder(const ObjFile& obj, size_t i) {
 /// Pass 2a, for material i and its map_Kd `diffuse`. Reads whether the image file exists; writes
 /// m's albedo texture (its image added to scene.textures), or a warning to scene.warnings when
 /// it would not show or is not found, or the kind to `ignored_maps` on mirrors and glass.
-void apply_map_kd(Material& m, const ObjFile& obj, size_t i, const DiffuseMap& diffuse, Scene& scene,
-                  std::vector<std::string>& ignored_maps) {
+void apply_map_kd(scene::Material& m, const ObjFile& obj, size_t i, const DiffuseMap& diffuse,
+                  scene::Scene& scene, std::vector<std::string>& ignored_maps) {
   const tinyobj::material_t& mtl = obj.mtls[i];
-  if (!diffuse.name.empty() && (m.kind == MaterialKind::mirror || m.kind == MaterialKind::dielectric)) {
+  if (!diffuse.name.empty() &&
+      (m.kind == scene::MaterialKind::mirror || m.kind == scene::MaterialKind::dielectric)) {
     note_once(ignored_maps, "map_Kd of mirror and glass materials");
   } else if (!diffuse.name.empty() && m.albedo.is_black()) {
     scene.warnings.push_back(obj.file + ": material '" + mtl.name + "': Kd is black, so map_Kd " + diffuse.name +
                              " would not show; left untextured");
   } else if (!diffuse.name.empty()) {
     const fs::path folder = material_folder(obj, i);
-    TextureImage image;
+    scene::TextureImage image;
     image.file = find_texture_file(folder, diffuse.name);
     if (image.file.empty()) {
       const std::string where = folder.empty() ? std::string(".") : folder.string();
@@ -528,7 +529,7 @@ void apply_map_kd(Material& m, const ObjFile& obj, size_t i, const DiffuseMap& d
                                "' not found in " + where + "; left untextured");
     } else {
       image.srgb = !diffuse.linear;
-      image.wrap_s = image.wrap_t = diffuse.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+      image.wrap_s = image.wrap_t = diffuse.clamp ? scene::TextureWrap::clamp : scene::TextureWrap::repeat;
       m.albedo_texture = diffuse_texture_ref(texture_index(scene.textures, image), diffuse);
     }
   }
@@ -537,30 +538,30 @@ void apply_map_kd(Material& m, const ObjFile& obj, size_t i, const DiffuseMap& d
 /// A map of material i other than map_Kd, with tinyobjloader's reading of its options (-s, -o,
 /// -clamp): its reference (the image added to scene.textures), or none, with a warning to
 /// scene.warnings ending in `fallback`, when the file is not found.
-TextureRef read_texture_map(const ObjFile& obj, size_t i, const std::string& texname,
+scene::TextureRef read_texture_map(const ObjFile& obj, size_t i, const std::string& texname,
                             const tinyobj::texture_option_t& o, bool srgb, const char* key, const char* fallback,
-                            Scene& scene) {
+                            scene::Scene& scene) {
   const fs::path folder = material_folder(obj, i);
-  TextureImage image;
+  scene::TextureImage image;
   image.file = find_texture_file(folder, texname);
   if (image.file.empty()) {
     const std::string where = folder.empty() ? std::string(".") : folder.string();
     scene.warnings.push_back(obj.file + ": material '" + obj.mtls[i].name + "': " + key + " '" + texname +
                              "' not found in " + where + "; " + fallback);
-    return TextureRef{};
+    return scene::TextureRef{};
   }
   DiffuseMap map;
   map.scale[0] = float(o.scale[0]), map.scale[1] = float(o.scale[1]);
   map.offset[0] = float(o.origin_offset[0]), map.offset[1] = float(o.origin_offset[1]);
   image.srgb = srgb;
-  image.wrap_s = image.wrap_t = o.clamp ? TextureWrap::clamp : TextureWrap::repeat;
+  image.wrap_s = image.wrap_t = o.clamp ? scene::TextureWrap::clamp : scene::TextureWrap::repeat;
   return diffuse_texture_ref(texture_index(scene.textures, image), map);
 }
 
 /// Pass 2b, for material i. Reads its map_d, map_Ke, norm and bump; writes m's alpha, emission
 /// and normal textures (read_texture_map), warnings to scene.warnings, and the kinds it leaves
 /// out to `ignored_maps`.
-void apply_other_maps(Material& m, const ObjFile& obj, size_t i, Scene& scene,
+void apply_other_maps(scene::Material& m, const ObjFile& obj, size_t i, scene::Scene& scene,
                       std::vector<std::string>& ignored_maps) {
   const tinyobj::material_t& mtl = obj.mtls[i];
   // map_d: a cut-out (leaves, fences), its image read as data; coverage below one half is not
@@ -568,10 +569,10 @@ void apply_other_maps(Material& m, const ObjFile& obj, size_t i, Scene& scene,
   if (!mtl.alpha_texname.empty() && m.is_traced_through()) {
     note_once(ignored_maps, "map_d of mirror and glass materials");
   } else if (!mtl.alpha_texname.empty()) {
-    const TextureRef ref =
+    const scene::TextureRef ref =
         read_texture_map(obj, i, mtl.alpha_texname, mtl.alpha_texopt, false, "map_d", "left opaque", scene);
     if (ref.valid()) {
-      m.alpha_mode = AlphaMode::mask;
+      m.alpha_mode = scene::AlphaMode::mask;
       m.alpha_cutoff = 0.5f;
       m.alpha_in_colour = true;
       m.alpha_texture = ref;
@@ -601,19 +602,19 @@ void apply_other_maps(Material& m, const ObjFile& obj, size_t i, Scene& scene,
 
 /// Pass 2, for material i: convert_material, the PBR extension, then passes 2a and 2b. Reads
 /// its MTL entry; writes textures and warnings to `scene` and left-out kinds to `ignored_maps`.
-Material convert_obj_material(const ObjFile& obj, size_t i, Scene& scene, std::vector<std::string>& ignored_maps) {
+scene::Material convert_obj_material(const ObjFile& obj, size_t i, scene::Scene& scene, std::vector<std::string>& ignored_maps) {
   const tinyobj::material_t& mtl = obj.mtls[i];
-  Material m = convert_material(mtl, obj.file, scene.warnings);
+  scene::Material m = convert_material(mtl, obj.file, scene.warnings);
   unused_maps(mtl, ignored_maps);
   const bool read = read_by_mtl_reader(obj, i);
   const DiffuseMap diffuse = read ? obj.mtl_reader.diffuse_map_of_material[i] : DiffuseMap{};
   // The PBR extension (Pr roughness, Pm metallic): glTF's metallic-roughness model with base
   // colour Kd. Glass and mirrors keep their kind.
-  if (diffuse.pbr_given && m.kind == MaterialKind::dielectric) {
+  if (diffuse.pbr_given && m.kind == scene::MaterialKind::dielectric) {
     m.roughness = std::clamp(float(mtl.roughness), 0.0f, 1.0f);  // Pr on glass: frosted glass
   } else if (diffuse.pbr_given && !m.is_traced_through()) {
     const Rgb emission = m.emission;
-    m = Material::make_metallic_roughness(mtl.name, clamp(rgb(mtl.diffuse), 0.0f, 1.0f),
+    m = scene::Material::make_metallic_roughness(mtl.name, clamp(rgb(mtl.diffuse), 0.0f, 1.0f),
                                           std::clamp(float(mtl.metallic), 0.0f, 1.0f),
                                           std::clamp(float(mtl.roughness), 0.0f, 1.0f));
     m.emission = emission;
@@ -652,9 +653,9 @@ struct CornerAttributes {
 /// Pass 4a, for mesh `mesh` of material `material`. Reads its corners: shading normals and uvs
 /// only when every corner has one; but a textured material keeps the uvs its faces have, corners
 /// without one reading the texture at (0, 0) (with a warning to `warnings`).
-CornerAttributes corner_attributes(const std::vector<tinyobj::index_t>& corners, const Material& material,
-                                   const std::string& file, const TriangleMesh& mesh,
-                                   std::vector<std::string>& warnings) {
+CornerAttributes corner_attributes(const std::vector<tinyobj::index_t>& corners,
+                                   const scene::Material& material, const std::string& file,
+                                   const scene::TriangleMesh& mesh, std::vector<std::string>& warnings) {
   bool has_normals = true, all_uvs = true, some_uvs = false;
   size_t corners_without_uv = 0;
   for (const tinyobj::index_t& c : corners) {
@@ -673,8 +674,8 @@ CornerAttributes corner_attributes(const std::vector<tinyobj::index_t>& corners,
 /// Pass 4b. Reads the corners and obj.attrib; writes mesh's vertices (one per distinct corner
 /// of the kept attributes, in order of first use), their file vertex (origin.vertex) and its
 /// indices. Throws InputError on an index past tinyobjloader's arrays.
-void weld_corners(TriangleMesh& mesh, const std::vector<tinyobj::index_t>& corners, CornerAttributes kept,
-                  const ObjFile& obj) {
+void weld_corners(scene::TriangleMesh& mesh, const std::vector<tinyobj::index_t>& corners,
+                  CornerAttributes kept, const ObjFile& obj) {
   const tinyobj::attrib_t& attrib = obj.attrib;
   const bool has_normals = kept.normals, has_uvs = kept.uvs;
   std::map<Corner, uint32_t> vertex_of;
@@ -704,13 +705,13 @@ void weld_corners(TriangleMesh& mesh, const std::vector<tinyobj::index_t>& corne
 /// material to scene.materials for faces without one), the file to scene.model_files, and
 /// warnings to scene.warnings.
 void build_meshes(const ObjFile& obj, const std::map<int, std::vector<tinyobj::index_t>>& corners_of,
-                  uint32_t first_material, Scene& scene) {
+                  uint32_t first_material, scene::Scene& scene) {
   const std::string stem = obj.path.stem().string();
   const auto file_index = int32_t(scene.model_files.size());
   scene.model_files.push_back(obj.file);
   if (corners_of.empty()) scene.warnings.push_back(obj.file + ": no faces");
   for (const auto& [material, corners] : corners_of) {
-    TriangleMesh mesh;
+    scene::TriangleMesh mesh;
     mesh.origin.file = file_index;
     if (material >= 0) {
       mesh.material = first_material + uint32_t(material);
@@ -718,7 +719,7 @@ void build_meshes(const ObjFile& obj, const std::map<int, std::vector<tinyobj::i
     } else {
       mesh.material = static_cast<uint32_t>(scene.materials.size());
       mesh.name = stem + ":default";
-      scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
+      scene.materials.push_back(scene::Material::make_diffuse("default", Rgb(0.8f)));
     }
     const CornerAttributes kept =
         corner_attributes(corners, scene.materials[mesh.material], obj.file, mesh, scene.warnings);
@@ -731,7 +732,7 @@ void build_meshes(const ObjFile& obj, const std::map<int, std::vector<tinyobj::i
 
 // A driver over named passes (above): read the file, convert its materials, gather each
 // material's triangles, and make a mesh of each.
-void load_obj(const fs::path& path, Scene& scene) {
+void load_obj(const fs::path& path, scene::Scene& scene) {
   ObjFile obj(path);
   read_obj(obj, scene.warnings);
 
@@ -746,4 +747,4 @@ void load_obj(const fs::path& path, Scene& scene) {
   build_meshes(obj, corners_of, first_material, scene);
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
 #include "raytrace_core/io/ply_header.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 namespace fs = std::filesystem;
 
@@ -194,7 +194,7 @@ PlyBody read_body(std::istream& in, const PlyHeader& header, const std::string& 
 
 }  // namespace
 
-void load_ply(const fs::path& path, Scene& scene) {
+void load_ply(const fs::path& path, scene::Scene& scene) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(file + ": cannot open file");
@@ -208,7 +208,7 @@ void load_ply(const fs::path& path, Scene& scene) {
     scene.warnings.push_back(file + ": " + std::to_string(body.faces_with_repeats) +
                              " face(s) name a vertex twice: their triangles without area dropped");
 
-  TriangleMesh mesh;
+  scene::TriangleMesh mesh;
   mesh.name = path.stem().string();
   mesh.origin.file = int32_t(scene.model_files.size());
   scene.model_files.push_back(file);
@@ -216,7 +216,7 @@ void load_ply(const fs::path& path, Scene& scene) {
   mesh.normals = std::move(body.normals);  // a zero normal (or none) makes the geometric one used
   mesh.indices = std::move(body.indices);
   mesh.material = static_cast<uint32_t>(scene.materials.size());
-  scene.materials.push_back(Material::make_diffuse("default", Rgb(0.8f)));
+  scene.materials.push_back(scene::Material::make_diffuse("default", Rgb(0.8f)));
   scene.warnings.push_back(ply_default_material_note(file));
   if (has_colours) scene.warnings.push_back(file + ": vertex colours ignored");
   if (mesh.indices.empty()) scene.warnings.push_back(file + ": no faces");
@@ -227,4 +227,4 @@ std::string ply_default_material_note(const std::string& file) {
   return file + ": a PLY holds geometry only: diffuse albedo 0.8, no lights";
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

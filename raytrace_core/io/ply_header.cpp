@@ -8,9 +8,9 @@
 #include <sstream>
 #include <system_error>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 size_t type_size(const std::string& t) {
   if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
@@ -99,4 +99,4 @@ PlyHeader read_header(std::istream& in, const std::string& file) {
   return header;
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 struct PlyProperty {
   std::string name;
@@ -39,4 +39,4 @@ std::vector<std::string> tokens_of(const std::string& line);
 /// element (if any) with a vertex_indices (or vertex_index) list.
 PlyHeader read_header(std::istream& in, const std::string& file);
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

@@ -14,11 +14,11 @@
 
 #include <glm/glm.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
-#include "raytrace_core/sun_sky.h"
+#include "raytrace_core/scene/sun_sky.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 
 namespace fs = std::filesystem;
 
@@ -28,7 +28,7 @@ std::string lower_extension(const fs::path& path) {
   return ext;
 }
 
-void transform_mesh(TriangleMesh& mesh, const glm::mat4& transform) {
+void transform_mesh(scene::TriangleMesh& mesh, const glm::mat4& transform) {
   const glm::mat3 linear(transform);
   const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
   for (Vec3& p : mesh.positions) p = Vec3(transform * glm::vec4(p, 1.0f));
@@ -52,7 +52,7 @@ void transform_mesh(TriangleMesh& mesh, const glm::mat4& transform) {
       std::swap(mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]);
 }
 
-Scene load_scene_file(const std::string& path) {
+scene::Scene load_scene_file(const std::string& path) {
   const fs::path file(path);
   std::error_code ec;
   if (!fs::exists(file, ec)) {
@@ -62,7 +62,7 @@ Scene load_scene_file(const std::string& path) {
   }
   if (fs::is_directory(file, ec)) throw InputError(path + ": is a directory, not a scene file");
 
-  Scene scene;
+  scene::Scene scene;
   scene.name = path;  // commit() prefixes its messages with the name, so they name the file too
   const std::string ext = lower_extension(file);
   if (ext == ".obj") {
@@ -80,7 +80,7 @@ Scene load_scene_file(const std::string& path) {
   return scene;
 }
 
-void select_camera(Scene& scene, const std::string& choice) {
+void select_camera(scene::Scene& scene, const std::string& choice) {
   // A scene whose camera came from no file's list (a built-in scene) offers that one.
   if (scene.cameras.empty() && scene.camera) scene.cameras.push_back({"scene", *scene.camera, 0.0f});
   const auto listed = [&scene] {
@@ -99,33 +99,35 @@ void select_camera(Scene& scene, const std::string& choice) {
     index = std::stoul(choice);
   }
   if (!index) throw InputError("--camera '" + choice + "': no camera of that name; " + listed());
-  const NamedCamera& chosen = scene.cameras[*index];
+  const scene::NamedCamera& chosen = scene.cameras[*index];
   scene.camera = chosen.camera;
   if (chosen.aspect > 0.0f) scene.render.width = std::max(1, int(std::lround(float(scene.render.height) * chosen.aspect)));
 }
 
-Scene load_scene(const std::string& path_or_name) { return load_scene(path_or_name, ExtraLighting{}); }
+scene::Scene load_scene(const std::string& path_or_name) { return load_scene(path_or_name, ExtraLighting{}); }
 
-Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra) {
-  Scene scene = is_builtin_scene(path_or_name) ? builtin_scene(path_or_name) : load_scene_file(path_or_name);
+scene::Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra) {
+  scene::Scene scene =
+      is_builtin_scene(path_or_name) ? builtin_scene(path_or_name) : load_scene_file(path_or_name);
   if (!extra.env_file.empty() && extra.sky_turbidity > 0.0f) throw InputError("--env and --sky: give one sky, not two");
   if (extra.sky_turbidity > 0.0f && !extra.sun) throw InputError("--sky needs --sun: the sky is drawn for the sun's position");
   if (!extra.env_file.empty() || extra.sky_turbidity > 0.0f) {
-    Light env;
-    env.kind = LightKind::environment;
+    scene::Light env;
+    env.kind = scene::LightKind::environment;
     env.radiance = Rgb(1.0f);
     std::string flag;
     if (!extra.env_file.empty()) {
       std::error_code ec;
       if (!fs::is_regular_file(extra.env_file, ec)) throw InputError("--env " + extra.env_file + ": no such file");
-      env.map = EnvironmentMap::load(extra.env_file, extra.env_scale, extra.env_rotate_degrees);
+      env.map = scene::EnvironmentMap::load(extra.env_file, extra.env_scale, extra.env_rotate_degrees);
       flag = "--env " + extra.env_file;
     } else {
-      env.map = preetham_sky(sky_direction(extra.sun_elevation_degrees, extra.sun_azimuth_degrees), extra.sky_turbidity);
+      env.map = scene::preetham_sky(scene::sky_direction(extra.sun_elevation_degrees, extra.sun_azimuth_degrees), extra.sky_turbidity);
       flag = "--sky";
     }
     const size_t before = scene.punctual_lights.size();
-    std::erase_if(scene.punctual_lights, [](const Light& l) { return l.kind == LightKind::environment; });
+    std::erase_if(scene.punctual_lights,
+                  [](const scene::Light& l) { return l.kind == scene::LightKind::environment; });
     if (scene.punctual_lights.size() != before)
       scene.warnings.push_back("the scene's own environment light is replaced by " + flag);
     scene.punctual_lights.push_back(env);
@@ -134,11 +136,11 @@ Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra) {
     if (!(extra.sun_elevation_degrees >= -90.0f && extra.sun_elevation_degrees <= 90.0f) ||
         !std::isfinite(extra.sun_azimuth_degrees) || !(extra.sun_irradiance >= 0.0f) || !std::isfinite(extra.sun_irradiance))
       throw InputError("--sun: elevation must lie in [-90, 90] degrees, azimuth be finite and irradiance ≥ 0");
-    Light sun;
-    sun.kind = LightKind::directional;
-    sun.direction = -sky_direction(extra.sun_elevation_degrees, extra.sun_azimuth_degrees);
+    scene::Light sun;
+    sun.kind = scene::LightKind::directional;
+    sun.direction = -scene::sky_direction(extra.sun_elevation_degrees, extra.sun_azimuth_degrees);
     sun.irradiance = Rgb(extra.sun_irradiance);
-    sun.cos_angle = std::cos(kSunAngularRadiusDegrees * (kPi / 180.0f));
+    sun.cos_angle = std::cos(scene::kSunAngularRadiusDegrees * (kPi / 180.0f));
     scene.punctual_lights.push_back(sun);
   }
   try {
@@ -151,29 +153,29 @@ Scene load_scene(const std::string& path_or_name, const ExtraLighting& extra) {
   return scene;
 }
 
-void transform_scene(Scene& scene, float scale, const Vec3& offset) {
+void transform_scene(scene::Scene& scene, float scale, const Vec3& offset) {
   if (scene.committed()) throw std::logic_error("transform_scene: the scene is already committed");
   if (!(scale > 0.0f) || !std::isfinite(scale) || !is_finite(offset))
     throw InputError("transform_scene: scale must be positive and finite, offset finite");
   const auto map = [&](const Vec3& p) { return scale * p + offset; };
 
-  for (TriangleMesh& mesh : scene.meshes)
+  for (scene::TriangleMesh& mesh : scene.meshes)
     for (Vec3& p : mesh.positions) p = map(p);  // normals keep their direction under p ↦ s·p + o
-  for (Sphere& sphere : scene.spheres) {
+  for (scene::Sphere& sphere : scene.spheres) {
     sphere.center = map(sphere.center);
     sphere.radius *= scale;
   }
-  for (Light& light : scene.punctual_lights) {
-    if (light.kind != LightKind::point && light.kind != LightKind::spot) continue;
+  for (scene::Light& light : scene.punctual_lights) {
+    if (light.kind != scene::LightKind::point && light.kind != scene::LightKind::spot) continue;
     light.position = map(light.position);
     // Irradiance from a point light falls as intensity / distance²: scaling the intensity by s²
     // keeps every image unchanged, like the radiance of area lights.
     light.intensity *= scale * scale;
   }
   // σa is per scene unit: the same optical depth through a body s times larger needs σa / s.
-  for (Material& material : scene.materials) material.absorption /= scale;
+  for (scene::Material& material : scene.materials) material.absorption /= scale;
   if (scene.camera) {
-    Camera& camera = *scene.camera;
+    scene::Camera& camera = *scene.camera;
     camera.look_from = map(camera.look_from);
     camera.look_at = map(camera.look_at);
     camera.aperture_radius *= scale;
@@ -181,4 +183,4 @@ void transform_scene(Scene& scene, float scale, const Vec3& offset) {
   }
 }
 
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

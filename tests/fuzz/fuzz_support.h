@@ -16,7 +16,7 @@
 #include <string>
 #include <string_view>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace gilt::fuzz {
@@ -48,7 +48,7 @@ inline fs::path write_scratch(const std::string& name, std::string_view bytes) {
 /// Loads and commits the scene file; bad input (InputError) is an expected outcome.
 inline void load(const fs::path& path) {
   try {
-    raytrace_core::Scene scene = raytrace_core::load_scene(path.string());
+    raytrace_core::scene::Scene scene = raytrace_core::io::load_scene(path.string());
     (void)scene.bounds();
   } catch (const raytrace_core::InputError&) {
   }

@@ -7,15 +7,18 @@
 
 #include <optional>
 
-#include "raytrace_core/bsdf.h"
+#include "raytrace_core/scene/bsdf.h"
 #include "tests/statistical/chi2.h"
 
 namespace gilt::test {
 
-inline Chi2Result chi2_bsdf(const raytrace_core::Material& material, const raytrace_core::Vec3& wo, size_t samples,
+inline Chi2Result chi2_bsdf(const raytrace_core::scene::Material& material, const raytrace_core::Vec3& wo, size_t samples,
                             uint64_t seed, double alpha, int theta_rows = 48, int phi_columns = 96,
                             int adaptive_depth = 0) {
-  using namespace raytrace_core;
+  using raytrace_core::util::Rng;
+  using raytrace_core::scene::bsdf_pdf;
+  using raytrace_core::scene::bsdf_sample;
+  using raytrace_core::Vec3;
   return chi2_directions(
       theta_grid(theta_rows, phi_columns), samples, seed,
       [&](Rng& rng) -> std::optional<Vec3> {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "raytrace_core/material.h"
-#include "raytrace_core/math.h"
+#include "raytrace_core/scene/material.h"
+#include "raytrace_core/util/math.h"
 
 namespace gilt::test {
 
@@ -19,7 +19,7 @@ inline raytrace_core::Vec3 spherical(float theta, float phi) {
 /// One lobe to test: a material seen from wo, named for the test's parameter.
 struct LobeCase {
   std::string name;
-  raytrace_core::Material material;
+  raytrace_core::scene::Material material;
   raytrace_core::Vec3 wo;
 };
 

@@ -23,8 +23,8 @@
 #include <gtest/gtest.h>
 #include <boost/math/distributions/chi_squared.hpp>
 
-#include "raytrace_core/math.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/math.h"
+#include "raytrace_core/util/rng.h"
 
 namespace gilt::test {
 
@@ -273,7 +273,7 @@ template <class Sample, class Pdf>
 Chi2Result chi2_directions(const DirectionGrid& grid, size_t n, uint64_t seed, const Sample& sample,
                            const Pdf& pdf, double alpha, int sub = 3, int adaptive_depth = 0,
                            std::optional<double> outside_mass = std::nullopt) {
-  raytrace_core::Rng rng(seed);
+  raytrace_core::util::Rng rng(seed);
   std::vector<double> observed(grid.size(), 0.0);
   for (size_t k = 0; k < n; ++k) {
     const std::optional<raytrace_core::Vec3> w = sample(rng);

@@ -1,4 +1,4 @@
-// Statistical and exact tests of raytrace_core/bsdf.h.
+// Statistical and exact tests of raytrace_core/scene/bsdf.h.
 //
 // Non-delta lobes (diffuse, glossy): the directions bsdf_sample draws must follow bsdf_pdf
 // (chi-square, see chi2.h; α = 0.01 Šidák-corrected over the kChi2Tests tests of this program),
@@ -17,14 +17,14 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 #include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 constexpr int kChi2Tests = 17;  // 4 diffuse + 12 glossy (3 exponents × 4 wo) + 1 pure Phong
@@ -71,7 +71,7 @@ TEST_P(LobeTest, SampleMatchesEvalAndPdf) {
   // The sample's f and pdf are the same float expressions as bsdf_eval and bsdf_pdf at its wi, so
   // they agree to rounding (relative 1e-6 allows a few operations of 2^-24 each).
   const LobeCase& c = GetParam();
-  Rng rng(42);
+  util::Rng rng(42);
   for (int k = 0; k < 20000; ++k) {
     const float u_lobe = rng.uniform();
     const auto s = bsdf_sample(c.material, c.wo, u_lobe, rng.uniform2());
@@ -144,7 +144,7 @@ TEST(Bsdf, DegenerateInputsGiveFiniteResults) {
                                   Material::make_dielectric("bad", 0.0f)};
   const std::vector<Vec3> wos{
       {0, 0, 1}, {0, 0, -1}, {1, 0, 0}, spherical(1.5707f, 0.3f), spherical(1.5709f, 0.3f)};
-  Rng rng(9);
+  util::Rng rng(9);
   for (const Material& m : materials)
     for (const Vec3& wo : wos)
       for (int k = 0; k < 200; ++k) {
@@ -155,7 +155,7 @@ TEST(Bsdf, DegenerateInputsGiveFiniteResults) {
           ASSERT_TRUE(s->f.is_finite() && is_finite(s->wi) && std::isfinite(s->pdf)) << m.name;
           ASSERT_GT(s->pdf, 0.0f) << m.name;
         }
-        const Vec3 wi = sample_uniform_sphere(u);
+        const Vec3 wi = util::sample_uniform_sphere(u);
         ASSERT_TRUE(bsdf_eval(m, wo, wi).is_finite()) << m.name;
         ASSERT_TRUE(std::isfinite(bsdf_pdf(m, wo, wi))) << m.name;
       }
@@ -194,7 +194,7 @@ TEST_P(GlossyFurnace, DirectionalAlbedoIsBoundedAndMatchesUniformSampling) {
   constexpr int kN = 200000;
   for (float theta : {0.0f, 0.5f, 1.0f, 1.3f, 1.55f, 2.2f}) {
     const Vec3 wo = spherical(theta, 0.7f);
-    Rng rng(1234);
+    util::Rng rng(1234);
     const AlbedoEstimate by_bsdf = estimate_albedo(kN, [&] {
       const float u_lobe = rng.uniform();
       const auto s = bsdf_sample(m, wo, u_lobe, rng.uniform2());
@@ -202,7 +202,7 @@ TEST_P(GlossyFurnace, DirectionalAlbedoIsBoundedAndMatchesUniformSampling) {
     });
     // Brute-force twin: uniform directions on wo's hemisphere, pdf 1/2π, using bsdf_eval only.
     const AlbedoEstimate by_uniform = estimate_albedo(kN, [&] {
-      Vec3 wi = sample_uniform_sphere(rng.uniform2());
+      Vec3 wi = util::sample_uniform_sphere(rng.uniform2());
       if (wi.z * wo.z < 0.0f) wi.z = -wi.z;
       return bsdf_eval(m, wo, wi) * (std::fabs(wi.z) * 2.0f * kPi);
     });
@@ -324,7 +324,7 @@ TEST(Dielectric, ReflectionBranchAndEnergyBalance) {
   // Importance mode: reflectance R = f_r|cos|, transmittance T = f_t|cos|, R + T = 1 exactly up to
   // rounding (1e-6: a handful of float operations on values ≤ 1); every sample's weight is 1.
   const Material glass = Material::make_dielectric("glass", 1.5f);
-  Rng rng(77);
+  util::Rng rng(77);
   for (float theta : {0.0f, 0.5f, 1.2f, 1.5f, 2.0f, 2.5f, 2.9f}) {
     const Vec3 wo = spherical(theta, 0.4f);
     const auto r = bsdf_sample(glass, wo, 0.0f, {}, TransportMode::importance);
@@ -351,7 +351,7 @@ TEST(Dielectric, SplitFrequencyIsFresnel) {
   for (float theta : {0.0f, 0.8f, 1.4f, 2.7f}) {
     const Vec3 wo = spherical(theta, 0.2f);
     const double reflectance = fresnel_dielectric(wo.z, eta);
-    Rng rng(31337);
+    util::Rng rng(31337);
     int reflected = 0;
     for (int k = 0; k < kN; ++k) {
       const float u_lobe = rng.uniform();
@@ -386,4 +386,4 @@ TEST(Dielectric, TotalInternalReflectionBeyondTheCriticalAngle) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 using rc::Rgb;
@@ -17,10 +17,10 @@ namespace {
 constexpr float kAlbedo = 0.6f;
 
 /// A white floor of 20 × 20 facing up at y = 0, under the given lights.
-rc::Scene open_floor(const std::vector<rc::Light>& lights) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("floor", Rgb(kAlbedo)));
-  rc::TriangleMesh m;
+rc::scene::Scene open_floor(const std::vector<rc::scene::Light>& lights) {
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("floor", Rgb(kAlbedo)));
+  rc::scene::TriangleMesh m;
   m.positions = {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}};
   m.indices = {0, 1, 2, 0, 2, 3};
   scene.meshes.push_back(m);
@@ -32,13 +32,13 @@ rc::Scene open_floor(const std::vector<rc::Light>& lights) {
 /// The floor's point (0.5, 0, 0.3) seen straight from above: its surface, its shading frame and
 /// the direction towards the viewer in that frame.
 struct FloorView {
-  rc::SurfaceInteraction si;
+  rc::scene::SurfaceInteraction si;
   rc::Frame frame;
   Vec3 wo;
 };
 
-FloorView view_from_above(const rc::Scene& scene) {
-  const rc::Ray down{Vec3(0.5f, 1.0f, 0.3f), Vec3(0.0f, -1.0f, 0.0f)};
+FloorView view_from_above(const rc::scene::Scene& scene) {
+  const rc::scene::Ray down{Vec3(0.5f, 1.0f, 0.3f), Vec3(0.0f, -1.0f, 0.0f)};
   const auto hit = scene.intersect(down);
   EXPECT_TRUE(hit.has_value());
   FloorView v;
@@ -48,17 +48,17 @@ FloorView view_from_above(const rc::Scene& scene) {
   return v;
 }
 
-rc::Light sun(Vec3 towards_ground, float irradiance) {
-  rc::Light l;
-  l.kind = rc::LightKind::directional;
+rc::scene::Light sun(Vec3 towards_ground, float irradiance) {
+  rc::scene::Light l;
+  l.kind = rc::scene::LightKind::directional;
   l.direction = glm::normalize(towards_ground);
   l.irradiance = Rgb(irradiance);
   return l;
 }
 
-rc::Light constant_sky(float radiance) {
-  rc::Light l;
-  l.kind = rc::LightKind::environment;
+rc::scene::Light constant_sky(float radiance) {
+  rc::scene::Light l;
+  l.kind = rc::scene::LightKind::environment;
   l.radiance = Rgb(radiance);
   return l;
 }
@@ -69,18 +69,18 @@ rc::Light constant_sky(float radiance) {
 // closed form ρ/π (E cos θ_sun + I cos θ_point / d²) exactly, with none of the noise of choosing
 // one light by power (which would read 0 or 1/p of each light's part).
 TEST(DirectLight, EveryLightOfAFewIsSampledAtEachPoint) {
-  rc::Light point;
-  point.kind = rc::LightKind::point;
+  rc::scene::Light point;
+  point.kind = rc::scene::LightKind::point;
   point.position = Vec3(0.5f, 2.0f, 0.3f);
   point.intensity = Rgb(3.0f);
   const Vec3 sun_travel(0.6f, -0.8f, 0.0f);
-  const rc::Scene scene = open_floor({sun(sun_travel, 2.0f), point});
+  const rc::scene::Scene scene = open_floor({sun(sun_travel, 2.0f), point});
   const FloorView v = view_from_above(scene);
   const float expected = kAlbedo / rc::kPi * (2.0f * 0.8f + 3.0f / 4.0f);
-  rc::Sampler rng(rc::Rng{});
+  rc::render::Sampler rng(rc::util::Rng{});
   uint64_t rays = 0;
   for (int i = 0; i < 64; ++i) {
-    const Rgb e = rc::estimate_direct(scene, v.si, scene.materials[v.si.material], v.frame, v.wo, true, rng, rays);
+    const Rgb e = rc::render::estimate_direct(scene, v.si, scene.materials[v.si.material], v.frame, v.wo, true, rng, rays);
     ASSERT_NEAR(e.r, expected, 1e-5f * expected) << "call " << i;
   }
   EXPECT_EQ(rays, 2u * 64u) << "one shadow ray per light and call";
@@ -91,14 +91,14 @@ TEST(DirectLight, EveryLightOfAFewIsSampledAtEachPoint) {
 // closed form ρ (E cos θ / π + L), up to float rounding of the cosine. (Drawn over the sphere, as
 // before, one sample had a standard deviation 1.29 times the sky's part.)
 TEST(DirectLight, SunAndSkyMeanMatchesTheClosedForm) {
-  const rc::Scene scene = open_floor({sun(Vec3(0.0f, -1.0f, 0.0f), 4.0f), constant_sky(0.5f)});
+  const rc::scene::Scene scene = open_floor({sun(Vec3(0.0f, -1.0f, 0.0f), 4.0f), constant_sky(0.5f)});
   const FloorView v = view_from_above(scene);
   // The floor's 20 × 20 lies below the point: the whole upper hemisphere is open sky.
   const double expected = kAlbedo * (4.0 / rc::kPi + 0.5);
-  rc::Sampler rng(rc::Rng(7));
+  rc::render::Sampler rng(rc::util::Rng(7));
   uint64_t rays = 0;
   for (int i = 0; i < 2000; ++i) {
-    const double e = rc::estimate_direct(scene, v.si, scene.materials[v.si.material], v.frame, v.wo, true, rng, rays).r;
+    const double e = rc::render::estimate_direct(scene, v.si, scene.materials[v.si.material], v.frame, v.wo, true, rng, rays).r;
     ASSERT_NEAR(e, expected, 1e-5 * expected) << "call " << i;
   }
   EXPECT_EQ(rays, 2u * 2000u) << "one shadow ray per light and call";
@@ -111,19 +111,19 @@ TEST(DirectLight, SunAndSkyMeanMatchesTheClosedForm) {
 // ρ (E cos θ / π + L / 2), up to float rounding. Choosing one of the two by power, a call read
 // the sun as 0 or 1/p times its part.
 TEST(DirectLight, PathTracerSamplesBothSunAndSkyAtEveryBounce) {
-  const rc::Scene scene = open_floor({sun(Vec3(0.3f, -1.0f, 0.2f), 4.0f), constant_sky(0.5f)});
-  ASSERT_TRUE(rc::samples_each_light(scene));
+  const rc::scene::Scene scene = open_floor({sun(Vec3(0.3f, -1.0f, 0.2f), 4.0f), constant_sky(0.5f)});
+  ASSERT_TRUE(rc::render::samples_each_light(scene));
   const FloorView v = view_from_above(scene);
-  const rc::Material& m = scene.materials[v.si.material];
-  const rc::LightQuery query = rc::light_query(v.si, m, true);
-  EXPECT_EQ(rc::light_choice_pmf(scene, query, 0), 1.0f);
-  EXPECT_EQ(rc::light_choice_pmf(scene, query, 1), 1.0f);
+  const rc::scene::Material& m = scene.materials[v.si.material];
+  const rc::scene::LightQuery query = rc::render::light_query(v.si, m, true);
+  EXPECT_EQ(rc::render::light_choice_pmf(scene, query, 0), 1.0f);
+  EXPECT_EQ(rc::render::light_choice_pmf(scene, query, 1), 1.0f);
   const double cos_sun = 1.0 / std::sqrt(0.3 * 0.3 + 1.0 + 0.2 * 0.2);
   const double expected = kAlbedo * (4.0 * cos_sun / rc::kPi + 0.5 / 2.0);
-  rc::Sampler rng(rc::Rng(9));
+  rc::render::Sampler rng(rc::util::Rng(9));
   uint64_t rays = 0;
   for (int i = 0; i < 2000; ++i) {
-    const double e = rc::sample_direct_mis(scene, v.si, m, v.frame, v.wo, true, rng, rays).r;
+    const double e = rc::render::sample_direct_mis(scene, v.si, m, v.frame, v.wo, true, rng, rays).r;
     ASSERT_NEAR(e, expected, 1e-5 * expected) << "call " << i;
   }
   EXPECT_EQ(rays, 2u * 2000u) << "one shadow ray per light and call";
@@ -133,15 +133,15 @@ TEST(DirectLight, PathTracerSamplesBothSunAndSkyAtEveryBounce) {
 // sample_direct_mis chooses one light per call, and a BSDF-sampled ray is weighed with the
 // sampler's own probability of that light.
 TEST(DirectLight, EmittingSurfacesAreChosenByTheLightSampler) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("floor", Rgb(kAlbedo)));
-  rc::Material lamp = rc::Material::make_diffuse("lamp", Rgb(0.0f));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("floor", Rgb(kAlbedo)));
+  rc::scene::Material lamp = rc::scene::Material::make_diffuse("lamp", Rgb(0.0f));
   lamp.emission = Rgb(5.0f);
   scene.materials.push_back(lamp);
-  rc::TriangleMesh floor;
+  rc::scene::TriangleMesh floor;
   floor.positions = {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}};
   floor.indices = {0, 1, 2, 0, 2, 3};
-  rc::TriangleMesh light;
+  rc::scene::TriangleMesh light;
   light.positions = {{0, 3, 0}, {1, 3, 0}, {0, 3, 1}};
   light.indices = {0, 2, 1};
   light.material = 1;
@@ -149,14 +149,14 @@ TEST(DirectLight, EmittingSurfacesAreChosenByTheLightSampler) {
   scene.punctual_lights = {sun(Vec3(0.0f, -1.0f, 0.0f), 4.0f)};
   scene.commit();
   ASSERT_EQ(scene.lights().size(), 2u);
-  EXPECT_FALSE(rc::samples_each_light(scene));
+  EXPECT_FALSE(rc::render::samples_each_light(scene));
   const FloorView v = view_from_above(scene);
-  const rc::Material& m = scene.materials[v.si.material];
-  const rc::LightQuery query = rc::light_query(v.si, m, true);
+  const rc::scene::Material& m = scene.materials[v.si.material];
+  const rc::scene::LightQuery query = rc::render::light_query(v.si, m, true);
   for (uint32_t li = 0; li < 2; ++li)
-    EXPECT_EQ(rc::light_choice_pmf(scene, query, li), scene.light_sampler().pmf(query, li));
-  rc::Sampler rng(rc::Rng(10));
+    EXPECT_EQ(rc::render::light_choice_pmf(scene, query, li), scene.light_sampler().pmf(query, li));
+  rc::render::Sampler rng(rc::util::Rng(10));
   uint64_t rays = 0;
-  for (int i = 0; i < 100; ++i) rc::sample_direct_mis(scene, v.si, m, v.frame, v.wo, true, rng, rays);
+  for (int i = 0; i < 100; ++i) rc::render::sample_direct_mis(scene, v.si, m, v.frame, v.wo, true, rng, rays);
   EXPECT_LE(rays, 100u) << "at most one shadow ray per call";
 }

@@ -13,8 +13,8 @@
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -33,23 +33,23 @@ double critical_t() {
   return boost::math::quantile(boost::math::complement(boost::math::students_t(kRuns - 1), alpha_each / 2.0));
 }
 
-void expect_furnace(rc::Scene& scene, float le, float rho, const char* what) {
+void expect_furnace(rc::scene::Scene& scene, float le, float rho, const char* what) {
   scene.commit();
   const double expected = le / (1.0 - rho);
-  const rc::PathSettings path;
-  const rc::Camera camera = scene.effective_camera();
-  auto radiance = [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); };
+  const rc::render::PathSettings path;
+  const rc::scene::Camera camera = scene.effective_camera();
+  auto radiance = [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); };
 
   const size_t values = size_t(kSize) * kSize * 3;
   std::vector<double> sum(values, 0.0), sum2(values, 0.0);
   for (int run = 0; run < kRuns; ++run) {
-    rc::RenderSettings settings;
+    rc::render::RenderSettings settings;
     settings.width = settings.height = kSize;
     settings.spp = kSppPerRun;
     settings.seed = 100 + run;
     settings.progress = false;
-    rc::RenderStats stats;
-    const rc::Film film = rc::render_image(scene, camera, settings, radiance, &stats);
+    rc::render::RenderStats stats;
+    const rc::render::Film film = rc::render::render_image(scene, camera, settings, radiance, &stats);
     ASSERT_EQ(stats.non_finite, 0u);
     const std::vector<rc::Rgb> px = film.pixels();
     for (size_t i = 0; i < px.size(); ++i)
@@ -81,13 +81,13 @@ class Furnace : public ::testing::TestWithParam<float> {};
 
 TEST_P(Furnace, EmptyBoxGivesLeOverOneMinusRho) {
   const float le = 0.5f, rho = GetParam();
-  rc::Scene scene = rc::furnace_scene(le, rho);
+  rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
   expect_furnace(scene, le, rho, "empty furnace");
 }
 
 TEST_P(Furnace, GlassAndMirrorSpheresConserveEnergy) {
   const float le = 0.5f, rho = GetParam();
-  rc::Scene scene = rc::furnace_scene(le, rho);
+  rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
   // Spheres in front of the camera, sized from the box so the test holds for any furnace size.
   const rc::Bounds3 b = [&] {
     rc::Bounds3 bb;
@@ -97,9 +97,9 @@ TEST_P(Furnace, GlassAndMirrorSpheresConserveEnergy) {
   }();
   const float r = 0.15f * b.diagonal().x;
   const uint32_t glass = uint32_t(scene.materials.size());
-  scene.materials.push_back(rc::Material::make_dielectric("glass", 1.5f));
-  scene.materials.push_back(rc::Material::make_mirror("mirror", rc::Rgb(1.0f)));
-  const rc::Camera cam = scene.effective_camera();
+  scene.materials.push_back(rc::scene::Material::make_dielectric("glass", 1.5f));
+  scene.materials.push_back(rc::scene::Material::make_mirror("mirror", rc::Rgb(1.0f)));
+  const rc::scene::Camera cam = scene.effective_camera();
   const rc::Vec3 forward = glm::normalize(cam.look_at - cam.look_from);
   const rc::Vec3 side = glm::normalize(glm::cross(forward, cam.up));
   const rc::Vec3 centre = cam.look_from + forward * (2.5f * r);

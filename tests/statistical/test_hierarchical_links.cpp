@@ -10,7 +10,7 @@
 
 #include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/rng.h"
 #include "tests/support/mesh_builders.h"
 
 namespace rc = gilt::raytrace_core;
@@ -49,12 +49,12 @@ double mean_radiance(const rad::solver::Solution& sol) {
 // elements, which shrinks as the elements do: 0.9 % at 3,000. That is not what this measures.)
 TEST(HierarchicalLinks, VisibleFractionDoesNotDependOnTheDecidingRays) {
   constexpr float le = 0.5f, rho = 0.7f;
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_emitter("furnace", rc::Rgb(le), rc::Rgb(rho)));
-  rc::TriangleMesh room, boxes;
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_emitter("furnace", rc::Rgb(le), rc::Rgb(rho)));
+  rc::scene::TriangleMesh room, boxes;
   gilt::test::add_box(room, rc::Vec3(0.0f, 1.5f, 0.0f), rc::Vec3(3.0f, 1.5f, 3.0f), 0.0f);
   for (size_t t = 0; t < room.indices.size(); t += 3) std::swap(room.indices[t + 1], room.indices[t + 2]);  // inwards
-  rc::Rng rng(29);
+  rc::util::Rng rng(29);
   for (int i = 0; i < 36; ++i) {
     const rc::Vec3 c(-2.25f + 0.9f * float(i % 6), 0.4f + 1.6f * rng.uniform(), -2.25f + 0.9f * float(i / 6));
     const rc::Vec3 half(0.15f + 0.25f * rng.uniform(), 0.1f + 0.3f * rng.uniform(), 0.15f + 0.25f * rng.uniform());

@@ -1,4 +1,4 @@
-// Tests of the light BVH (raytrace_core/light_sampler.h).
+// Tests of the light BVH (raytrace_core/scene/light_sampler.h).
 //
 // - Exactness: for any query, the probabilities pmf() gives sum to 1 over the lights, and every
 //   light sample() draws carries the probability pmf() gives it, to the bit (MIS depends on it).
@@ -18,19 +18,19 @@
 #include <vector>
 
 #include "radiosity/solver/form_factor.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/light_sampler.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/scene/light_sampler.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 constexpr int kChi2Tests = 4;
 const double kAlpha = test::sidak_alpha(test::kFamilyAlpha, kChi2Tests);
 
-Vec3 random_unit(Rng& rng) {
+Vec3 random_unit(util::Rng& rng) {
   const Vec2 u = rng.uniform2();
   const float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.0f * kPi * u.y;
   return {r * std::cos(phi), r * std::sin(phi), z};
@@ -49,7 +49,7 @@ Scene random_lights(bool distant) {
   scene.materials = {Material::make_emitter("dim", Rgb(1.0f)), Material::make_emitter("bright", Rgb(20.0f, 10.0f, 5.0f)),
                      Material::make_emitter("both", Rgb(4.0f))};
   scene.materials[2].two_sided_emission = true;
-  Rng rng(7, 3);
+  util::Rng rng(7, 3);
   scene.meshes.resize(3);
   for (uint32_t m = 0; m < 3; ++m) scene.meshes[m].material = m;
   for (int t = 0; t < 400; ++t) {
@@ -87,7 +87,7 @@ Scene random_lights(bool distant) {
 
 /// Queries around and among the lights: one-sided, two-sided and without a normal.
 std::vector<LightQuery> random_queries(int count, uint64_t seed) {
-  Rng rng(seed, 1);
+  util::Rng rng(seed, 1);
   std::vector<LightQuery> out;
   for (int i = 0; i < count; ++i) {
     LightQuery q;
@@ -115,7 +115,7 @@ TEST(LightBvh, ProbabilitiesSumToOneAndMatchTheDraws) {
       // then ends without a light, which the missing mass counts. Never more than 1, to float
       // products along ~10 levels: a few ulps each.
       EXPECT_LE(sum, 1.0 + 1e-5);
-      Rng rng(5, uint64_t(queries_with_light));
+      util::Rng rng(5, uint64_t(queries_with_light));
       int drawn = 0;
       for (int k = 0; k < 200; ++k) {
         const LightChoice c = sampler.sample(q, rng.uniform());
@@ -139,7 +139,7 @@ TEST(LightBvh, DrawsFollowThePmf) {
     constexpr size_t kDraws = 1000000;
     std::vector<double> observed(n + 1, 0.0), expected(n + 1, 0.0);
     for (uint32_t i = 0; i < n; ++i) expected[i] = kDraws * double(sampler.pmf(q, i));
-    Rng rng(33, uint64_t(t));
+    util::Rng rng(33, uint64_t(t));
     for (size_t k = 0; k < kDraws; ++k) {
       const LightChoice c = sampler.sample(q, rng.uniform());
       observed[c.pmf > 0.0f ? c.light : n] += 1.0;
@@ -155,7 +155,7 @@ TEST(LightBvh, DrawsFollowThePmf) {
 TEST(LightBvh, EveryLightThatCanReachHasAProbability) {
   const Scene scene = random_lights(false);
   const LightSampler& sampler = scene.light_sampler();
-  Rng rng(9, 9);
+  util::Rng rng(9, 9);
   int reachable = 0;
   for (const LightQuery& q : random_queries(300, 41)) {
     for (uint32_t i = 0; i < scene.lights().size(); ++i) {
@@ -234,7 +234,7 @@ Estimate irradiance(const Scene& scene, const Vec3& p, int n, uint64_t seed) {
   at.p = p;
   at.ng = Vec3(0.0f, 1.0f, 0.0f);
   const LightQuery q{p, at.ng, false};
-  Rng rng(seed, 2);
+  util::Rng rng(seed, 2);
   double sum = 0.0, sum2 = 0.0;
   for (int k = 0; k < n; ++k) {
     double e = 0.0;
@@ -282,4 +282,4 @@ TEST(LightBvh, DirectLightIsUnbiasedAndLessNoisyThanByPower) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

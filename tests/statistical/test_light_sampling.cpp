@@ -1,4 +1,4 @@
-// Chi-square tests of light sampling (raytrace_core/light.h): the directions sample_light draws
+// Chi-square tests of light sampling (raytrace_core/scene/light.h): the directions sample_light draws
 // from a reference point must be distributed as light_pdf says, and light_pdf must agree with the
 // pdf the sample reports. Method and significance as in chi2.h: α = 0.01 Šidák-corrected over the
 // kChi2Tests tests of this program, 10⁶ samples from fixed seeds.
@@ -18,13 +18,13 @@
 #include <numbers>
 #include <optional>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 // triangle (solid angle; oblique and close; tiny and far, by area), near sphere, far sphere, sphere
@@ -74,7 +74,7 @@ void expect_light_follows_pdf(const Scene& scene, const SurfacePoint& ref, const
   const Light& light = scene.lights()[0];
   const auto r = test::chi2_directions(
       grid, kSamples, seed,
-      [&](Rng& rng) -> std::optional<Vec3> {
+      [&](util::Rng& rng) -> std::optional<Vec3> {
         const LightSample ls = sample_light(scene, light, ref, rng.uniform2());
         if (!(ls.pdf > 0.0f)) return std::nullopt;
         return frame.to_local(ls.wi);
@@ -92,7 +92,7 @@ void expect_light_follows_pdf(const Scene& scene, const SurfacePoint& ref, const
 // order 1e-5 at worst, so 1e-4 is a bound with margin, not a fit.
 void expect_pdf_matches_sample(const Scene& scene, const SurfacePoint& ref, uint64_t seed) {
   const Light& light = scene.lights()[0];
-  Rng rng(seed);
+  util::Rng rng(seed);
   int compared = 0;
   for (int k = 0; k < 20000; ++k) {
     const LightSample ls = sample_light(scene, light, ref, rng.uniform2());
@@ -238,7 +238,7 @@ TEST(LightSampling, EnvironmentMap) {
     const Light& light = scene.lights()[0];
     const SurfacePoint ref = reference_point({0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f});
     expect_light_follows_pdf(scene, ref, kYUp, test::theta_grid(48, 96), 61 + uint64_t(turn), turn != 0.0f);
-    Rng rng(62);
+    util::Rng rng(62);
     for (int k = 0; k < 20000; ++k) {
       const LightSample ls = sample_light(scene, light, ref, rng.uniform2());
       ASSERT_GT(ls.pdf, 0.0f);
@@ -271,7 +271,7 @@ TEST(LightSampling, EnvironmentMapPhotonsDeliverItsIrradiance) {
     const double cell = 0.5 * (std::pow(std::sin(t1c), 2) - std::pow(std::sin(t0), 2)) * 2.0 * std::numbers::pi / w;
     for (int col = 0; col < w; ++col) expected += double(map->texels()[size_t(row * w + col)].g) * cell;
   }
-  Rng rng(71);
+  util::Rng rng(71);
   constexpr int kN = 2000000;
   double sum = 0.0, sum_sq = 0.0;
   for (int k = 0; k < kN; ++k) {
@@ -327,7 +327,7 @@ TEST(LightSampling, ConstantEnvironment) {
   ASSERT_EQ(scene.lights().size(), 1u);
   const SurfacePoint ref = reference_point({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f});
   expect_light_follows_pdf(scene, ref, Frame{}, test::sphere_grid(32, 64), 51, false);
-  Rng rng(52);
+  util::Rng rng(52);
   for (int k = 0; k < 1000; ++k) {
     const LightSample ls = sample_light(scene, scene.lights()[0], ref, rng.uniform2());
     ASSERT_EQ(ls.pdf, light_pdf(scene, scene.lights()[0], ref, ls.wi, SurfacePoint{}));
@@ -348,7 +348,7 @@ TEST(LightSampling, ConstantEnvironmentAboutTheReceivingSide) {
   const SurfacePoint ref = reference_point({0.0f, 0.0f, 0.0f}, n);
   const auto r = test::chi2_directions(
       test::sphere_grid(32, 64), kSamples, 53,
-      [&](Rng& rng) -> std::optional<Vec3> {
+      [&](util::Rng& rng) -> std::optional<Vec3> {
         const LightSample ls = sample_light(scene, env, ref, rng.uniform2(), n);
         if (!(ls.pdf > 0.0f)) return std::nullopt;
         return Frame::from_normal(n).to_local(ls.wi);
@@ -358,7 +358,7 @@ TEST(LightSampling, ConstantEnvironmentAboutTheReceivingSide) {
       },
       kAlpha, 3, 0, 0.0);
   test::expect_chi2_pass(r);
-  Rng rng(54);
+  util::Rng rng(54);
   for (int k = 0; k < 10000; ++k) {
     const LightSample ls = sample_light(scene, env, ref, rng.uniform2(), n);
     if (!(ls.pdf > 0.0f)) continue;  // on the horizon: nothing drawn
@@ -367,8 +367,8 @@ TEST(LightSampling, ConstantEnvironmentAboutTheReceivingSide) {
     ASSERT_NEAR(ls.radiance.g * glm::dot(ls.wi, n) / ls.pdf, kPi * env.radiance.g, 1e-5f * kPi * env.radiance.g);
   }
   const LightSample any = sample_light(scene, env, ref, Vec2(0.3f, 0.9f));
-  EXPECT_EQ(any.pdf, uniform_sphere_pdf());
+  EXPECT_EQ(any.pdf, util::uniform_sphere_pdf());
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -1,5 +1,5 @@
-// Tests of the GGX distribution (raytrace_core/microfacet.h) and of the glTF metallic-roughness
-// BSDF built on it (raytrace_core/bsdf.cpp), plus the thin-walled and tinted dielectric.
+// Tests of the GGX distribution (raytrace_core/scene/microfacet.h) and of the glTF metallic-roughness
+// BSDF built on it (raytrace_core/scene/bsdf.cpp), plus the thin-walled and tinted dielectric.
 //
 //   - D is normalised: ∫ D(h) cos θh dω = 1, by quadrature in cos θ.
 //   - Visible normals: sample_visible follows visible_d (chi-square; visible_d integrating to one
@@ -24,15 +24,15 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/microfacet.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/scene/microfacet.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 #include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 constexpr int kChi2Tests = 6 + 24;  // visible normals + BSDF lobes
@@ -83,7 +83,7 @@ TEST_P(VisibleNormals, SamplesFollowVisibleD) {
   const GgxDistribution ggx(c.alpha);
   const auto r = test::chi2_directions(
       test::theta_grid(48, 96, 0.5 * std::numbers::pi), kChi2Samples, 0x71 + std::hash<std::string>{}(c.name) % 997,
-      [&](Rng& rng) -> std::optional<Vec3> { return ggx.sample_visible(c.wo, rng.uniform2()); },
+      [&](util::Rng& rng) -> std::optional<Vec3> { return ggx.sample_visible(c.wo, rng.uniform2()); },
       [&](Vec3 h) { return ggx.visible_d(c.wo, h); }, kAlpha);
   test::expect_chi2_pass(r);
 }
@@ -130,7 +130,7 @@ TEST_P(MetallicRoughnessLobe, SampleMatchesEvalAndPdf) {
   // Same float expressions on both sides: agreement to rounding (relative 1e-5, a few dozen
   // operations of 2^-24 each through the normalised half vector).
   const LobeCase& c = GetParam();
-  Rng rng(42);
+  util::Rng rng(42);
   int taken = 0;
   for (int k = 0; k < 20000; ++k) {
     const float u_lobe = rng.uniform();
@@ -191,11 +191,11 @@ TEST(MetallicRoughness, EvalIsTheSpecificationsFormula) {
 }
 
 TEST(MetallicRoughness, IsReciprocalPositiveAndTwoSided) {
-  Rng rng(5);
+  util::Rng rng(5);
   for (int k = 0; k < 20000; ++k) {
     const Material m = Material::make_metallic_roughness("mr", Rgb(rng.uniform(), rng.uniform(), rng.uniform()),
                                                          rng.uniform(), rng.uniform());
-    Vec3 wo = sample_uniform_sphere(rng.uniform2()), wi = sample_uniform_sphere(rng.uniform2());
+    Vec3 wo = util::sample_uniform_sphere(rng.uniform2()), wi = util::sample_uniform_sphere(rng.uniform2());
     if (wo.z < 0.0f) wo.z = -wo.z;
     if (wi.z < 0.0f) wi.z = -wi.z;
     const Rgb a = bsdf_eval(m, wo, wi), b = bsdf_eval(m, wi, wo);
@@ -220,7 +220,7 @@ TEST(MetallicRoughness, DegenerateInputsGiveFiniteResults) {
                                         Material::make_metallic_roughness("nan", Rgb(0.5f), nan, nan),
                                         Material::make_metallic_roughness("ior0", Rgb(0.5f), 0.0f, 0.5f, 0.0f)};
   const std::vector<Vec3> wos{{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, spherical(1.5707f, 0.3f), spherical(1.5709f, 0.3f)};
-  Rng rng(9);
+  util::Rng rng(9);
   for (const Material& m : materials)
     for (const Vec3& wo : wos)
       for (int k = 0; k < 500; ++k) {
@@ -230,7 +230,7 @@ TEST(MetallicRoughness, DegenerateInputsGiveFiniteResults) {
           ASSERT_TRUE(s->f.is_finite() && is_finite(s->wi) && std::isfinite(s->pdf)) << m.name;
           ASSERT_GT(s->pdf, 0.0f) << m.name;
         }
-        const Vec3 wi = sample_uniform_sphere(u);
+        const Vec3 wi = util::sample_uniform_sphere(u);
         ASSERT_TRUE(bsdf_eval(m, wo, wi).is_finite()) << m.name;
         ASSERT_TRUE(std::isfinite(bsdf_pdf(m, wo, wi))) << m.name;
       }
@@ -260,7 +260,7 @@ TEST(MetallicRoughness, WhiteFurnace) {
       for (float theta : {0.0f, 0.8f, 1.3f, 1.5f}) {
         const Material m = Material::make_metallic_roughness("white", Rgb(1.0f), metallic, roughness);
         const Vec3 wo = spherical(theta, 0.4f);
-        Rng rng(77);
+        util::Rng rng(77);
         const test::MeanEstimate by_bsdf = test::estimate_mean(kN, [&] {
           const float u_lobe = rng.uniform();
           const auto s = bsdf_sample(m, wo, u_lobe, rng.uniform2());
@@ -275,7 +275,7 @@ TEST(MetallicRoughness, WhiteFurnace) {
         // alone (too noisy for the narrow r = 0.1 lobe, whose check is the chi-square above).
         if (roughness >= 0.5f) {
           const test::MeanEstimate by_uniform = test::estimate_mean(kN, [&] {
-            Vec3 wi = sample_uniform_sphere(rng.uniform2());
+            Vec3 wi = util::sample_uniform_sphere(rng.uniform2());
             if (wi.z < 0.0f) wi.z = -wi.z;
             return double(bsdf_eval(m, wo, wi).g) * wi.z * 2.0 * std::numbers::pi;
           });
@@ -346,4 +346,4 @@ TEST(MetallicRoughness, DiffuseReflectanceIsTheLambertianPart) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -26,8 +26,8 @@
 
 #include "photonmap/photon_mapper.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;
@@ -49,15 +49,15 @@ struct WallPoint {
 
 /// Points on the furnace's walls where rays from the centre, uniform over directions, meet them:
 /// every part of every wall, the edges and corners included.
-std::vector<WallPoint> wall_points(const rc::Scene& scene) {
+std::vector<WallPoint> wall_points(const rc::scene::Scene& scene) {
   std::vector<WallPoint> points;
-  rc::Rng rng = rc::Rng::for_item(3, 0, 0);
+  rc::util::Rng rng = rc::util::Rng::for_item(3, 0, 0);
   while (points.size() < size_t(kPoints)) {
-    const rc::Vec3 d = rc::sample_uniform_sphere(rng.uniform2());
-    const rc::Ray ray{rc::Vec3(0.0f), d, rc::kInfinity};
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const rc::Vec3 d = rc::util::sample_uniform_sphere(rng.uniform2());
+    const rc::scene::Ray ray{rc::Vec3(0.0f), d, rc::kInfinity};
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     if (!hit) continue;
-    const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+    const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
     points.push_back({si.p, glm::dot(si.ng, d) < 0.0f ? si.ng : -si.ng});
   }
   return points;
@@ -74,7 +74,7 @@ class PhotonMapperLookup : public ::testing::TestWithParam<LookupCase> {};
 
 TEST_P(PhotonMapperLookup, FurnaceIrradianceIsPiLeOverOneMinusRho) {
   const float le = 0.5f, rho = GetParam().rho;
-  rc::Scene scene = rc::furnace_scene(le, rho);
+  rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
   scene.commit();
   const std::vector<WallPoint> points = wall_points(scene);
   const double expected = rc::kPi * le / (1.0 - rho);
@@ -90,7 +90,7 @@ TEST_P(PhotonMapperLookup, FurnaceIrradianceIsPiLeOverOneMinusRho) {
     ASSERT_GT(mapper.stats().irradiance_points, 1000u);
     double e = 0.0;
     for (size_t i = 0; i < points.size(); ++i) {
-      rc::Sampler sampler(rc::Rng::for_item(settings.photons.seed, i, 0x77));
+      rc::render::Sampler sampler(rc::util::Rng::for_item(settings.photons.seed, i, 0x77));
       e += mapper.irradiance(points[i].p, points[i].inward, sampler).g;
     }
     e /= double(points.size());

@@ -18,7 +18,7 @@ namespace rad = gilt::radiosity;
 namespace {
 
 /// Sum over the vertices of the direct irradiance (channel mean) from the scene's emitters.
-double direct_sum(const rc::Scene& scene, int visibility_samples, uint64_t seed) {
+double direct_sum(const rc::scene::Scene& scene, int visibility_samples, uint64_t seed) {
   rad::solver::SolverSettings s;
   s.solver = rad::solver::SolverKind::progressive;
   s.mesh.elements = 1500;
@@ -37,7 +37,7 @@ struct MeanSpread {
   double mean = 0.0, variance = 0.0;
 };
 
-MeanSpread over_seeds(const rc::Scene& scene, int visibility_samples, int seeds) {
+MeanSpread over_seeds(const rc::scene::Scene& scene, int visibility_samples, int seeds) {
   std::vector<double> x;
   for (int seed = 0; seed < seeds; ++seed) x.push_back(direct_sum(scene, visibility_samples, uint64_t(seed)));
   MeanSpread m;
@@ -57,7 +57,7 @@ MeanSpread over_seeds(const rc::Scene& scene, int visibility_samples, int seeds)
 // one, 7.5 standard errors; now 0.6. (Its spread over seeds grew from 0.23 % to 0.28 %; 4 plain
 // rays scatter by 0.33 %.)
 TEST(ProbeVisibility, PenumbraReadsWhatPlainRaysRead) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   const MeanSpread adaptive = over_seeds(scene, 16, 64), plain = over_seeds(scene, 4, 64);
   const double standard_error = std::sqrt(adaptive.variance / 64.0 + plain.variance / 64.0);

@@ -14,8 +14,8 @@
 
 #include "radiosity/bake/check.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -23,7 +23,7 @@ namespace rad = gilt::radiosity;
 
 namespace {
 
-rad::solver::Solution solve(const rc::Scene& scene) {
+rad::solver::Solution solve(const rc::scene::Scene& scene) {
   rad::solver::SolverSettings s;
   s.mesh.elements = 1000;
   s.tolerance = 1e-4;
@@ -32,7 +32,7 @@ rad::solver::Solution solve(const rc::Scene& scene) {
 }
 
 TEST(RadiosityCheck, FurnaceErrorIsTheReferenceNoise) {
-  const rc::Scene scene = rc::load_scene("furnace");
+  const rc::scene::Scene scene = rc::io::load_scene("furnace");
   const rad::solver::Solution sol = solve(scene);
   const rad::bake::CheckResult check = rad::bake::check_against_path_tracer(scene, sol, rad::bake::CheckSettings{});
   std::printf("[ measured ] furnace: %zu vertices, mean relative error %.4f, noise %.4f\n", check.points,
@@ -47,7 +47,7 @@ TEST(RadiosityCheck, FurnaceErrorIsTheReferenceNoise) {
 // check's relative mean absolute error (the one not ruled by the few dark vertices under the
 // blocks) must agree with that to within 6 % plus the reference noise as above.
 TEST(RadiosityCheck, CornellAgreesWithTheImageSpaceError) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   const rad::solver::Solution sol = solve(scene);
   const rad::bake::CheckResult check = rad::bake::check_against_path_tracer(scene, sol, rad::bake::CheckSettings{});
   std::printf("[ measured ] cornell: %zu vertices, mean relative error %.4f, relative mean absolute error %.4f, "
@@ -58,7 +58,7 @@ TEST(RadiosityCheck, CornellAgreesWithTheImageSpaceError) {
 }
 
 TEST(RadiosityCheck, SameResultForAnyThreadCountAndBadSettingsAreRefused) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   const rad::solver::Solution sol = solve(scene);
   rad::bake::CheckSettings settings;
   settings.points = 16;
@@ -66,7 +66,7 @@ TEST(RadiosityCheck, SameResultForAnyThreadCountAndBadSettingsAreRefused) {
   const rad::bake::CheckResult all = rad::bake::check_against_path_tracer(scene, sol, settings);
   rad::bake::CheckResult one;
   {
-    rc::ThreadLimit limit(1);
+    rc::util::ThreadLimit limit(1);
     one = rad::bake::check_against_path_tracer(scene, sol, settings);
   }
   EXPECT_EQ(all.mean_relative_error, one.mean_relative_error);

@@ -15,11 +15,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/util/image_error.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -29,8 +29,8 @@ namespace {
 
 constexpr int kSize = 40;
 
-rc::RenderSettings settings(int spp, uint64_t seed) {
-  rc::RenderSettings s;
+rc::render::RenderSettings settings(int spp, uint64_t seed) {
+  rc::render::RenderSettings s;
   s.width = s.height = kSize;
   s.spp = spp;
   s.seed = seed;
@@ -38,14 +38,14 @@ rc::RenderSettings settings(int spp, uint64_t seed) {
   return s;
 }
 
-std::vector<rc::Rgb> path_render(const rc::Scene& scene, int spp, uint64_t seed) {
-  const rc::PathSettings path;
-  return rc::render_image(scene, scene.effective_camera(), settings(spp, seed),
-                          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); })
+std::vector<rc::Rgb> path_render(const rc::scene::Scene& scene, int spp, uint64_t seed) {
+  const rc::render::PathSettings path;
+  return rc::render::render_image(scene, scene.effective_camera(), settings(spp, seed),
+                          [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); })
       .pixels();
 }
 
-std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, int elements,
+std::vector<rc::Rgb> radiosity_render(const rc::scene::Scene& scene, int elements,
                                       rad::bake::ViewMode mode = rad::bake::ViewMode::mesh, uint64_t seed = 1, int spp = 64) {
   rad::solver::SolverSettings s;
   s.mesh.elements = elements;
@@ -54,19 +54,21 @@ std::vector<rc::Rgb> radiosity_render(const rc::Scene& scene, int elements,
   const rad::solver::Solution sol = rad::solver::solve(scene, s);
   const rad::bake::RadiosityView view(scene, sol, mode);
   // Same pixel filter and sample positions as the reference (same seed): only the radiance differs.
-  return rc::render_image(scene, scene.effective_camera(), settings(spp, seed),
-                          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); })
+  return rc::render::render_image(scene, scene.effective_camera(), settings(spp, seed),
+                                  [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+                                    return view.radiance(ray, ctx);
+                                  })
       .pixels();
 }
 
 }  // namespace
 
 TEST(RadiosityVsPath, CornellErrorFallsWithTheMesh) {
-  rc::Scene scene = rc::load_scene("cornell");
+  rc::scene::Scene scene = rc::io::load_scene("cornell");
   const std::vector<rc::Rgb> reference = path_render(scene, 2048, 1);
-  const double noise = 0.5 * rc::mean_relative_error(path_render(scene, 2048, 2), reference);
-  const double coarse = rc::mean_relative_error(radiosity_render(scene, 400), reference);
-  const double fine = rc::mean_relative_error(radiosity_render(scene, 1600), reference);
+  const double noise = 0.5 * rc::util::mean_relative_error(path_render(scene, 2048, 2), reference);
+  const double coarse = rc::util::mean_relative_error(radiosity_render(scene, 400), reference);
+  const double fine = rc::util::mean_relative_error(radiosity_render(scene, 1600), reference);
   std::printf("mean relative error: 400 elements %.4f, 1600 elements %.4f; reference noise %.4f\n", coarse, fine, noise);
   ::testing::Test::RecordProperty("error_400", std::to_string(coarse));
   ::testing::Test::RecordProperty("error_1600", std::to_string(fine));
@@ -81,15 +83,15 @@ TEST(RadiosityVsPath, CornellErrorFallsWithTheMesh) {
 // mesh view by more than that noise, and it must converge with the mesh as the mesh view does
 // (the bound above, with both renders' noise added).
 TEST(RadiosityVsPath, TwoPassViewTakesTheDirectLightExactly) {
-  rc::Scene scene = rc::load_scene("cornell");
+  rc::scene::Scene scene = rc::io::load_scene("cornell");
   const std::vector<rc::Rgb> reference = path_render(scene, 2048, 1);
-  const double reference_noise = 0.5 * rc::mean_relative_error(path_render(scene, 2048, 2), reference);
+  const double reference_noise = 0.5 * rc::util::mean_relative_error(path_render(scene, 2048, 2), reference);
   const std::vector<rc::Rgb> coarse_image = radiosity_render(scene, 400, rad::bake::ViewMode::two_pass, 1, 1024);
   const double own_noise =
-      0.5 * rc::mean_relative_error(radiosity_render(scene, 400, rad::bake::ViewMode::two_pass, 2, 1024), coarse_image);
-  const double mesh = rc::mean_relative_error(radiosity_render(scene, 400), reference);
-  const double coarse = rc::mean_relative_error(coarse_image, reference);
-  const double fine = rc::mean_relative_error(radiosity_render(scene, 1600, rad::bake::ViewMode::two_pass, 1, 1024), reference);
+      0.5 * rc::util::mean_relative_error(radiosity_render(scene, 400, rad::bake::ViewMode::two_pass, 2, 1024), coarse_image);
+  const double mesh = rc::util::mean_relative_error(radiosity_render(scene, 400), reference);
+  const double coarse = rc::util::mean_relative_error(coarse_image, reference);
+  const double fine = rc::util::mean_relative_error(radiosity_render(scene, 1600, rad::bake::ViewMode::two_pass, 1, 1024), reference);
   std::printf("mean relative error: mesh view %.4f; two-pass 400 elements %.4f, 1600 elements %.4f; "
               "noise: two-pass %.4f, reference %.4f\n", mesh, coarse, fine, own_noise, reference_noise);
   EXPECT_LT(coarse + own_noise, mesh) << "the two-pass view is no closer to the path tracer than the mesh view";

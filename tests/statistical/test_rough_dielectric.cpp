@@ -1,4 +1,4 @@
-// Tests of the rough dielectric (raytrace_core/rough_dielectric.h): GGX reflection and
+// Tests of the rough dielectric (raytrace_core/scene/rough_dielectric.h): GGX reflection and
 // refraction, solid and thin-walled, and next-event estimation through it.
 //
 //   - Sampling: bsdf_sample's directions follow bsdf_pdf over the whole sphere (chi-square, both
@@ -26,17 +26,17 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/bsdf.h"
-#include "raytrace_core/direct_light.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/render/direct_light.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/statistical/bsdf_chi2.h"
 #include "tests/statistical/bsdf_test_kit.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 constexpr size_t kChi2Samples = 1000000;
@@ -93,7 +93,7 @@ TEST_P(RoughDielectricLobe, SampleMatchesEvalAndPdf) {
   // The sample's f and pdf come from the same routine as bsdf_eval's and bsdf_pdf's, evaluated
   // at the direction it returns: equal up to float rounding of that direction (relative 1e-4).
   const LobeCase& c = GetParam();
-  Rng rng(42);
+  util::Rng rng(42);
   int taken = 0, transmitted = 0;
   for (int k = 0; k < 20000; ++k) {
     const float u_lobe = rng.uniform();
@@ -121,14 +121,15 @@ INSTANTIATE_TEST_SUITE_P(Bsdf, RoughDielectricLobe, testing::ValuesIn(lobe_cases
                          [](const auto& info) { return info.param.name; });
 
 TEST(RoughDielectric, AdjointAndReciprocalAndPositive) {
-  Rng rng(5);
+  util::Rng rng(5);
   for (float roughness : {0.1f, 0.5f, 1.0f})
     for (float ior : {1.33f, 1.5f, 2.4f})
       for (bool thin : {false, true}) {
         const Material m = rough_glass(roughness, ior, thin);
         int nonzero_t = 0;
         for (int k = 0; k < 4000; ++k) {
-          const Vec3 a = sample_uniform_sphere(rng.uniform2()), b = sample_uniform_sphere(rng.uniform2());
+          const Vec3 a = util::sample_uniform_sphere(rng.uniform2()),
+                     b = util::sample_uniform_sphere(rng.uniform2());
           // Refraction ends where a·b = −1/η: there wo·h → 0, F → 1 and T = 1 − F cancels in
           // float, its relative error growing as the inverse distance (2e-3 at 0.01 for η = 2.4).
           // The band of 0.05 around it is left out of the comparison, not of the sign checks.
@@ -166,7 +167,7 @@ TEST(RoughDielectric, WhiteFurnace) {
       for (float theta : {0.0f, 0.8f, 1.3f, kPi - 0.3f, kPi - 1.0f}) {
         const Material m = rough_glass(roughness, 1.5f, thin);
         const Vec3 wo = spherical(theta, 0.4f);
-        Rng rng(91);
+        util::Rng rng(91);
         const test::MeanEstimate by_bsdf = test::estimate_mean(kN, [&] {
           const float u_lobe = rng.uniform();
           const auto s = bsdf_sample(m, wo, u_lobe, rng.uniform2(), TransportMode::importance);
@@ -178,7 +179,7 @@ TEST(RoughDielectric, WhiteFurnace) {
         EXPECT_LE(by_bsdf.mean, 1.0 + kZ * by_bsdf.standard_error + 1e-6) << roughness << " " << thin << " " << theta;
         if (roughness >= 0.6f) {  // wide lobes: uniform directions over the sphere see them well
           const test::MeanEstimate by_uniform = test::estimate_mean(kN, [&] {
-            const Vec3 wi = sample_uniform_sphere(rng.uniform2());
+            const Vec3 wi = util::sample_uniform_sphere(rng.uniform2());
             return double(bsdf_eval(m, wo, wi, TransportMode::importance).g) * std::fabs(wi.z) * 4.0 * std::numbers::pi;
           });
           EXPECT_NEAR(by_bsdf.mean, by_uniform.mean, kZ * std::hypot(by_bsdf.standard_error, by_uniform.standard_error))
@@ -200,7 +201,7 @@ TEST(RoughDielectric, NearlySmoothRefractsAlongSnell) {
   const Material smooth = Material::make_dielectric("smooth", 1.5f);
   const auto exact = bsdf_sample(smooth, wo, 0.999f, {0.5f, 0.5f});
   ASSERT_TRUE(exact && exact->transmission);
-  Rng rng(3);
+  util::Rng rng(3);
   int refracted = 0, close = 0;
   for (int k = 0; k < 10000; ++k) {
     const float u_lobe = rng.uniform();
@@ -245,9 +246,9 @@ TEST(RoughDielectric, NextEventEstimationSeesLightsBehindIt) {
     const Vec3 wo = frame.to_local(wo_world);
     const bool above = glm::dot(wo_world, si.ng) > 0.0f;
     constexpr int kN = 400000;
-    Sampler rng(Rng(17));
+    render::Sampler rng(util::Rng(17));
     uint64_t rays = 0;
-    const test::MeanEstimate nee = test::estimate_mean(kN, [&] { return double(sample_direct(scene, si, m, frame, wo, above, rng, rays).value.g); });
+    const test::MeanEstimate nee = test::estimate_mean(kN, [&] { return double(render::sample_direct(scene, si, m, frame, wo, above, rng, rays).value.g); });
     const test::MeanEstimate by_bsdf = test::estimate_mean(kN, [&] {
       const float u_lobe = rng.uniform();
       const auto s = bsdf_sample(m, wo, u_lobe, rng.uniform2());
@@ -268,4 +269,4 @@ TEST(RoughDielectric, NextEventEstimationSeesLightsBehindIt) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

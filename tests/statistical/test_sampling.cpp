@@ -1,4 +1,4 @@
-// Chi-square tests of the warping functions in raytrace_core/sampling.h (see chi2.h for the method).
+// Chi-square tests of the warping functions in raytrace_core/util/sampling.h (see chi2.h for the method).
 //
 // Each test draws 10⁶ samples from a fixed seed, so results are deterministic; the significance
 // level α = 0.01 is shared by the kChi2Tests chi-square tests of this program (Šidák correction),
@@ -9,11 +9,11 @@
 #include <numbers>
 #include <vector>
 
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 #include "tests/statistical/chi2.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 using test::chi2_directions;
@@ -230,4 +230,4 @@ TEST(Distribution1D, NegativeAndNanWeightsCountAsZero) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

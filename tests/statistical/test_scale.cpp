@@ -13,8 +13,8 @@
 
 #include <cmath>
 
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
@@ -23,19 +23,19 @@ namespace rc = gilt::raytrace_core;
 namespace {
 
 std::vector<rc::Rgb> render(float scale, const rc::Vec3& offset, uint64_t seed) {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  if (scale != 1.0f || offset != rc::Vec3(0.0f)) rc::transform_scene(scene, scale, offset);
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  if (scale != 1.0f || offset != rc::Vec3(0.0f)) rc::io::transform_scene(scene, scale, offset);
   scene.commit();
-  rc::RenderSettings s;
+  rc::render::RenderSettings s;
   s.width = s.height = 48;
   s.spp = 64;
   s.seed = seed;
   s.progress = false;
-  const rc::PathSettings path;
-  rc::RenderStats stats;
-  const rc::Film film = rc::render_image(
+  const rc::render::PathSettings path;
+  rc::render::RenderStats stats;
+  const rc::render::Film film = rc::render::render_image(
       scene, scene.effective_camera(), s,
-      [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); }, &stats);
+      [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); }, &stats);
   EXPECT_EQ(stats.non_finite, 0u);
   return film.pixels();
 }

@@ -15,10 +15,10 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "raytrace_core/io/image_error.h"
+#include "raytrace_core/util/image_error.h"
 #include "photonmap/sppm.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
@@ -29,8 +29,8 @@ namespace {
 
 constexpr int kSize = 32;
 
-rc::RenderSettings settings(int spp, uint64_t seed) {
-  rc::RenderSettings s;
+rc::render::RenderSettings settings(int spp, uint64_t seed) {
+  rc::render::RenderSettings s;
   s.width = s.height = kSize;
   s.spp = spp;
   s.seed = seed;
@@ -40,14 +40,14 @@ rc::RenderSettings settings(int spp, uint64_t seed) {
 
 /// A closed icosphere of radius 1 (1,280 facets, facing in), diffuse 0.5, lit by a point light
 /// of intensity 1 at `lamp`; not yet committed, so that a test can add to it.
-rc::Scene lit_sphere_room(const rc::Vec3& lamp_position) {
-  rc::Scene scene;
-  scene.materials = {rc::Material::make_diffuse("wall", rc::Rgb(0.5f))};
-  rc::TriangleMesh sphere = gilt::test::icosphere(3);
+rc::scene::Scene lit_sphere_room(const rc::Vec3& lamp_position) {
+  rc::scene::Scene scene;
+  scene.materials = {rc::scene::Material::make_diffuse("wall", rc::Rgb(0.5f))};
+  rc::scene::TriangleMesh sphere = gilt::test::icosphere(3);
   for (size_t i = 0; i < sphere.indices.size(); i += 3) std::swap(sphere.indices[i + 1], sphere.indices[i + 2]);
   scene.meshes.push_back(std::move(sphere));
-  rc::Light lamp;
-  lamp.kind = rc::LightKind::point;
+  rc::scene::Light lamp;
+  lamp.kind = rc::scene::LightKind::point;
   lamp.position = lamp_position;
   lamp.intensity = rc::Rgb(1.0f);
   scene.punctual_lights.push_back(lamp);
@@ -61,15 +61,16 @@ struct MeanComparison {
   double path, sppm, standard_error;
 };
 
-MeanComparison compare_means(const rc::Scene& scene, const rc::Camera& camera, uint64_t path_seed, uint64_t sppm_seed,
+MeanComparison compare_means(const rc::scene::Scene& scene, const rc::scene::Camera& camera, uint64_t path_seed, uint64_t sppm_seed,
                              int iterations, float radius) {
   double path[4], photons[4];
   for (int s = 0; s < 4; ++s) {
-    const rc::PathSettings ps;
-    path[s] = gilt::test::film_mean(rc::render_image(scene, camera, settings(256, path_seed + s),
-                                                      [&](const rc::Ray& ray, rc::SampleContext& ctx) {
-                                                        return rc::path_radiance(scene, ray, ctx, ps);
-                                                      }));
+    const rc::render::PathSettings ps;
+    path[s] = gilt::test::film_mean(
+        rc::render::render_image(scene, camera, settings(256, path_seed + s),
+                                 [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+                                   return rc::render::path_radiance(scene, ray, ctx, ps);
+                                 }));
     pm::SppmSettings sppm;
     sppm.photons_per_iteration = 20000;
     sppm.initial_radius = radius;
@@ -92,18 +93,18 @@ MeanComparison compare_means(const rc::Scene& scene, const rc::Camera& camera, u
 }  // namespace
 
 TEST(Sppm, ApproachesThePathTracedReference) {
-  const rc::Scene scene = rc::load_scene("cornell-caustics");
-  const rc::Camera camera = scene.effective_camera();
-  const rc::PathSettings path;
+  const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
+  const rc::scene::Camera camera = scene.effective_camera();
+  const rc::render::PathSettings path;
   auto path_render = [&](uint64_t seed) {
-    return rc::render_image(scene, camera, settings(2048, seed),
-                            [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); })
+    return rc::render::render_image(scene, camera, settings(2048, seed),
+                            [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); })
         .pixels();
   };
   const std::vector<rc::Rgb> a = path_render(101), b = path_render(102);
   std::vector<rc::Rgb> reference(a.size());
   for (size_t i = 0; i < a.size(); ++i) reference[i] = (a[i] + b[i]) * 0.5f;
-  const double noise = 0.5 * rc::mean_relative_error(a, b);
+  const double noise = 0.5 * rc::util::mean_relative_error(a, b);
 
   pm::SppmSettings sppm;
   sppm.photons_per_iteration = 20000;
@@ -111,10 +112,10 @@ TEST(Sppm, ApproachesThePathTracedReference) {
   double error[3];
   for (int i = 0; i < 3; ++i) {
     pm::SppmStats stats;
-    const rc::Film film = pm::render_sppm(scene, camera, settings(iterations[i], 7), sppm, &stats);
+    const rc::render::Film film = pm::render_sppm(scene, camera, settings(iterations[i], 7), sppm, &stats);
     ASSERT_EQ(stats.iterations, iterations[i]);
     ASSERT_EQ(film.non_finite_count(), 0u);
-    error[i] = rc::mean_relative_error(film.pixels(), reference);
+    error[i] = rc::util::mean_relative_error(film.pixels(), reference);
     std::printf("sppm %2d iterations: mean relative error %.4f (reference noise %.4f), mean radius %.3g\n",
                 iterations[i], error[i], noise, stats.mean_final_radius);
   }
@@ -150,9 +151,9 @@ TEST(Sppm, ApproachesThePathTracedReference) {
 //   the BSDF is zero, with probability (β − sin β cos β) / π for cosine-distributed directions:
 //   about 3 % of the flux over the initial disk (β up to 41°), less as the radius shrinks.
 TEST(Sppm, KeepsThePhotonsOfACurvedSurface) {
-  rc::Scene scene = lit_sphere_room(rc::Vec3(0.0f));
+  rc::scene::Scene scene = lit_sphere_room(rc::Vec3(0.0f));
   scene.commit();
-  rc::Camera camera;
+  rc::scene::Camera camera;
   camera.look_from = rc::Vec3(0.0f, 0.0f, 0.5f);
   camera.look_at = rc::Vec3(0.0f, 0.0f, -1.0f);
   camera.vfov_degrees = 60.0f;
@@ -173,14 +174,14 @@ TEST(Sppm, KeepsThePhotonsOfACurvedSurface) {
 // reciprocal is biased up by its relative variance (at 16 iterations, 16 probes, the image came
 // out 2 % bright).
 TEST(Sppm, DividesByTheSurfaceTheDiskHolds) {
-  rc::Scene scene = lit_sphere_room(rc::Vec3(0.0f, 0.6f, 0.0f));
-  rc::TriangleMesh plank;
+  rc::scene::Scene scene = lit_sphere_room(rc::Vec3(0.0f, 0.6f, 0.0f));
+  rc::scene::TriangleMesh plank;
   const float w = 0.05f, l = 0.8f;
   plank.positions = {{-w, 0.0f, -l}, {-w, 0.0f, l}, {w, 0.0f, l}, {w, 0.0f, -l}};
   plank.indices = {0, 1, 2, 0, 2, 3};  // facing +y
   scene.meshes.push_back(std::move(plank));
   scene.commit();
-  rc::Camera camera;
+  rc::scene::Camera camera;
   camera.look_from = rc::Vec3(0.0f, 0.3f, 0.0f);
   camera.look_at = rc::Vec3(0.0f);
   camera.up = rc::Vec3(0.0f, 0.0f, -1.0f);

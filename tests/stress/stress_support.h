@@ -18,10 +18,10 @@
 #include "photonmap/sppm.h"
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
-#include "raytrace_core/whitted.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
+#include "raytrace_core/render/whitted.h"
 
 namespace gilt::stress {
 
@@ -89,34 +89,34 @@ inline double image_mean(const std::vector<rc::Rgb>& image) {
 }
 
 /// Renders the committed scene with its own camera by `method` at a fixed seed.
-inline MethodResult render_method(const rc::Scene& scene, Method method, const Budget& budget,
+inline MethodResult render_method(const rc::scene::Scene& scene, Method method, const Budget& budget,
                                   uint64_t seed) {
-  rc::RenderSettings s;
+  rc::render::RenderSettings s;
   s.width = s.height = budget.size;
   s.spp = budget.spp;
   s.seed = seed;
   s.progress = false;
-  const rc::Camera camera = scene.effective_camera();
+  const rc::scene::Camera camera = scene.effective_camera();
   MethodResult r;
-  rc::RenderStats stats;
-  rc::Film film;
+  rc::render::RenderStats stats;
+  rc::render::Film film;
   switch (method) {
     case Method::path: {
-      const rc::PathSettings path;
-      film = rc::render_image(
+      const rc::render::PathSettings path;
+      film = rc::render::render_image(
           scene, camera, s,
-          [&](const rc::Ray& ray, rc::SampleContext& ctx) {
-            return rc::path_radiance(scene, ray, ctx, path);
+          [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+            return rc::render::path_radiance(scene, ray, ctx, path);
           },
           &stats);
       break;
     }
     case Method::whitted: {
-      const rc::WhittedSettings whitted;
-      film = rc::render_image(
+      const rc::render::WhittedSettings whitted;
+      film = rc::render::render_image(
           scene, camera, s,
-          [&](const rc::Ray& ray, rc::SampleContext& ctx) {
-            return rc::whitted_radiance(scene, ray, ctx, whitted);
+          [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+            return rc::render::whitted_radiance(scene, ray, ctx, whitted);
           },
           &stats);
       break;
@@ -131,9 +131,10 @@ inline MethodResult render_method(const rc::Scene& scene, Method method, const B
           count_non_finite(r.solution->vertex_radiosity) + count_non_finite(r.solution->vertex_irradiance);
       r.non_finite_residual = !std::isfinite(r.solution->residual);
       const rad::bake::RadiosityView view(scene, *r.solution);
-      film = rc::render_image(
+      film = rc::render::render_image(
           scene, camera, s,
-          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return view.radiance(ray, ctx); }, &stats);
+          [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return view.radiance(ray, ctx); },
+          &stats);
       break;
     }
     case Method::photon: {
@@ -143,9 +144,12 @@ inline MethodResult render_method(const rc::Scene& scene, Method method, const B
       settings.photons.seed = seed;
       settings.gather_rays = budget.gather_rays;
       const pm::PhotonMapper mapper(scene, settings);
-      film = rc::render_image(
+      film = rc::render::render_image(
           scene, camera, s,
-          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return mapper.radiance(ray, ctx); }, &stats);
+          [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) {
+            return mapper.radiance(ray, ctx);
+          },
+          &stats);
       break;
     }
     case Method::sppm: {

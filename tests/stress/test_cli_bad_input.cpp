@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 #include "tests/stress/bad_files.h"
 
 namespace fs = std::filesystem;
@@ -318,7 +318,7 @@ TEST_F(CliBadInput, SceneWithoutLightsWarnsAndExitsZero) {
     EXPECT_TRUE(fs::exists(out)) << method;
     EXPECT_NE(r.out.find("\"non_finite_samples\":0"), std::string::npos) << method << ": " << r.out;
     EXPECT_NE(r.out.find("\"rays\":0,"), std::string::npos) << method << ": " << r.out;
-    const rc::Image image = rc::read_image(out.string());
+    const rc::util::Image image = rc::util::read_image(out.string());
     for (const rc::Rgb& p : image.pixels) EXPECT_TRUE(p.is_black()) << method;
   }
   const fs::path mesh = dir_ / "dark.ply";

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/stress/bad_files.h"
 #include "tests/stress/stress_support.h"
@@ -46,7 +46,7 @@ class Loaders : public ::testing::Test {
     // The OBJ seed's MTL half sits after "#---mtl---"; the loader just sees a comment line, and
     // "mtllib scene.mtl" names a file that is absent (a warning, not an error).
     try {
-      const rc::Scene scene = rc::load_scene(path.string());
+      const rc::scene::Scene scene = rc::io::load_scene(path.string());
       EXPECT_TRUE(scene.committed()) << what;
       return "";
     } catch (const rc::InputError& e) {

@@ -23,10 +23,10 @@
 
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/support/mesh_builders.h"
 
 namespace gilt::radiosity {
@@ -34,10 +34,10 @@ using namespace mesh;
 using namespace solver;
 namespace {
 
-using rc::Material;
+using rc::scene::Material;
 using rc::Rgb;
-using rc::Scene;
-using rc::TriangleMesh;
+using rc::scene::Scene;
+using rc::scene::TriangleMesh;
 using test::add_box;
 using test::add_quad;
 
@@ -45,7 +45,7 @@ using test::add_quad;
 constexpr uint64_t kSeeds = 300;
 
 Scene random_scene(uint64_t seed) {
-  rc::Rng rng = rc::Rng::for_item(seed, 0, 0x5eed);
+  rc::util::Rng rng = rc::util::Rng::for_item(seed, 0, 0x5eed);
   const auto u = [&](float lo, float hi) { return lo + (hi - lo) * rng.uniform(); };
   Scene scene;
   scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.7f)));
@@ -91,8 +91,8 @@ Scene random_scene(uint64_t seed) {
 
   test::add_ceiling_lamp(scene, 2);
   if (rng.uniform() < 0.5f) {
-    rc::Light sun;
-    sun.kind = rc::LightKind::directional;
+    rc::scene::Light sun;
+    sun.kind = rc::scene::LightKind::directional;
     sun.direction = glm::normalize(Vec3(u(-1.0f, 1.0f), -1.0f, u(-1.0f, 1.0f)));
     sun.irradiance = Rgb(1.0f);
     scene.punctual_lights.push_back(sun);

@@ -40,39 +40,39 @@ gilt::stress::Budget budget() {
   return b;
 }
 
-uint32_t add_material(rc::Scene& scene, rc::Material material) {
+uint32_t add_material(rc::scene::Scene& scene, rc::scene::Material material) {
   scene.materials.push_back(std::move(material));
   return uint32_t(scene.materials.size() - 1);
 }
 
-rc::TriangleMesh& add_mesh(rc::Scene& scene, const std::string& name, uint32_t material) {
-  rc::TriangleMesh& mesh = scene.meshes.emplace_back();
+rc::scene::TriangleMesh& add_mesh(rc::scene::Scene& scene, const std::string& name, uint32_t material) {
+  rc::scene::TriangleMesh& mesh = scene.meshes.emplace_back();
   mesh.name = name;
   mesh.material = material;
   return mesh;
 }
 
 /// Appends triangle (a, b, c) with its own three vertices.
-void add_triangle(rc::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c) {
+void add_triangle(rc::scene::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c) {
   const auto first = uint32_t(mesh.positions.size());
   mesh.positions.insert(mesh.positions.end(), {a, b, c});
   mesh.indices.insert(mesh.indices.end(), {first, first + 1, first + 2});
 }
 
 /// Appends the quad a b c d (counter-clockwise seen from the front) as two triangles.
-void add_quad(rc::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+void add_quad(rc::scene::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const auto first = uint32_t(mesh.positions.size());
   mesh.positions.insert(mesh.positions.end(), {a, b, c, d});
   mesh.indices.insert(mesh.indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
 }
 
 /// A floor-level quad [x0, x1] × [z0, z1] at height y facing up.
-void add_floor_quad(rc::TriangleMesh& mesh, float x0, float x1, float z0, float z1, float y) {
+void add_floor_quad(rc::scene::TriangleMesh& mesh, float x0, float x1, float z0, float z1, float y) {
   add_quad(mesh, Vec3(x0, y, z0), Vec3(x0, y, z1), Vec3(x1, y, z1), Vec3(x1, y, z0));
 }
 
 /// An axis-aligned box, faces outward.
-void add_box(rc::TriangleMesh& mesh, const Vec3& lo, const Vec3& hi) {
+void add_box(rc::scene::TriangleMesh& mesh, const Vec3& lo, const Vec3& hi) {
   const Vec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
                      {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
   add_quad(mesh, p[0], p[3], p[2], p[1]);  // −z
@@ -89,22 +89,24 @@ void add_box(rc::TriangleMesh& mesh, const Vec3& lo, const Vec3& hi) {
 /// Quads lying on the floor and on each other: exactly coplanar (z-fighting), 1e-6 and 1e-3
 /// apart, a two-sided sheet (two coincident quads facing opposite ways), a block touching the
 /// floor, the back wall and another block face to face.
-rc::Scene touching_and_coplanar() {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  const uint32_t red = add_material(scene, rc::Material::make_diffuse("red2", rc::Rgb(0.8f, 0.1f, 0.1f)));
-  const uint32_t blue = add_material(scene, rc::Material::make_diffuse("blue2", rc::Rgb(0.1f, 0.1f, 0.8f)));
+rc::scene::Scene touching_and_coplanar() {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  const uint32_t red =
+      add_material(scene, rc::scene::Material::make_diffuse("red2", rc::Rgb(0.8f, 0.1f, 0.1f)));
+  const uint32_t blue =
+      add_material(scene, rc::scene::Material::make_diffuse("blue2", rc::Rgb(0.1f, 0.1f, 0.8f)));
   add_floor_quad(add_mesh(scene, "on_floor", red), 40, 200, 20, 160, 0.0f);
   add_floor_quad(add_mesh(scene, "on_floor_too", blue), 100, 260, 60, 200, 0.0f);
   add_floor_quad(add_mesh(scene, "floor_1e-6", blue), 300, 420, 20, 140, 1e-6f);
   add_floor_quad(add_mesh(scene, "floor_1e-6_again", red), 330, 450, 40, 160, 2e-6f);
   add_floor_quad(add_mesh(scene, "floor_1e-3", red), 440, 540, 20, 120, 1e-3f);
   // A sheet: the same quad facing up and facing down, coincident.
-  rc::TriangleMesh& sheet = add_mesh(scene, "sheet", blue);
+  rc::scene::TriangleMesh& sheet = add_mesh(scene, "sheet", blue);
   const Vec3 a(200, 250, 150), b(200, 250, 260), c(320, 250, 260), d(320, 250, 150);
   add_quad(sheet, a, b, c, d);
   add_quad(sheet, a, d, c, b);
   // Blocks touching the back wall (z = 559.2) and the floor, and each other face to face.
-  rc::TriangleMesh& blocks = add_mesh(scene, "touching_blocks", red);
+  rc::scene::TriangleMesh& blocks = add_mesh(scene, "touching_blocks", red);
   add_box(blocks, Vec3(60, 0, 459.2f), Vec3(160, 100, 559.2f));
   add_box(blocks, Vec3(160, 0, 459.2f), Vec3(240, 60, 559.2f));
   return scene;
@@ -113,18 +115,18 @@ rc::Scene touching_and_coplanar() {
 /// Sliver triangles of aspect 1e-6: a floor quad split along its diagonal with the middle
 /// vertex 1e-6 of the diagonal's length off it (a watertight surface with a sliver in it),
 /// needles floating in the room and an emitting sliver.
-rc::Scene slivers() {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  const uint32_t grey = add_material(scene, rc::Material::make_diffuse("grey", rc::Rgb(0.6f)));
-  const uint32_t glow = add_material(scene, rc::Material::make_emitter("glow", rc::Rgb(50.0f)));
-  rc::TriangleMesh& split = add_mesh(scene, "split_quad", grey);
+rc::scene::Scene slivers() {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  const uint32_t grey = add_material(scene, rc::scene::Material::make_diffuse("grey", rc::Rgb(0.6f)));
+  const uint32_t glow = add_material(scene, rc::scene::Material::make_emitter("glow", rc::Rgb(50.0f)));
+  rc::scene::TriangleMesh& split = add_mesh(scene, "split_quad", grey);
   const Vec3 a(60, 1, 60), b(60, 1, 300), c(300, 1, 300), d(300, 1, 60);
   const Vec3 diagonal = c - a;
   const Vec3 off = Vec3(-diagonal.z, 0.0f, diagonal.x) * 1e-6f;  // perpendicular, in the plane
   const Vec3 e = 0.5f * (a + c) + off;
   split.positions = {a, b, c, d, e};
   split.indices = {0, 1, 4, 4, 1, 2, 0, 4, 2, 0, 2, 3};  // a b e, e b c, the sliver a e c, a c d
-  rc::TriangleMesh& needles = add_mesh(scene, "needles", grey);
+  rc::scene::TriangleMesh& needles = add_mesh(scene, "needles", grey);
   for (int i = 0; i < 8; ++i) {
     const float z = 100.0f + 40.0f * i, h = 1e-6f * 300.0f * float(i + 1);
     add_triangle(needles, Vec3(100, 200 + 10 * i, z), Vec3(400, 200 + 10 * i, z + 0.5f * i),
@@ -137,16 +139,16 @@ rc::Scene slivers() {
 
 /// Degenerate triangles: zero area (collinear), a repeated vertex, all three the same, a mesh of
 /// nothing else, an emitter of zero area, and zero-length shading normals.
-rc::Scene degenerate() {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  const uint32_t grey = add_material(scene, rc::Material::make_diffuse("grey", rc::Rgb(0.6f)));
-  const uint32_t glow = add_material(scene, rc::Material::make_emitter("glow", rc::Rgb(50.0f)));
-  rc::TriangleMesh& mixed = add_mesh(scene, "mixed", grey);
+rc::scene::Scene degenerate() {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  const uint32_t grey = add_material(scene, rc::scene::Material::make_diffuse("grey", rc::Rgb(0.6f)));
+  const uint32_t glow = add_material(scene, rc::scene::Material::make_emitter("glow", rc::Rgb(50.0f)));
+  rc::scene::TriangleMesh& mixed = add_mesh(scene, "mixed", grey);
   add_quad(mixed, Vec3(100, 150, 300), Vec3(100, 250, 300), Vec3(250, 250, 300), Vec3(250, 150, 300));
   add_triangle(mixed, Vec3(100, 100, 200), Vec3(200, 100, 200), Vec3(300, 100, 200));  // collinear
   mixed.indices.insert(mixed.indices.end(), {0, 0, 1, 2, 2, 2});                       // repeated vertices
   mixed.normals.assign(mixed.positions.size(), Vec3(0.0f));                            // unusable normals
-  rc::TriangleMesh& only = add_mesh(scene, "only_degenerate", grey);
+  rc::scene::TriangleMesh& only = add_mesh(scene, "only_degenerate", grey);
   add_triangle(only, Vec3(10, 10, 10), Vec3(10, 10, 10), Vec3(10, 10, 10));
   add_triangle(only, Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(2, 2, 2));
   add_triangle(add_mesh(scene, "flat_light", glow), Vec3(200, 300, 200), Vec3(300, 300, 200),
@@ -155,43 +157,43 @@ rc::Scene degenerate() {
 }
 
 /// Every diffuse surface of the box reflects 99.9 %.
-rc::Scene albedo_0999() {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  for (rc::Material& m : scene.materials)
+rc::scene::Scene albedo_0999() {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  for (rc::scene::Material& m : scene.materials)
     if (!m.is_emissive()) m.albedo = rc::Rgb(0.999f);
   return scene;
 }
 
 /// The closed white furnace with albedo 0.999 (L = Le / (1 − ρ) = 1000 Le).
-rc::Scene furnace_0999() { return rc::furnace_scene(0.5f, 0.999f); }
+rc::scene::Scene furnace_0999() { return rc::io::furnace_scene(0.5f, 0.999f); }
 
 /// The Cornell box with its light's emission multiplied by `k`.
-rc::Scene emission_scaled(float k) {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  for (rc::Material& m : scene.materials) m.emission *= k;
+rc::scene::Scene emission_scaled(float k) {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  for (rc::scene::Material& m : scene.materials) m.emission *= k;
   return scene;
 }
 
 /// Two lights twelve orders of magnitude apart: the box's light at 1e6 × its radiance and a
 /// small quad on the back wall at 1e-6 ×.
-rc::Scene emission_1e6_and_1e_minus6() {
-  rc::Scene scene = emission_scaled(1e6f);
-  const uint32_t dim = add_material(scene, rc::Material::make_emitter("dim", rc::Rgb(1e-6f)));
+rc::scene::Scene emission_1e6_and_1e_minus6() {
+  rc::scene::Scene scene = emission_scaled(1e6f);
+  const uint32_t dim = add_material(scene, rc::scene::Material::make_emitter("dim", rc::Rgb(1e-6f)));
   add_quad(add_mesh(scene, "dim_light", dim), Vec3(250, 300, 559.0f), Vec3(310, 300, 559.0f),
            Vec3(310, 360, 559.0f), Vec3(250, 360, 559.0f));
   return scene;
 }
 
 /// The Cornell box with its light switched off: no emitter and no punctual light at all.
-rc::Scene no_lights() {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  for (rc::Material& m : scene.materials) m.emission = rc::Rgb(0.0f);
+rc::scene::Scene no_lights() {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  for (rc::scene::Material& m : scene.materials) m.emission = rc::Rgb(0.0f);
   return scene;
 }
 
 struct SceneCase {
   std::string name;
-  std::function<rc::Scene()> make;
+  std::function<rc::scene::Scene()> make;
   int radiosity_elements = 200;
   int photons = 10'000;
 };
@@ -216,7 +218,7 @@ const std::vector<SceneCase>& scene_cases() {
   return cases;
 }
 
-MethodResult run_case(const rc::Scene& scene, Method method, int radiosity_elements = 200, int photons = 10'000) {
+MethodResult run_case(const rc::scene::Scene& scene, Method method, int radiosity_elements = 200, int photons = 10'000) {
   gilt::stress::Budget b = budget();
   b.radiosity_elements = radiosity_elements;
   b.photons = photons;
@@ -231,7 +233,7 @@ TEST_P(Pathological, NoNonFiniteValueNoCrashNoHang) {
   const SceneCase& c = scene_cases()[std::get<0>(GetParam())];
   const Method method = std::get<1>(GetParam());
   const gilt::stress::Watchdog watchdog(c.name + " / " + method_name(method), kCaseLimit);
-  rc::Scene scene = c.make();
+  rc::scene::Scene scene = c.make();
   scene.commit();
   const MethodResult r = run_case(scene, method, c.radiosity_elements, c.photons);
   EXPECT_EQ(r.non_finite_samples, 0u);
@@ -255,7 +257,7 @@ class PathologicalMethod : public ::testing::TestWithParam<Method> {};
 
 // The degenerate triangles are dropped with a warning, not an error, and the rest renders.
 TEST_P(PathologicalMethod, DegenerateTrianglesAreDroppedWithAWarning) {
-  rc::Scene scene = degenerate();
+  rc::scene::Scene scene = degenerate();
   scene.commit();
   bool warned = false;
   for (const std::string& w : scene.warnings) warned = warned || w.find("degenerate") != std::string::npos;
@@ -265,7 +267,7 @@ TEST_P(PathologicalMethod, DegenerateTrianglesAreDroppedWithAWarning) {
 // No lights: every method returns an all-black image (exactly zero, not merely dark).
 TEST_P(PathologicalMethod, NoLightsGivesBlack) {
   const gilt::stress::Watchdog watchdog(std::string("no lights / ") + method_name(GetParam()), kCaseLimit);
-  rc::Scene scene = no_lights();
+  rc::scene::Scene scene = no_lights();
   scene.commit();
   ASSERT_TRUE(scene.lights().empty());
   const MethodResult r = run_case(scene, GetParam());
@@ -282,12 +284,12 @@ TEST_P(PathologicalMethod, NoLightsGivesBlack) {
 TEST_P(PathologicalMethod, EmissionFrom1eMinus6To1e6ScalesTheImage) {
   const Method method = GetParam();
   const gilt::stress::Watchdog watchdog(std::string("emission sweep / ") + method_name(method), kCaseLimit);
-  rc::Scene base = emission_scaled(1.0f);
+  rc::scene::Scene base = emission_scaled(1.0f);
   base.commit();
   const double reference = gilt::stress::image_mean(run_case(base, method).image);
   ASSERT_GT(reference, 0.0);
   for (float k : {1e-6f, 1e-3f, 1e3f, 1e6f}) {
-    rc::Scene scene = emission_scaled(k);
+    rc::scene::Scene scene = emission_scaled(k);
     scene.commit();
     const MethodResult r = run_case(scene, method);
     EXPECT_EQ(r.non_finite_total(), 0u) << "k = " << k;

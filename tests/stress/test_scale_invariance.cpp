@@ -72,8 +72,8 @@ Budget budget() {
 
 MethodResult render(const std::string& scene_name, Method method, float scale, const rc::Vec3& offset,
                     uint64_t seed) {
-  rc::Scene scene = rc::builtin_scene(scene_name);
-  if (scale != 1.0f || offset != rc::Vec3(0.0f)) rc::transform_scene(scene, scale, offset);
+  rc::scene::Scene scene = rc::io::builtin_scene(scene_name);
+  if (scale != 1.0f || offset != rc::Vec3(0.0f)) rc::io::transform_scene(scene, scale, offset);
   scene.commit();
   return gilt::stress::render_method(scene, method, budget(), seed);
 }

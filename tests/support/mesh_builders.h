@@ -6,14 +6,14 @@
 #include <cmath>
 #include <cstdint>
 
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::test {
 namespace rc = gilt::raytrace_core;
 
 /// Appends the quad (c0, c1, c2, c3) as two triangles; its front is the side it winds
 /// counter-clockwise about.
-inline void add_quad(rc::TriangleMesh& mesh, const std::array<rc::Vec3, 4>& c) {
+inline void add_quad(rc::scene::TriangleMesh& mesh, const std::array<rc::Vec3, 4>& c) {
   const auto base = static_cast<uint32_t>(mesh.positions.size());
   mesh.positions.insert(mesh.positions.end(), c.begin(), c.end());
   mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
@@ -23,7 +23,7 @@ inline void add_quad(rc::TriangleMesh& mesh, const std::array<rc::Vec3, 4>& c) {
 /// then turned by `turn` about y, then moved to `center`. Corner i has x, y, z at the + side
 /// where bit 0, 1, 2 of i is set; its bottom (y = −half.y) is the third quad, indices 12–17 of
 /// those appended.
-inline void add_box(rc::TriangleMesh& mesh, const rc::Vec3& center, const rc::Vec3& half, float turn,
+inline void add_box(rc::scene::TriangleMesh& mesh, const rc::Vec3& center, const rc::Vec3& half, float turn,
                     float tilt = 0.0f) {
   const float cy = std::cos(turn), sy = std::sin(turn), cx = std::cos(tilt), sx = std::sin(tilt);
   const auto base = static_cast<uint32_t>(mesh.positions.size());
@@ -41,8 +41,8 @@ inline void add_box(rc::TriangleMesh& mesh, const rc::Vec3& center, const rc::Ve
 }
 
 /// Adds a 1 × 1 lamp of material `material` at height `height` over the origin, facing down.
-inline void add_ceiling_lamp(rc::Scene& scene, uint32_t material, float height = 3.0f) {
-  rc::TriangleMesh lamp;
+inline void add_ceiling_lamp(rc::scene::Scene& scene, uint32_t material, float height = 3.0f) {
+  rc::scene::TriangleMesh lamp;
   lamp.name = "lamp";
   lamp.material = material;
   add_quad(lamp, {rc::Vec3(-0.5f, height, -0.5f), rc::Vec3(0.5f, height, -0.5f), rc::Vec3(0.5f, height, 0.5f),

@@ -5,14 +5,14 @@
 #include <cstdint>
 #include <vector>
 
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace gilt::test {
 namespace rc = gilt::raytrace_core;
 
 /// Unit-radius icosphere subdivided `levels` times, outward-facing, as one closed mesh.
-inline rc::TriangleMesh icosphere(int levels, uint32_t material = 0) {
+inline rc::scene::TriangleMesh icosphere(int levels, uint32_t material = 0) {
   const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
   std::vector<rc::Vec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
                              {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
@@ -38,7 +38,7 @@ inline rc::TriangleMesh icosphere(int levels, uint32_t material = 0) {
     }
     f = std::move(next);
   }
-  rc::TriangleMesh mesh;
+  rc::scene::TriangleMesh mesh;
   mesh.name = "icosphere";
   mesh.positions = std::move(p);
   mesh.indices = std::move(f);
@@ -47,7 +47,7 @@ inline rc::TriangleMesh icosphere(int levels, uint32_t material = 0) {
 }
 
 /// Mean of all pixels of a film, per channel averaged.
-inline double film_mean(const rc::Film& film) {
+inline double film_mean(const rc::render::Film& film) {
   double sum = 0.0;
   for (const rc::Rgb& c : film.pixels()) sum += c.average();
   return sum / (double(film.width()) * film.height());

@@ -1,4 +1,4 @@
-// The default view of a scene without a camera (raytrace_core/camera.h, default_camera): every
+// The default view of a scene without a camera (raytrace_core/scene/camera.h, default_camera): every
 // corner of the bounds is in the picture, and the model fills it rather than sitting small in the
 // middle.
 
@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "raytrace_core/camera.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/scene/camera.h"
+#include "raytrace_core/util/rng.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 /// Where a point lands on the film of `c` for an image of `aspect`, in [0,1]² when it is in view,
@@ -30,7 +30,7 @@ Vec2 film_position(const Camera& c, Vec3 p, float aspect) {
 }
 
 TEST(DefaultCamera, EveryCornerIsInViewAndTheBoxFillsIt) {
-  Rng rng(17);
+  util::Rng rng(17);
   for (int trial = 0; trial < 200; ++trial) {
     Bounds3 b;
     const Vec3 centre(20.0f * rng.uniform() - 10.0f, 20.0f * rng.uniform() - 10.0f, 20.0f * rng.uniform() - 10.0f);
@@ -66,4 +66,4 @@ TEST(DefaultCamera, AnEmptySceneGetsAValidCamera) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "radiosity/solver/cluster_kernel.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/rng.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -56,7 +56,7 @@ TEST(ClusterKernel, CoaxialDisksMatchHowell) {
 // (measured: from 1.6 % to 0.06 %), and no configuration's error may exceed the fourth-order scale
 // ((a + b) / |d|)⁴ / 4.
 TEST(ClusterKernel, SquaresInGeneralPositionAgreeWithQuadrature) {
-  rc::Rng rng(17);
+  rc::util::Rng rng(17);
   auto unit = [&] {
     for (;;) {
       const dvec3 v(2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);

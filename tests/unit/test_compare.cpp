@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 
 #include "tests/support/cli_run.h"
 
@@ -51,14 +51,14 @@ class Compare : public ::testing::Test {
   }
 
   /// index.html of `report` as headless Chromium shows it in a window `width` × `height`.
-  rc::Image screenshot(const fs::path& report, int width, int height) {
+  rc::util::Image screenshot(const fs::path& report, int width, int height) {
     const fs::path shot = dir_ / (report.filename().string() + "-shot.png");
     const Result r = run("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --force-device-scale-factor=1 "
                          "--user-data-dir='" + (dir_ / "profile").string() + "' --window-size=" + std::to_string(width) +
                          "," + std::to_string(height) + " --screenshot='" + shot.string() + "' 'file://" +
                          (report / "index.html").string() + "'");
     EXPECT_EQ(r.code, 0) << r.err;
-    return rc::read_image(shot.string());
+    return rc::util::read_image(shot.string());
   }
 
   fs::path dir_;
@@ -145,7 +145,7 @@ TEST_F(Compare, ReferenceMethodFollowsTheScenesCaustics) {
 TEST_F(Compare, BadInputExitsTwo) {
   const std::string out = (dir_ / "r").string();
   const fs::path small = dir_ / "small.exr";
-  rc::write_image(small.string(), rc::Image{4, 4, std::vector<rc::Rgb>(16, rc::Rgb(0.5f))});
+  rc::util::write_image(small.string(), rc::util::Image{4, 4, std::vector<rc::Rgb>(16, rc::Rgb(0.5f))});
   const std::pair<std::string, std::string> cases[] = {
       {"compare cornell --methods path,magic -o " + out, "magic"},
       {"compare cornell --budgets 1,-2 -o " + out, "--budgets"},
@@ -168,7 +168,7 @@ namespace {
 
 /// Whether `image`, enlarged by the whole factor `scale`, appears as an exact block in `page`
 /// (each image pixel's centre compared; pixelated scaling keeps the values).
-bool shows_block(const rc::Image& page, const rc::Image& image, int scale) {
+bool shows_block(const rc::util::Image& page, const rc::util::Image& image, int scale) {
   auto at = [&](int x, int y) { return page.pixels[size_t(y) * page.width + x]; };
   const int w = image.width * scale, h = image.height * scale;
   for (int y = 0; y + h <= page.height; ++y)
@@ -195,9 +195,9 @@ TEST_F(Compare, PageShowsImagesAndPlotInChromium) {
     GTEST_SKIP() << "chromium is not installed";
   }
   const fs::path report = small_report("report");
-  const rc::Image page = screenshot(report, 1200, 1600);
+  const rc::util::Image page = screenshot(report, 1200, 1600);
   ASSERT_GT(page.width, 0);
-  const rc::Image ref = rc::read_image((report / "images/reference.png").string());
+  const rc::util::Image ref = rc::util::read_image((report / "images/reference.png").string());
   ASSERT_EQ(ref.width, 32);
   const int scale = 192 / 32;  // report.cpp: enlarged to about 192 pixels by a whole factor
 
@@ -205,13 +205,13 @@ TEST_F(Compare, PageShowsImagesAndPlotInChromium) {
   EXPECT_TRUE(shows_block(page, ref, scale)) << "the reference image was not found in the screenshot";
 
   // (2) The plot: pixels of each method's line colour (path #0072B2, radiosity #CC79A7).
-  const rc::Image swatch = [&] {
+  const rc::util::Image swatch = [&] {
     // The same colours through the same PNG decoding as the screenshot.
     const fs::path file = dir_ / "swatch.png";
     auto linear = [](float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); };
-    rc::write_image(file.string(), rc::Image{2, 1, {rc::Rgb(linear(0 / 255.f), linear(114 / 255.f), linear(178 / 255.f)),
+    rc::util::write_image(file.string(), rc::util::Image{2, 1, {rc::Rgb(linear(0 / 255.f), linear(114 / 255.f), linear(178 / 255.f)),
                                                     rc::Rgb(linear(204 / 255.f), linear(121 / 255.f), linear(167 / 255.f))}});
-    return rc::read_image(file.string());
+    return rc::util::read_image(file.string());
   }();
   for (int m = 0; m < 2; ++m) {
     size_t count = 0;
@@ -232,10 +232,10 @@ TEST_F(Compare, PageFitsALaptopScreen) {
   const Result r = gilt("compare cornell --methods path --budgets 0.05,0.1,0.2,0.4,0.8 --reference-time 0.5 "
                         "--width 256 --height 256 -q -o '" + report.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  const rc::Image page = screenshot(report, 1280, 2600);
+  const rc::util::Image page = screenshot(report, 1280, 2600);
   ASSERT_EQ(page.width, 1280);
   for (const char* budget : {"0.05s", "0.1s", "0.2s", "0.4s", "0.8s"}) {
-    const rc::Image image = rc::read_image((report / "images" / ("path_" + std::string(budget) + ".png")).string());
+    const rc::util::Image image = rc::util::read_image((report / "images" / ("path_" + std::string(budget) + ".png")).string());
     ASSERT_EQ(image.width, 256);
     EXPECT_TRUE(shows_block(page, image, 1)) << "the " << budget << " image is not shown whole at 1,280 pixels";
   }

@@ -6,18 +6,18 @@
 #include <fstream>
 #include <iterator>
 
-#include "raytrace_core/io/image_io.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/image_io.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/render/render.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 
 namespace {
 
-rc::Film render(const rc::Scene& scene, int threads, uint64_t seed,
-                rc::SamplerKind sampler = rc::SamplerKind::sobol) {
-  rc::RenderSettings s;
+rc::render::Film render(const rc::scene::Scene& scene, int threads, uint64_t seed,
+                rc::render::SamplerKind sampler = rc::render::SamplerKind::sobol) {
+  rc::render::RenderSettings s;
   s.sampler = sampler;
   s.width = 48;
   s.height = 40;
@@ -26,9 +26,9 @@ rc::Film render(const rc::Scene& scene, int threads, uint64_t seed,
   s.threads = threads;
   s.tile_size = 8;
   s.progress = false;
-  const rc::PathSettings path;
-  return rc::render_image(scene, scene.effective_camera(), s,
-                          [&](const rc::Ray& ray, rc::SampleContext& ctx) { return rc::path_radiance(scene, ray, ctx, path); });
+  const rc::render::PathSettings path;
+  return rc::render::render_image(scene, scene.effective_camera(), s,
+                          [&](const rc::scene::Ray& ray, rc::render::SampleContext& ctx) { return rc::render::path_radiance(scene, ray, ctx, path); });
 }
 
 std::string file_bytes(const std::filesystem::path& p) {
@@ -39,12 +39,12 @@ std::string file_bytes(const std::filesystem::path& p) {
 }  // namespace
 
 TEST(Determinism, OneAndTwoThreadsGiveIdenticalExr) {
-  const rc::Scene scene = rc::load_scene("cornell-caustics");
-  const rc::Film one = render(scene, 1, 42), two = render(scene, 2, 42);
+  const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
+  const rc::render::Film one = render(scene, 1, 42), two = render(scene, 2, 42);
   const auto dir = std::filesystem::temp_directory_path() / ("gilt-determinism-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  rc::write_image((dir / "one.exr").string(), {one.width(), one.height(), one.pixels()});
-  rc::write_image((dir / "two.exr").string(), {two.width(), two.height(), two.pixels()});
+  rc::util::write_image((dir / "one.exr").string(), {one.width(), one.height(), one.pixels()});
+  rc::util::write_image((dir / "two.exr").string(), {two.width(), two.height(), two.pixels()});
   const std::string a = file_bytes(dir / "one.exr"), b = file_bytes(dir / "two.exr");
   std::filesystem::remove_all(dir);
   ASSERT_FALSE(a.empty());
@@ -53,15 +53,16 @@ TEST(Determinism, OneAndTwoThreadsGiveIdenticalExr) {
 }
 
 TEST(Determinism, EachSamplerIsIndependentOfThreads) {
-  const rc::Scene scene = rc::load_scene("cornell");
-  for (rc::SamplerKind kind : {rc::SamplerKind::sobol, rc::SamplerKind::independent}) {
-    EXPECT_TRUE(render(scene, 1, 5, kind).pixels() == render(scene, 2, 5, kind).pixels()) << rc::sampler_name(kind);
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
+  for (rc::render::SamplerKind kind :
+       {rc::render::SamplerKind::sobol, rc::render::SamplerKind::independent}) {
+    EXPECT_TRUE(render(scene, 1, 5, kind).pixels() == render(scene, 2, 5, kind).pixels()) << rc::render::sampler_name(kind);
   }
-  EXPECT_FALSE(render(scene, 2, 5, rc::SamplerKind::sobol).pixels() ==
-               render(scene, 2, 5, rc::SamplerKind::independent).pixels());
+  EXPECT_FALSE(render(scene, 2, 5, rc::render::SamplerKind::sobol).pixels() ==
+               render(scene, 2, 5, rc::render::SamplerKind::independent).pixels());
 }
 
 TEST(Determinism, DifferentSeedsGiveDifferentImages) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   EXPECT_FALSE(render(scene, 2, 1).pixels() == render(scene, 2, 2).pixels());
 }

@@ -10,7 +10,7 @@
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/solver/element_direct.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/scene/scene.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -58,10 +58,10 @@ TEST(ElementDirect, SamplesWithinCountLargeElementsFinerGrids) {
 // Cornell box's mesh lit by two point lights, for each grid side the rays equal side² × lights ×
 // Σ scale², found as the rays that fit exactly.
 TEST(ElementDirect, TheTraceCostsWhatTheCountForetold) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   for (float x : {-0.2f, 0.3f}) {
-    rc::Light point;
-    point.kind = rc::LightKind::point;
+    rc::scene::Light point;
+    point.kind = rc::scene::LightKind::point;
     point.position = rc::Vec3(x, 1.2f, 0.1f);
     point.intensity = rc::Rgb(1.0f);
     scene.punctual_lights.push_back(point);
@@ -70,7 +70,7 @@ TEST(ElementDirect, TheTraceCostsWhatTheCountForetold) {
   rad::mesh::MeshSettings settings;
   settings.elements = 300;
   const rad::mesh::RadiosityMesh mesh = rad::mesh::build_mesh(scene, settings);
-  const rc::Scene geometry = rad::mesh::element_scene(scene, mesh);
+  const rc::scene::Scene geometry = rad::mesh::element_scene(scene, mesh);
   for (int samples : {1, 4, 9, 16}) {
     uint64_t rays = 0;
     rad::solver::element_punctual_irradiance(scene, geometry, mesh, samples, 0, rays);

@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "radiosity/bake/check.h"
-#include "raytrace_core/closest_point.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/closest_point.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
@@ -171,15 +171,17 @@ class ExportTest : public ::testing::Test {
     fs::create_directories(dir_);
 
     scene_.name = "test room";
-    scene_.materials.push_back(rc::Material::make_diffuse("white wall", rc::Rgb(0.7f, 0.6f, 0.5f)));
-    scene_.materials.push_back(rc::Material::make_emitter("lamp", rc::Rgb(10.0f, 8.0f, 6.0f), rc::Rgb(0.5f)));
-    scene_.materials.push_back(rc::Material::make_glossy("unused", rc::Rgb(0.2f), rc::Rgb(0.3f), 50.0f));
-    rc::TriangleMesh wall;
+    scene_.materials.push_back(rc::scene::Material::make_diffuse("white wall", rc::Rgb(0.7f, 0.6f, 0.5f)));
+    scene_.materials.push_back(
+        rc::scene::Material::make_emitter("lamp", rc::Rgb(10.0f, 8.0f, 6.0f), rc::Rgb(0.5f)));
+    scene_.materials.push_back(
+        rc::scene::Material::make_glossy("unused", rc::Rgb(0.2f), rc::Rgb(0.3f), 50.0f));
+    rc::scene::TriangleMesh wall;
     wall.name = "wall";
     wall.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
     wall.indices = {0, 1, 2, 0, 2, 3};
     wall.material = 0;
-    rc::TriangleMesh lamp;
+    rc::scene::TriangleMesh lamp;
     lamp.name = "lamp";
     lamp.positions = {{0.25f, 0.25f, 1}, {0.5f, 0.75f, 1}, {0.75f, 0.25f, 1}};
     lamp.indices = {0, 1, 2};
@@ -202,7 +204,7 @@ class ExportTest : public ::testing::Test {
         {0.01f, 0.02f, 0.03f}, {1.1f, 2.2f, 3.3f},         {4e-5f, 5e-4f, 6e-3f}};
     solution_.vertex_radiosity.resize(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-      const rc::Material& m = scene_.materials[mesh.vertex_material[v]];
+      const rc::scene::Material& m = scene_.materials[mesh.vertex_material[v]];
       solution_.vertex_radiosity[v] = m.emission * rc::kPi + m.albedo * solution_.vertex_irradiance[v];
     }
     for (const auto& e : mesh.elements) {
@@ -246,7 +248,7 @@ class ExportTest : public ::testing::Test {
   void check_gltf(const std::string& file, bool binary);
 
   fs::path dir_;
-  rc::Scene scene_;
+  rc::scene::Scene scene_;
   Solution solution_;
 };
 
@@ -650,8 +652,9 @@ TEST_F(ExportTest, PlyWritesNonManifoldElementsAsTheyAre) {
 
 TEST_F(ExportTest, MaterialsLoadBackIntoGiltAsTheSameKind) {
   // One element each for a glossy, a mirror and a dielectric material as well.
-  scene_.materials.push_back(rc::Material::make_mirror("mirror", rc::Rgb(0.9f, 0.8f, 0.7f)));
-  scene_.materials.push_back(rc::Material::make_dielectric("glass", 1.33f, rc::Rgb(0.5f, 0.25f, 0.0f)));
+  scene_.materials.push_back(rc::scene::Material::make_mirror("mirror", rc::Rgb(0.9f, 0.8f, 0.7f)));
+  scene_.materials.push_back(
+      rc::scene::Material::make_dielectric("glass", 1.33f, rc::Rgb(0.5f, 0.25f, 0.0f)));
   RadiosityMesh& mesh = solution_.mesh;
   for (uint32_t material = 2; material < 5; ++material) {
     const float z = 2.0f + static_cast<float>(material);
@@ -668,21 +671,21 @@ TEST_F(ExportTest, MaterialsLoadBackIntoGiltAsTheSameKind) {
   }
 
   write_solution(path("out.obj"), scene_, solution_, {});
-  const rc::Scene obj = rc::load_scene_file(path("out.obj"));
+  const rc::scene::Scene obj = rc::io::load_scene_file(path("out.obj"));
   ASSERT_EQ(obj.materials.size(), scene_.materials.size());
   size_t triangles = 0;
-  for (const rc::TriangleMesh& m : obj.meshes) triangles += m.triangle_count();
+  for (const rc::scene::TriangleMesh& m : obj.meshes) triangles += m.triangle_count();
   EXPECT_EQ(triangles, mesh.element_count());
   for (size_t i = 0; i < obj.materials.size(); ++i) {
-    const rc::Material& want = scene_.materials[i];
-    const rc::Material& got = obj.materials[i];
+    const rc::scene::Material& want = scene_.materials[i];
+    const rc::scene::Material& got = obj.materials[i];
     SCOPED_TRACE(want.name);
     EXPECT_EQ(got.kind, want.kind);
     EXPECT_EQ(got.albedo, want.albedo);
     EXPECT_EQ(got.specular, want.specular);
     EXPECT_EQ(got.emission, want.emission);
     EXPECT_EQ(got.exponent, want.exponent);
-    if (want.kind == rc::MaterialKind::dielectric) {
+    if (want.kind == rc::scene::MaterialKind::dielectric) {
       EXPECT_EQ(got.ior, want.ior);
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(got.absorption[c], want.absorption[c], 1e-6);
     }
@@ -690,11 +693,11 @@ TEST_F(ExportTest, MaterialsLoadBackIntoGiltAsTheSameKind) {
 
   // glTF keeps only the diffuse reading (metallic 0, roughness 1) and the emission.
   write_solution(path("out.glb"), scene_, solution_, {});
-  const rc::Scene glb = rc::load_scene_file(path("out.glb"));
+  const rc::scene::Scene glb = rc::io::load_scene_file(path("out.glb"));
   ASSERT_EQ(glb.materials.size(), scene_.materials.size());
   for (size_t i = 0; i < glb.materials.size(); ++i) {
     SCOPED_TRACE(scene_.materials[i].name);
-    EXPECT_EQ(glb.materials[i].kind, rc::MaterialKind::diffuse);
+    EXPECT_EQ(glb.materials[i].kind, rc::scene::MaterialKind::diffuse);
     EXPECT_EQ(glb.materials[i].albedo, scene_.materials[i].albedo);
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(glb.materials[i].emission[c], scene_.materials[i].emission[c], 1e-5);
@@ -740,11 +743,11 @@ TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
   // A sphere of 1,280 flat facets, remeshed into fewer, larger elements whose vertices lie on
   // it; bisecting elements (as adaptive subdivision does at shadow edges) puts new vertices at
   // the middle of chords, inside the sphere, and the export moves them back onto it.
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
   scene.meshes.push_back(test::icosphere(3));
-  rc::Light sky;
-  sky.kind = rc::LightKind::environment;
+  rc::scene::Light sky;
+  sky.kind = rc::scene::LightKind::environment;
   sky.radiance = rc::Rgb(1.0f);
   scene.punctual_lights.push_back(sky);
   scene.commit();
@@ -754,7 +757,7 @@ TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
   const Solution solution = solve(scene, settings);
   // How far a point is from the input surface (within 0.1), along a normal-facing search.
   const auto off = [&scene](const Vec3& p, const Vec3& n) {
-    const std::optional<rc::Hit> h = scene.nearest_triangle(0, p, 0.1f, n, 0.5f);
+    const std::optional<rc::scene::Hit> h = scene.nearest_triangle(0, p, 0.1f, n, 0.5f);
     return h ? h->t : 1.0f;
   };
   RadiosityMesh raw = solution.mesh;
@@ -774,21 +777,21 @@ TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
 // --- The exported elements at random points of the input (check_element_colours) ----------------
 
 /// The mesh write_solution writes for a solution.
-RadiosityMesh exported_mesh(const rc::Scene& scene, const Solution& solution) {
+RadiosityMesh exported_mesh(const rc::scene::Scene& scene, const Solution& solution) {
   return without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge));
 }
 
 /// The furnace (every face emits 0.5 and reflects 0.5; E = π·0.5 / (1 − 0.5) everywhere inside),
 /// solved as tests/unit/test_radiosity.cpp solves it, to within 0.2 % at every vertex.
 struct Furnace {
-  rc::Scene scene;
+  rc::scene::Scene scene;
   Solution solution;
   RadiosityMesh exported;
 };
 
 const Furnace& furnace() {
   static const Furnace f = [] {
-    Furnace out{rc::furnace_scene(0.5f, 0.5f), {}, {}};
+    Furnace out{rc::io::furnace_scene(0.5f, 0.5f), {}, {}};
     out.scene.commit();
     SolverSettings settings;
     settings.tolerance = 1e-5;
@@ -819,7 +822,7 @@ std::optional<Scanned> scan_elements(const RadiosityMesh& mesh, const Vec3& p, c
                &c = mesh.positions[mesh.elements[e][2]];
     const Vec3 normal = glm::cross(b - a, c - a);
     if (!(glm::dot(normal, n) > facing * glm::length(normal))) continue;
-    const rc::Vec2 uv = rc::closest_point_on_triangle(p, a, b, c);
+    const rc::Vec2 uv = rc::util::closest_point_on_triangle(p, a, b, c);
     const Vec3 x = (1.0f - uv.x - uv.y) * a + uv.x * b + uv.y * c;
     const float d2 = glm::dot(x - p, x - p);
     if (d2 > best_distance2 || (best && d2 == best_distance2)) continue;
@@ -830,8 +833,8 @@ std::optional<Scanned> scan_elements(const RadiosityMesh& mesh, const Vec3& p, c
 }
 
 /// The unit normal of the input face a checked point was drawn on.
-Vec3 face_normal(const rc::Scene& scene, const SurfaceCheckPoint& at) {
-  const rc::TriangleMesh& m = scene.meshes[at.mesh];
+Vec3 face_normal(const rc::scene::Scene& scene, const SurfaceCheckPoint& at) {
+  const rc::scene::TriangleMesh& m = scene.meshes[at.mesh];
   const uint32_t* c = &m.indices[3 * size_t(at.triangle)];
   return glm::normalize(
       glm::cross(m.positions[c[1]] - m.positions[c[0]], m.positions[c[2]] - m.positions[c[0]]));

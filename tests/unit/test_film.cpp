@@ -1,6 +1,6 @@
 // Film accumulation and reconstruction-filter sampling.
 
-#include "raytrace_core/film.h"
+#include "raytrace_core/render/film.h"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/render.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/render/render.h"
+#include "raytrace_core/scene/scene.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
@@ -193,9 +193,9 @@ TEST(Filter, ChiSquareRejectsTheWrongShape) {
 // offsets' x coordinates fall one in each 1/n of [0, 1), so the count of samples left of the
 // step is nF rounded up or down, and the error is at most 1/n.
 TEST(Filter, PixelsAreFilterWeightedMeansOfUnitWeightSamples) {
-  Scene scene;
+  scene::Scene scene;
   scene.commit();
-  Camera camera;
+  scene::Camera camera;
   camera.look_from = Vec3(0.0f, 0.0f, 1.0f);
   camera.look_at = Vec3(0.0f);
   camera.up = Vec3(0.0f, 1.0f, 0.0f);
@@ -208,7 +208,7 @@ TEST(Filter, PixelsAreFilterWeightedMeansOfUnitWeightSamples) {
       settings.width = 8, settings.height = 1, settings.spp = kSpp, settings.progress = false;
       settings.filter = Filter{kind, 1.5f};
       settings.sampler = sampler;
-      const Film film = render_image(scene, camera, settings, [](const Ray& ray, SampleContext&) {
+      const Film film = render_image(scene, camera, settings, [](const scene::Ray& ray, SampleContext&) {
         return Rgb(ray.origin.x < 0.0f ? 1.0f : 0.0f);
       });
       for (int px = 1; px <= 6; ++px) {
@@ -236,4 +236,4 @@ TEST(Filter, ParsesNames) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

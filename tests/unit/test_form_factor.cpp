@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "radiosity/solver/form_factor.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/rng.h"
 
 namespace {
 
@@ -770,7 +770,7 @@ TEST(FormFactorFarField, WithinStatedBoundAtTheSwitchDistance) {
   double worst = 0.0;
   int compared = 0;
   for (uint64_t i = 0; compared < 20000; ++i) {
-    gilt::raytrace_core::Rng rng = gilt::raytrace_core::Rng::for_item(11, i, 0);
+    gilt::raytrace_core::util::Rng rng = gilt::raytrace_core::util::Rng::for_item(11, i, 0);
     auto u = [&] { return 2.0f * rng.uniform() - 1.0f; };
     const Vec3 a(u(), u(), 0.0f), b(u(), u(), 0.0f), c0(u(), u(), 0.0f);
     const bool ccw = glm::cross(b - a, c0 - a).z > 0.0f;
@@ -803,7 +803,7 @@ TEST(FormFactorFarField, BatchEqualsOneByOne) {
   using gilt::radiosity::solver::SourceBatch;
   using gilt::radiosity::solver::SourceTriangle;
   using gilt::raytrace_core::Vec3;
-  gilt::raytrace_core::Rng rng = gilt::raytrace_core::Rng::for_item(12, 0, 0);
+  gilt::raytrace_core::util::Rng rng = gilt::raytrace_core::util::Rng::for_item(12, 0, 0);
   auto u = [&] { return 2.0f * rng.uniform() - 1.0f; };
   std::vector<SourceTriangle> triangles;
   for (size_t k = 0; k < SourceBatch::kMaxBatch; ++k) {

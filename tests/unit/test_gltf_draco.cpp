@@ -26,12 +26,12 @@
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <nlohmann/json.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/model_files.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -245,7 +245,8 @@ class GltfDraco : public ::testing::Test {
 /// Expects `mesh` to be the source triangles, up to their order and a rotation of each one's
 /// corners (Draco may reorder both, but keeps the winding), each attribute within its
 /// quantisation error; the largest errors go to `worst` (position, normal, UV).
-void expect_source_triangles(const TriangleMesh& mesh, const std::vector<Triangle>& source, float worst[3]) {
+void expect_source_triangles(const scene::TriangleMesh& mesh, const std::vector<Triangle>& source,
+                             float worst[3]) {
   ASSERT_EQ(mesh.indices.size(), 3 * source.size());
   ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
   ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
@@ -286,7 +287,7 @@ TEST_F(GltfDraco, DecodesPositionsNormalsUvsAndIndicesWithinTheQuantisationError
       SCOPED_TRACE("encoding method " + std::to_string(method) + ", index component type " +
                    std::to_string(index_type));
       const std::string path = write("cube.glb", glb(cube_gltf(e, e.bytes.size(), index_type), e.bytes));
-      const Scene scene = load_scene(path);
+      const scene::Scene scene = load_scene(path);
       ASSERT_EQ(scene.meshes.size(), 1u);
       EXPECT_EQ(scene.meshes[0].positions.size(), e.points);
       float worst[3] = {0, 0, 0};
@@ -404,7 +405,7 @@ TEST_F(GltfDraco, TheBadPrimitiveIsNamedAmongOthers) {
             std::string::npos)
       << error;
   // With both right, both load.
-  const Scene scene = load_scene(write(
+  const scene::Scene scene = load_scene(write(
       "two.glb",
       cube_glb([&](Json& j) { j["meshes"][0]["primitives"].push_back(j["meshes"][0]["primitives"][0]); })));
   EXPECT_EQ(scene.meshes.size(), 2u);
@@ -500,7 +501,7 @@ TEST_F(GltfDraco, OntoInputAddsUncompressedColoursInDecodedOrder) {
     EXPECT_GE(a.bufferView, 0) << name;
   }
   float worst[3] = {0, 0, 0};
-  const Scene again = load_scene((dir_ / "out.glb").string());
+  const scene::Scene again = load_scene((dir_ / "out.glb").string());
   ASSERT_EQ(again.meshes.size(), 1u);
   expect_source_triangles(again.meshes[0], cube_triangles(), worst);
 }
@@ -540,10 +541,10 @@ TEST_F(GltfDraco, LightmapWritesTheDecodedPrimitiveWhenItMakesItsOwnUvs) {
     EXPECT_EQ(std::count(list->begin(), list->end(), "KHR_draco_mesh_compression"), 0);
   for (const auto& [name, index] : p.attributes)
     EXPECT_GE(out.accessors.at(size_t(index)).bufferView, 0) << name;
-  const Scene again = load_scene((dir_ / "out.glb").string());
+  const scene::Scene again = load_scene((dir_ / "out.glb").string());
   ASSERT_EQ(again.meshes.size(), 1u);
   EXPECT_EQ(again.meshes[0].triangle_count(), cube_triangles().size());
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

@@ -20,11 +20,11 @@
 #include <utility>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
 #include "raytrace_core/io/scene_io.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -186,7 +186,7 @@ class GltfTextures : public ::testing::Test {
   std::string write_red_blue_png(const std::string& name) {
     const fs::path path = dir_ / name;
     fs::create_directories(path.parent_path());
-    write_image(path.string(), Image{2, 1, {Rgb(1.0f, 0.0f, 0.0f), Rgb(0.0f, 0.0f, 1.0f)}});
+    util::write_image(path.string(), util::Image{2, 1, {Rgb(1.0f, 0.0f, 0.0f), Rgb(0.0f, 0.0f, 1.0f)}});
     return path.string();
   }
   std::vector<unsigned char> red_blue_png_bytes() {
@@ -197,13 +197,13 @@ class GltfTextures : public ::testing::Test {
   std::optional<std::string> old_cache_;
 };
 
-bool has_warning(const Scene& scene, const std::string& part) {
+bool has_warning(const scene::Scene& scene, const std::string& part) {
   for (const std::string& w : scene.warnings)
     if (w.find(part) != std::string::npos) return true;
   return false;
 }
 
-int count_warnings(const Scene& scene, const std::string& part) {
+int count_warnings(const scene::Scene& scene, const std::string& part) {
   int n = 0;
   for (const std::string& w : scene.warnings) n += w.find(part) != std::string::npos;
   return n;
@@ -224,11 +224,15 @@ std::string error_of(const std::function<void()>& f) {
 
 // Points on the quad at (x, y) = (0.25, 0.75) and (0.75, 0.25): the centres of the red and the
 // blue texel when UVs are (x, y).
-SurfaceInteraction left_point(const Scene& scene) { return scene.triangle_point(0, 1, {0.25f, 0.5f}); }
-SurfaceInteraction right_point(const Scene& scene) { return scene.triangle_point(0, 0, {0.5f, 0.25f}); }
+scene::SurfaceInteraction left_point(const scene::Scene& scene) {
+  return scene.triangle_point(0, 1, {0.25f, 0.5f});
+}
+scene::SurfaceInteraction right_point(const scene::Scene& scene) {
+  return scene.triangle_point(0, 0, {0.5f, 0.25f});
+}
 
-Rgb albedo_at(const Scene& scene, const SurfaceInteraction& si) {
-  Material scratch;
+Rgb albedo_at(const scene::Scene& scene, const scene::SurfaceInteraction& si) {
+  scene::Material scratch;
   return scene.shading_material(si, scratch).albedo;
 }
 
@@ -244,9 +248,9 @@ void expect_rgb_near(Rgb actual, Rgb expected) {
 
 /// The albedo on the left and right half of the quad: baseColorFactor (0.5, 0.8, 1) times red,
 /// then times blue.
-void expect_red_left_blue_right(const Scene& scene) {
+void expect_red_left_blue_right(const scene::Scene& scene) {
   ASSERT_EQ(scene.meshes.size(), 1u);
-  const SurfaceInteraction left = left_point(scene), right = right_point(scene);
+  const scene::SurfaceInteraction left = left_point(scene), right = right_point(scene);
   EXPECT_NEAR(left.uv.x, 0.25f, 1e-6f);
   EXPECT_NEAR(right.uv.x, 0.75f, 1e-6f);
   expect_rgb_near(albedo_at(scene, left), Rgb(0.5f, 0.0f, 0.0f));
@@ -266,11 +270,11 @@ TEST_F(GltfTextures, ImageFileBesideTheModel) {
   quad.images = R"([{"uri": "maps/red%20blue.png"}])";  // percent-encoded, relative to the .gltf
   const std::string path = write("quad.gltf", quad.gltf());
 
-  const Scene loaded = load_scene_file(path);
+  const scene::Scene loaded = load_scene_file(path);
   ASSERT_EQ(loaded.textures.size(), 1u);
   EXPECT_TRUE(fs::equivalent(loaded.textures[0].file, dir_ / "maps" / "red blue.png"));
   EXPECT_TRUE(loaded.textures[0].srgb);
-  const Material& m = loaded.materials[loaded.meshes[0].material];
+  const scene::Material& m = loaded.materials[loaded.meshes[0].material];
   EXPECT_EQ(m.albedo_texture.image, 0);
   EXPECT_EQ(m.albedo_texture.map, (std::array<float, 6>{1, 0, 0, 0, 1, 0}));  // glTF UVs are (s, t) already
   EXPECT_EQ(m.albedo, Rgb(0.5f, 0.8f, 1.0f));
@@ -285,7 +289,7 @@ TEST_F(GltfTextures, ImageInDataUri) {
   quad.images = R"([{"uri": "data:image/png;base64,)" + base64(png) + "\"}]";
   const std::string path = write("quad.gltf", quad.gltf());
 
-  const Scene loaded = load_scene_file(path);
+  const scene::Scene loaded = load_scene_file(path);
   ASSERT_EQ(loaded.textures.size(), 1u);
   const fs::path file = loaded.textures[0].file;
   EXPECT_TRUE(fs::equivalent(file.parent_path(), cache()));
@@ -303,7 +307,7 @@ TEST_F(GltfTextures, ImageInDataUriWithoutImageType) {
   const std::vector<unsigned char> png = red_blue_png_bytes();
   QuadModel quad;
   quad.images = R"([{"uri": "data:application/octet-stream;base64,)" + base64(png) + "\"}]";
-  const Scene scene = load_scene(write("quad.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene(write("quad.gltf", quad.gltf()));
   ASSERT_EQ(scene.textures.size(), 1u);
   EXPECT_EQ(fs::path(scene.textures[0].file).extension(), ".png");
   expect_red_left_blue_right(scene);
@@ -314,12 +318,12 @@ TEST_F(GltfTextures, ImageInBufferViewOfGltfAndGlb) {
   quad.image_bytes = red_blue_png_bytes();
   quad.images = R"([{"bufferView": 5, "mimeType": "image/png"}])";
 
-  const Scene from_gltf = load_scene(write("quad.gltf", quad.gltf()));
+  const scene::Scene from_gltf = load_scene(write("quad.gltf", quad.gltf()));
   ASSERT_EQ(from_gltf.textures.size(), 1u);
   EXPECT_EQ(read_bytes(from_gltf.textures[0].file), quad.image_bytes);
   expect_red_left_blue_right(from_gltf);
 
-  const Scene from_glb = load_scene(write("quad.glb", quad.glb()));
+  const scene::Scene from_glb = load_scene(write("quad.glb", quad.glb()));
   ASSERT_EQ(from_glb.textures.size(), 1u);
   EXPECT_EQ(from_glb.textures[0].file, from_gltf.textures[0].file);  // same bytes, same cache file
   expect_red_left_blue_right(from_glb);
@@ -330,7 +334,7 @@ TEST_F(GltfTextures, JpegMimeTypeGivesJpgFile) {
   QuadModel quad;
   quad.image_bytes = {0xff, 0xd8, 0xff, 0xe0, 0, 0, 0, 0};  // never opened: the scene is not committed
   quad.images = R"([{"bufferView": 5, "mimeType": "image/jpeg"}])";
-  const Scene scene = load_scene_file(write("quad.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene_file(write("quad.gltf", quad.gltf()));
   ASSERT_EQ(scene.textures.size(), 1u);
   EXPECT_EQ(fs::path(scene.textures[0].file).extension(), ".jpg");
 }
@@ -338,7 +342,7 @@ TEST_F(GltfTextures, JpegMimeTypeGivesJpgFile) {
 TEST_F(GltfTextures, MissingImageFileLeavesMaterialUntextured) {
   QuadModel quad;
   quad.images = R"([{"uri": "nowhere.png"}])";
-  const Scene scene = load_scene(write("quad.gltf", quad.gltf()));  // not fatal: commits
+  const scene::Scene scene = load_scene(write("quad.gltf", quad.gltf()));  // not fatal: commits
   EXPECT_TRUE(scene.textures.empty());
   EXPECT_FALSE(scene.materials[scene.meshes[0].material].is_textured());
   EXPECT_EQ(count_warnings(scene, "nowhere.png"), 1) << "one warning naming the file";
@@ -373,7 +377,7 @@ TEST_F(GltfTextures, TexCoordSelectsTheUvSet) {
   // TEXCOORD_1: normalized unsigned short, mirrored; 65535 reads as 1.
   quad.materials =
       R"([{"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0, "texCoord": 1}}}])";
-  const Scene set1 = load_scene(write("set1.gltf", quad.gltf()));
+  const scene::Scene set1 = load_scene(write("set1.gltf", quad.gltf()));
   ASSERT_EQ(set1.meshes[0].uvs.size(), 4u);
   EXPECT_EQ(set1.meshes[0].uvs[0], Vec2(1.0f, 0.0f));
   EXPECT_EQ(set1.meshes[0].uvs[3], Vec2(1.0f, 1.0f));
@@ -382,20 +386,20 @@ TEST_F(GltfTextures, TexCoordSelectsTheUvSet) {
 
   // TEXCOORD_2: normalized unsigned byte; 255 reads as 1.
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 2}}}])";
-  const Scene set2 = load_scene_file(write("set2.gltf", quad.gltf()));
+  const scene::Scene set2 = load_scene_file(write("set2.gltf", quad.gltf()));
   ASSERT_EQ(set2.meshes[0].uvs.size(), 4u);
   EXPECT_EQ(set2.meshes[0].uvs[0], Vec2(1.0f, 0.0f));
   EXPECT_EQ(set2.meshes[0].uvs[2], Vec2(0.0f, 1.0f));
 
   // A set the primitive lacks: a warning naming it, no UVs.
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 5}}}])";
-  const Scene set5 = load_scene_file(write("set5.gltf", quad.gltf()));
+  const scene::Scene set5 = load_scene_file(write("set5.gltf", quad.gltf()));
   EXPECT_TRUE(set5.meshes[0].uvs.empty());
   EXPECT_TRUE(has_warning(set5, "TEXCOORD_5"));
 
   // An untextured material keeps TEXCOORD_0.
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]}}])";
-  const Scene plain = load_scene_file(write("plain.gltf", quad.gltf()));
+  const scene::Scene plain = load_scene_file(write("plain.gltf", quad.gltf()));
   ASSERT_EQ(plain.meshes[0].uvs.size(), 4u);
   EXPECT_EQ(plain.meshes[0].uvs[1], Vec2(1.0f, 0.0f));
 }
@@ -412,21 +416,21 @@ TEST_F(GltfTextures, TextureTransformMap) {
         {"offset": [0.25, 0.5], "rotation": 0.3, "scale": [2, 3]}}}}},
     {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform":
         {"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5]}}}}}])";
-  const Scene scene = load_scene_file(write("transform.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene_file(write("transform.gltf", quad.gltf()));
   ASSERT_EQ(scene.materials.size(), 2u);
 
   // Worked by hand: T(o)·R(r)·S(s) with R's rows (cos r, sin r) and (−sin r, cos r), so
   //   s = cos r·sx·u + sin r·sy·v + ox,   t = −sin r·sx·u + cos r·sy·v + oy.
   const float c = std::cos(0.3f), s = std::sin(0.3f);
   const std::array<float, 6> expected{2 * c, 3 * s, 0.25f, -2 * s, 3 * c, 0.5f};
-  const TextureRef& general = scene.materials[0].albedo_texture;
+  const scene::TextureRef& general = scene.materials[0].albedo_texture;
   for (int i = 0; i < 6; ++i)
     EXPECT_NEAR(general.map[size_t(i)], expected[size_t(i)], 1e-6f) << "map[" << i << "]";
 
   // The extension's own example reads the image's lower-left quadrant (t grows downwards), turned
   // a quarter clockwise: the UV square's corners land on s ∈ [0, ½], t ∈ [½, 1], with u running up
   // the image and v running right.
-  const TextureRef& example = scene.materials[1].albedo_texture;
+  const scene::TextureRef& example = scene.materials[1].albedo_texture;
   const auto near = [](Vec2 a, Vec2 b) { return std::abs(a.x - b.x) < 1e-6f && std::abs(a.y - b.y) < 1e-6f; };
   EXPECT_TRUE(near(example.st({0, 0}), {0.0f, 1.0f}));
   EXPECT_TRUE(near(example.st({1, 0}), {0.0f, 0.5f}));
@@ -441,7 +445,7 @@ TEST_F(GltfTextures, TextureTransformOffsetAndTexCoordOverride) {
   quad.extensions_used = R"(["KHR_texture_transform"])";
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions":
       {"KHR_texture_transform": {"offset": [0.5, 0]}}}}}])";
-  const Scene shifted = load_scene(write("shifted.gltf", quad.gltf()));
+  const scene::Scene shifted = load_scene(write("shifted.gltf", quad.gltf()));
   // Half the image's width along s (repeating): blue on the left, red on the right.
   expect_rgb_near(albedo_at(shifted, left_point(shifted)), Rgb(0.0f, 0.0f, 1.0f));
   expect_rgb_near(albedo_at(shifted, right_point(shifted)), Rgb(1.0f, 0.0f, 0.0f));
@@ -449,7 +453,7 @@ TEST_F(GltfTextures, TextureTransformOffsetAndTexCoordOverride) {
   // The extension's texCoord overrides the textureInfo's.
   quad.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0, "extensions":
       {"KHR_texture_transform": {"texCoord": 1}}}}}])";
-  const Scene overridden = load_scene_file(write("overridden.gltf", quad.gltf()));
+  const scene::Scene overridden = load_scene_file(write("overridden.gltf", quad.gltf()));
   ASSERT_EQ(overridden.meshes[0].uvs.size(), 4u);
   EXPECT_EQ(overridden.meshes[0].uvs[0], Vec2(1.0f, 0.0f));  // TEXCOORD_1
 
@@ -480,19 +484,20 @@ TEST_F(GltfTextures, SamplerWrapModes) {
                       R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": )" + std::to_string(i) +
                       "}}}";
   quad.materials += "]";
-  const Scene scene = load_scene_file(write("samplers.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene_file(write("samplers.gltf", quad.gltf()));
   ASSERT_EQ(scene.materials.size(), 5u);
   // One image per file and pair of wrap modes: textures 0 and 4 share one, as do 2 (a sampler
   // without wrap modes) and 3 (no sampler), both repeating.
   ASSERT_EQ(scene.textures.size(), 3u);
   const auto wraps = [&](int material) {
-    const TextureImage& t = scene.textures[size_t(scene.materials[size_t(material)].albedo_texture.image)];
+    const scene::TextureImage& t =
+        scene.textures[size_t(scene.materials[size_t(material)].albedo_texture.image)];
     return std::make_pair(t.wrap_s, t.wrap_t);
   };
-  EXPECT_EQ(wraps(0), std::make_pair(TextureWrap::clamp, TextureWrap::mirror));
-  EXPECT_EQ(wraps(1), std::make_pair(TextureWrap::mirror, TextureWrap::repeat));
-  EXPECT_EQ(wraps(2), std::make_pair(TextureWrap::repeat, TextureWrap::repeat));
-  EXPECT_EQ(wraps(3), std::make_pair(TextureWrap::repeat, TextureWrap::repeat));
+  EXPECT_EQ(wraps(0), std::make_pair(scene::TextureWrap::clamp, scene::TextureWrap::mirror));
+  EXPECT_EQ(wraps(1), std::make_pair(scene::TextureWrap::mirror, scene::TextureWrap::repeat));
+  EXPECT_EQ(wraps(2), std::make_pair(scene::TextureWrap::repeat, scene::TextureWrap::repeat));
+  EXPECT_EQ(wraps(3), std::make_pair(scene::TextureWrap::repeat, scene::TextureWrap::repeat));
   EXPECT_EQ(scene.materials[2].albedo_texture.image, scene.materials[3].albedo_texture.image);
   EXPECT_EQ(scene.materials[0].albedo_texture.image, scene.materials[4].albedo_texture.image);
 
@@ -512,14 +517,14 @@ TEST_F(GltfTextures, UnmodelledMaterialExtensionsAreNamed) {
     {"extensions": {"KHR_materials_unlit": {}}},
     {"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}, "KHR_materials_ior": {"ior": 1.4}}},
     {"pbrMetallicRoughness": {"metallicFactor": 0}, "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}])";
-  const Scene scene = load_scene_file(write("extensions.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene_file(write("extensions.gltf", quad.gltf()));
   ASSERT_EQ(count_warnings(scene, "material extensions are ignored"), 1) << "one line per file";
   EXPECT_TRUE(has_warning(scene, "KHR_materials_unlit (its surfaces are lit)"));
   EXPECT_TRUE(has_warning(scene, "KHR_materials_clearcoat"));
   EXPECT_FALSE(has_warning(scene, "KHR_materials_ior"));       // read: the dielectric part's F0
   EXPECT_FALSE(has_warning(scene, "KHR_materials_specular"));  // read: factor 0 is Lambertian
-  EXPECT_EQ(scene.materials[2].kind, MaterialKind::diffuse);
-  EXPECT_EQ(scene.materials[1].kind, MaterialKind::metallic_roughness);
+  EXPECT_EQ(scene.materials[2].kind, scene::MaterialKind::diffuse);
+  EXPECT_EQ(scene.materials[1].kind, scene::MaterialKind::metallic_roughness);
   EXPECT_FLOAT_EQ(scene.materials[1].ior, 1.4f);
 }
 
@@ -533,13 +538,13 @@ TEST_F(GltfTextures, OtherTexturesWarnedInOneLine) {
     {"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}}, "normalTexture": {"index": 0, "scale": 0.5}},
     {"name": "chrome", "pbrMetallicRoughness": {"metallicFactor": 1, "roughnessFactor": 0,
                                                 "baseColorTexture": {"index": 0}}}])";
-  const Scene scene = load_scene_file(write("others.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene_file(write("others.gltf", quad.gltf()));
   EXPECT_TRUE(scene.materials[0].albedo_texture.valid());
   EXPECT_TRUE(scene.materials[0].emission_texture.valid());
   EXPECT_TRUE(scene.materials[1].metallic_roughness_texture.valid());
   EXPECT_FALSE(scene.materials[1].albedo_texture.valid());
   // A mirror's base colour tints its reflection, which an albedo texture cannot: left out.
-  EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
+  EXPECT_EQ(scene.materials[2].kind, scene::MaterialKind::mirror);
   EXPECT_FALSE(scene.materials[2].is_textured());
   // Normal textures are read (as data), with their scale.
   for (size_t i : {0, 1}) {
@@ -575,8 +580,8 @@ TEST_F(GltfTextures, NormalTextureTiltsTheShadingNormalUpTheImage) {
   for (const float scale : {1.0f, 0.5f}) {
     quad.materials = R"([{"pbrMetallicRoughness": {"metallicFactor": 0}, "normalTexture": {"index": 0, "scale": )" +
                      std::to_string(scale) + "}}]";
-    const Scene scene = load_scene(write("tilt.gltf", quad.gltf()));
-    const SurfaceInteraction si = left_point(scene);
+    const scene::Scene scene = load_scene(write("tilt.gltf", quad.gltf()));
+    const scene::SurfaceInteraction si = left_point(scene);
     const Vec3 expected = glm::normalize(Vec3(scale * (2 * 128 / 255.0f - 1), -scale * (2 * 191 / 255.0f - 1),
                                               2 * 238 / 255.0f - 1));
     EXPECT_NEAR(si.ns.x, expected.x, 1e-5f) << scale;
@@ -587,9 +592,9 @@ TEST_F(GltfTextures, NormalTextureTiltsTheShadingNormalUpTheImage) {
   // bitangent n × t along −x, so "up the image" now tilts the normal towards −x.
   quad.tangents = {0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
   quad.materials = R"([{"pbrMetallicRoughness": {"metallicFactor": 0}, "normalTexture": {"index": 0}}])";
-  const Scene scene = load_scene(write("tangents.gltf", quad.gltf()));
+  const scene::Scene scene = load_scene(write("tangents.gltf", quad.gltf()));
   ASSERT_EQ(scene.meshes[0].tangents.size(), 4u);
-  const SurfaceInteraction si = left_point(scene);
+  const scene::SurfaceInteraction si = left_point(scene);
   const Vec3 expected = glm::normalize(Vec3(-(2 * 191 / 255.0f - 1), 2 * 128 / 255.0f - 1, 2 * 238 / 255.0f - 1));
   EXPECT_NEAR(si.ns.x, expected.x, 1e-5f);
   EXPECT_NEAR(si.ns.y, expected.y, 1e-5f);
@@ -605,26 +610,27 @@ TEST_F(GltfTextures, AlphaModeMaskAndBlendComeFromTheBaseColour) {
     quad.materials = "[" + material + "]";
     return load_scene(write("alpha.gltf", quad.gltf()));
   };
-  const auto stops_at_centre = [](const Scene& scene) {
+  const auto stops_at_centre = [](const scene::Scene& scene) {
     const Bounds3& b = scene.bounds();
     const Vec3 c = 0.5f * (b.lo + b.hi), size = b.hi - b.lo;
     const int axis = size.x <= size.y && size.x <= size.z ? 0 : size.y <= size.z ? 1 : 2;  // the quad's normal
     Vec3 from = c, dir(0.0f);
     from[axis] += 1.0f;
     dir[axis] = -1.0f;
-    return scene.occluded(Ray{from, dir, 2.0f});
+    return scene.occluded(scene::Ray{from, dir, 2.0f});
   };
   const std::string factor = R"("pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.3]})";
-  const Scene masked = load_with("{" + factor + R"(, "alphaMode": "MASK"})");
-  EXPECT_EQ(masked.materials[0].alpha_mode, AlphaMode::mask);
+  const scene::Scene masked = load_with("{" + factor + R"(, "alphaMode": "MASK"})");
+  EXPECT_EQ(masked.materials[0].alpha_mode, scene::AlphaMode::mask);
   EXPECT_FLOAT_EQ(masked.materials[0].alpha, 0.3f);
   EXPECT_FALSE(stops_at_centre(masked));
   EXPECT_TRUE(stops_at_centre(load_with("{" + factor + R"(, "alphaMode": "MASK", "alphaCutoff": 0.2})")));
-  EXPECT_EQ(load_with("{" + factor + R"(, "alphaMode": "BLEND"})").materials[0].alpha_mode, AlphaMode::blend);
+  EXPECT_EQ(load_with("{" + factor + R"(, "alphaMode": "BLEND"})").materials[0].alpha_mode,
+            scene::AlphaMode::blend);
   // OPAQUE (the default) ignores alpha.
   EXPECT_TRUE(stops_at_centre(load_with("{" + factor + "}")));
   EXPECT_NE(error_of([&] { load_with("{" + factor + R"(, "alphaMode": "CUTOUT"})"); }).find("alphaMode"), std::string::npos);
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

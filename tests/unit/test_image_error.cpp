@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "raytrace_core/io/image_error.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/image_error.h"
+#include "raytrace_core/util/rng.h"
 
 namespace rc = gilt::raytrace_core;
 
@@ -15,24 +15,24 @@ TEST(ImageError, MatchesHandComputedValues) {
   // Differences: 0.1 in every channel of the first pixel, 0 in the second.
   const std::vector<rc::Rgb> reference = {rc::Rgb(0.4f), rc::Rgb(1.0f)};
   const std::vector<rc::Rgb> image = {rc::Rgb(0.5f), rc::Rgb(1.0f)};
-  const rc::ImageError e = rc::image_error(image, reference);
+  const rc::util::ImageError e = rc::util::image_error(image, reference);
   const double d = double(0.5f) - double(0.4f), r = double(0.4f);
   EXPECT_NEAR(e.mae, d / 2, 1e-12);
   EXPECT_NEAR(e.rmse, std::sqrt(d * d / 2), 1e-12);
   EXPECT_NEAR(e.relmse, d * d / (r * r + 0.01) / 2, 1e-12);
   EXPECT_NEAR(e.mean_relative, d / (r + 0.01) / 2, 1e-12);
-  EXPECT_EQ(rc::mean_relative_error(image, reference), e.mean_relative);
-  EXPECT_EQ(rc::image_error(reference, reference).rmse, 0.0);
+  EXPECT_EQ(rc::util::mean_relative_error(image, reference), e.mean_relative);
+  EXPECT_EQ(rc::util::image_error(reference, reference).rmse, 0.0);
   // Brightness: (0.5 + 1) / (0.4 + 1) in every channel; a black reference reads 1.
   EXPECT_NEAR(e.mean_ratio, (double(0.5f) + 1.0) / (r + 1.0), 1e-12);
-  EXPECT_EQ(rc::image_error(image, std::vector<rc::Rgb>(2, rc::Rgb(0.0f))).mean_ratio, 1.0);
-  EXPECT_THROW(rc::image_error(image, std::vector<rc::Rgb>(1)), std::invalid_argument);
+  EXPECT_EQ(rc::util::image_error(image, std::vector<rc::Rgb>(2, rc::Rgb(0.0f))).mean_ratio, 1.0);
+  EXPECT_THROW(rc::util::image_error(image, std::vector<rc::Rgb>(1)), std::invalid_argument);
 }
 
 namespace {
 
 /// A standard normal variate (Box–Muller).
-double normal(rc::Rng& rng) {
+double normal(rc::util::Rng& rng) {
   const double u1 = 1.0 - double(rng.uniform()), u2 = rng.uniform();
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.14159265358979323846 * u2);
 }
@@ -49,7 +49,7 @@ TEST(ImageError, TheReferencesNoiseIsTakenOutOfTheSquaredErrors) {
   constexpr int kPixels = 128 * 128;
   constexpr double kRelativeNoise = 0.03;  // the reference's standard deviation over μ
   constexpr double kW = 0.75;             // share of the reference's samples in half A
-  rc::Rng rng(2026);
+  rc::util::Rng rng(2026);
   std::vector<rc::Rgb> exact(kPixels), a(kPixels), b(kPixels), reference(kPixels), better(kPixels), worse(kPixels);
   double true_floor = 0.0;
   for (int i = 0; i < kPixels; ++i)
@@ -65,11 +65,11 @@ TEST(ImageError, TheReferencesNoiseIsTakenOutOfTheSquaredErrors) {
       true_floor += sd * sd;
     }
   true_floor /= 3.0 * kPixels;
-  const std::vector<rc::Rgb> variance = rc::reference_variance(a, b, kW);
+  const std::vector<rc::Rgb> variance = rc::util::reference_variance(a, b, kW);
 
   for (const std::vector<rc::Rgb>* method : {&better, &worse}) {
-    const rc::ImageError clean = rc::image_error(*method, exact);
-    const rc::ImageError noisy = rc::image_error(*method, reference, variance);
+    const rc::util::ImageError clean = rc::util::image_error(*method, exact);
+    const rc::util::ImageError noisy = rc::util::image_error(*method, reference, variance);
     EXPECT_TRUE(noisy.noise_corrected);
     EXPECT_FALSE(clean.noise_corrected);
     const double tolerance = 4.0 * (noisy.relmse_stderr + clean.relmse_stderr);
@@ -93,15 +93,15 @@ TEST(ImageError, TheReferencesNoiseIsTakenOutOfTheSquaredErrors) {
     EXPECT_NEAR(noisy.mse_floor, true_floor, 4.0 * std::sqrt(2.0 * max_sd2 * true_floor / n));
   }
   // The two rank as against the exact image, and the better one is found below the floor.
-  const rc::ImageError better_e = rc::image_error(better, reference, variance);
-  const rc::ImageError worse_e = rc::image_error(worse, reference, variance);
+  const rc::util::ImageError better_e = rc::util::image_error(better, reference, variance);
+  const rc::util::ImageError worse_e = rc::util::image_error(worse, reference, variance);
   EXPECT_LT(better_e.relmse, worse_e.relmse);
   EXPECT_LT(better_e.relmse, better_e.relmse_floor);
   EXPECT_GT(worse_e.relmse, worse_e.relmse_floor);
   // Without a variance nothing is subtracted.
-  const rc::ImageError plain = rc::image_error(better, reference);
+  const rc::util::ImageError plain = rc::util::image_error(better, reference);
   EXPECT_EQ(plain.relmse, plain.relmse_measured);
   EXPECT_EQ(plain.relmse_floor, 0.0);
-  EXPECT_THROW(rc::image_error(better, reference, std::vector<rc::Rgb>(3)), std::invalid_argument);
-  EXPECT_THROW(rc::reference_variance(a, b, 1.0), std::invalid_argument);
+  EXPECT_THROW(rc::util::image_error(better, reference, std::vector<rc::Rgb>(3)), std::invalid_argument);
+  EXPECT_THROW(rc::util::reference_variance(a, b, 1.0), std::invalid_argument);
 }

@@ -1,6 +1,6 @@
 // Image files: round trips within each format's precision, and atomic, tidy writes.
 
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/image_io.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -19,9 +19,9 @@
 #include <set>
 #include <string>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 namespace fs = std::filesystem;
@@ -286,4 +286,4 @@ TEST_F(ImageIoTest, ReadsTheFirstThreeOfFourChannels) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -22,10 +22,10 @@
 #include "radiosity/bake/lightmap.h"
 #include "radiosity/bake/onto_input.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/model_files.h"
 
@@ -102,12 +102,12 @@ bool strictly_inside(const Vec2* t, const Vec2& p, double eps) {
 }
 
 struct Solved {
-  rc::Scene scene;
+  rc::scene::Scene scene;
   rad::solver::Solution solution;
 };
 
 Solved solve(const fs::path& scene_file, int elements) {
-  Solved s{rc::load_scene(scene_file.string()), {}};
+  Solved s{rc::io::load_scene(scene_file.string()), {}};
   rad::solver::SolverSettings settings;
   settings.mesh.elements = elements;
   s.solution = rad::solver::solve(s.scene, settings);
@@ -124,7 +124,7 @@ TEST(Lightmap, FacesAreLaidOutApartAtOneDensity) {
   std::vector<std::array<Vec2, 3>> triangles;
   double largest_density = 0.0, smallest_density = 1e300;
   for (size_t m = 0; m < s.scene.meshes.size(); ++m) {
-    const rc::TriangleMesh& mesh = s.scene.meshes[m];
+    const rc::scene::TriangleMesh& mesh = s.scene.meshes[m];
     ASSERT_EQ(lm.corner_uv[m].size(), mesh.indices.size());
     for (size_t f = 0; f < mesh.triangle_count(); ++f) {
       std::array<Vec2, 3> t;
@@ -171,7 +171,7 @@ TEST(Lightmap, TexelsHoldTheSunAndSkyAndThePanelsShadows) {
   for (size_t m = 0; m < s.scene.meshes.size(); ++m)
     if (s.scene.meshes[m].origin.mesh == 0) floor = m;
   ASSERT_NE(floor, SIZE_MAX);
-  const rc::TriangleMesh& mesh = s.scene.meshes[floor];
+  const rc::scene::TriangleMesh& mesh = s.scene.meshes[floor];
   // The lightmap at a floor point (x, z): find its face and barycentrics.
   const auto at = [&](float x, float z) {
     for (size_t f = 0; f < mesh.triangle_count(); ++f) {
@@ -197,7 +197,7 @@ TEST(Lightmap, TexelsHoldTheSunAndSkyAndThePanelsShadows) {
   // The panels' tops: the sun and the whole sky.
   for (size_t m = 0; m < s.scene.meshes.size(); ++m) {
     if (s.scene.meshes[m].origin.mesh != 1) continue;
-    const rc::TriangleMesh& panel = s.scene.meshes[m];
+    const rc::scene::TriangleMesh& panel = s.scene.meshes[m];
     for (size_t f = 0; f < panel.triangle_count(); ++f) {
       const Vec3 n = glm::cross(panel.positions[panel.indices[3 * f + 1]] - panel.positions[panel.indices[3 * f]],
                                 panel.positions[panel.indices[3 * f + 2]] - panel.positions[panel.indices[3 * f]]);
@@ -218,7 +218,7 @@ TEST(Lightmap, TexelsHoldTheSunAndSkyAndThePanelsShadows) {
 TEST(Lightmap, FinalGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   // --bake-gather traces each point's light. On the panels' tops nothing but the sun and the sky
   // reaches: E = 2 + 0.3π, the sun by its shadow ray and the uniform sky by the gather rays,
-  // every one of which escapes and brings πL (rc::sky_left_to_bsdf_sampling): exact, up to
+  // every one of which escapes and brings πL (rc::render::sky_left_to_bsdf_sampling): exact, up to
   // float rounding in the sum of 4,096 samples.
   const fs::path dir = fresh_dir("gather");
   const Solved s = solve(write_model(dir), 400);
@@ -226,9 +226,9 @@ TEST(Lightmap, FinalGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   const int rays = 4096;
   const double tolerance = 1e-4 * open;
   const rad::bake::SolutionAtInput gathered(s.scene, s.solution, rad::bake::Quantity::irradiance, rad::bake::BakeGather{rays, 3});
-  const rc::Material& grey = s.scene.materials[s.scene.meshes[0].material];
+  const rc::scene::Material& grey = s.scene.materials[s.scene.meshes[0].material];
   int tops = 0;
-  for (const rc::TriangleMesh& panel : s.scene.meshes) {
+  for (const rc::scene::TriangleMesh& panel : s.scene.meshes) {
     if (panel.origin.mesh != 1) continue;
     for (size_t f = 0; f < panel.triangle_count(); ++f) {
       const Vec3 a = panel.positions[panel.indices[3 * f]], b = panel.positions[panel.indices[3 * f + 1]],
@@ -288,7 +288,7 @@ TEST(Lightmap, VertexGatherIsUnbiasedOnOpenSurfacesAndRepeatable) {
   EXPECT_EQ(count.late, 0u);
   // Each vertex draws its own stream: the same for any thread count.
   {
-    const rc::ThreadLimit one(1);
+    const rc::util::ThreadLimit one(1);
     const rad::solver::Solution again = rad::bake::gather_at_vertices(s.scene, s.solution, rad::bake::BakeGather{rays, 3});
     for (size_t v = 0; v < mesh.vertex_count(); ++v) EXPECT_EQ(again.vertex_irradiance[v].g, gathered.vertex_irradiance[v].g);
   }
@@ -368,7 +368,7 @@ TEST(Lightmap, TheGltfKeepsItsNodesAndFacesAndGainsAUvSet) {
       EXPECT_EQ(extras.Get("texCoord").GetNumberAsInt(), 0);
     }
     const std::string stem = fs::path(name).stem().string();
-    const rc::Image image = rc::read_image((dir / (stem + "_lightmap.exr")).string());
+    const rc::util::Image image = rc::util::read_image((dir / (stem + "_lightmap.exr")).string());
     EXPECT_EQ(image.width, 64);
     EXPECT_EQ(image.height, 64);
     size_t lit = 0;
@@ -541,7 +541,7 @@ TEST(Lightmap, TheInputsOwnUvSetIsUsedWhenItCanHoldTheLightmap) {
     // The floor's corners in the set used, by vertex.
     size_t floor = 0;
     while (s.scene.meshes[floor].origin.mesh != 0) ++floor;
-    const rc::TriangleMesh& mesh = s.scene.meshes[floor];
+    const rc::scene::TriangleMesh& mesh = s.scene.meshes[floor];
     const float low = c.expected_set == 1 ? 0.0f : 0.5f;
     const Vec2 corner[4] = {Vec2(0, 1), Vec2(0.5f, 1), Vec2(0.5f, low), Vec2(0, low)};
     for (size_t k = 0; k < mesh.indices.size(); ++k) EXPECT_EQ(lm.corner_uv[floor][k], corner[mesh.indices[k]]);
@@ -684,7 +684,7 @@ TEST(Lightmap, AnAtlasTooSmallForItsChartsIsRefusedNotLeftEmpty) {
   write_file(dir / "tiles.obj", obj);
   write_file(dir / "scene.json", R"({"meshes": [{"file": "tiles.obj"}],
     "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}]})");
-  const rc::Scene scene = rc::load_scene((dir / "scene.json").string());
+  const rc::scene::Scene scene = rc::io::load_scene((dir / "scene.json").string());
   try {
     rad::bake::check_lightmap_layout(scene, 16);
     ADD_FAILURE() << "a 16-texel atlas cannot hold six charts";

@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/io/image_io.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/image_io.h"
 #include "raytrace_core/io/scene_io.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -66,20 +66,20 @@ std::string error_of(const std::function<void()>& f) {
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE((text).find(part), std::string::npos) << "in: " << (text)
 
-bool has_warning(const Scene& scene, const std::string& part) {
+bool has_warning(const scene::Scene& scene, const std::string& part) {
   for (const std::string& w : scene.warnings)
     if (w.find(part) != std::string::npos) return true;
   return false;
 }
 
-Vec3 triangle_normal(const TriangleMesh& mesh, size_t t) {
+Vec3 triangle_normal(const scene::TriangleMesh& mesh, size_t t) {
   const Vec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
              c = mesh.positions[mesh.indices[3 * t + 2]];
   return glm::cross(b - a, c - a);
 }
 
-const TriangleMesh& mesh_named(const Scene& scene, const std::string& name) {
-  for (const TriangleMesh& m : scene.meshes)
+const scene::TriangleMesh& mesh_named(const scene::Scene& scene, const std::string& name) {
+  for (const scene::TriangleMesh& m : scene.meshes)
     if (m.name == name) return m;
   throw std::runtime_error("no mesh " + name);
 }
@@ -130,11 +130,11 @@ f 1 2 3
 usemtl hot
 f -4 -3 -2
 )");
-  Scene scene = load_scene_file(obj);
+  scene::Scene scene = load_scene_file(obj);
   ASSERT_EQ(scene.materials.size(), 5u);
   ASSERT_EQ(scene.meshes.size(), 5u);  // one mesh per material, the two lamp groups merged
-  for (const TriangleMesh& mesh : scene.meshes) {
-    const Material& m = scene.materials[mesh.material];
+  for (const scene::TriangleMesh& mesh : scene.meshes) {
+    const scene::Material& m = scene.materials[mesh.material];
     if (m.name == "lamp") {
       EXPECT_EQ(mesh.triangle_count(), 3u);  // the quad triangulated, plus the later lamp face
       EXPECT_EQ(mesh.normals.size(), mesh.positions.size());
@@ -145,34 +145,34 @@ f -4 -3 -2
       EXPECT_TRUE(mesh.normals.empty());
     }
   }
-  const auto material = [&](const std::string& name) -> const Material& {
-    for (const Material& m : scene.materials)
+  const auto material = [&](const std::string& name) -> const scene::Material& {
+    for (const scene::Material& m : scene.materials)
       if (m.name == name) return m;
     throw std::runtime_error("no material " + name);
   };
-  EXPECT_EQ(material("glass").kind, MaterialKind::dielectric);
+  EXPECT_EQ(material("glass").kind, scene::MaterialKind::dielectric);
   EXPECT_FLOAT_EQ(material("glass").ior, 1.33f);
   EXPECT_NEAR(material("glass").absorption.r, -std::log(0.9f), 1e-5f);
   EXPECT_EQ(material("glass").absorption.b, 0.0f);
   EXPECT_FLOAT_EQ(material("glass").roughness, 0.4f);  // Pr on glass: frosted, still glass
   EXPECT_TRUE(material("glass").is_rough_dielectric());
-  EXPECT_EQ(material("chrome").kind, MaterialKind::mirror);
+  EXPECT_EQ(material("chrome").kind, scene::MaterialKind::mirror);
   EXPECT_FLOAT_EQ(material("chrome").specular.g, 0.9f);
-  EXPECT_EQ(material("plastic").kind, MaterialKind::glossy);
+  EXPECT_EQ(material("plastic").kind, scene::MaterialKind::glossy);
   EXPECT_FLOAT_EQ(material("plastic").exponent, 50.0f);
-  const Material& hot = material("hot");  // Kd + Ks = 1.3 > 1: scaled to sum 1
+  const scene::Material& hot = material("hot");  // Kd + Ks = 1.3 > 1: scaled to sum 1
   EXPECT_NEAR(hot.albedo.r + hot.specular.r, 1.0f, 1e-6f);
   EXPECT_TRUE(has_warning(scene, "Kd + Ks exceeds 1"));
 
-  const Scene committed = load_scene(obj);
+  const scene::Scene committed = load_scene(obj);
   EXPECT_EQ(committed.lights().size(), 3u);  // the three lamp triangles
 }
 
 TEST_F(Loaders, ObjWithoutMtlGetsDefaultMaterial) {
   const std::string obj = write("plain.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   ASSERT_EQ(scene.meshes.size(), 1u);
-  EXPECT_EQ(scene.materials[scene.meshes[0].material].kind, MaterialKind::diffuse);
+  EXPECT_EQ(scene.materials[scene.meshes[0].material].kind, scene::MaterialKind::diffuse);
   EXPECT_TRUE(has_warning(scene, "missing.mtl"));
 }
 
@@ -183,9 +183,9 @@ TEST_F(Loaders, ObjAndMtlCommentsAfterNumbers) {
   const std::string obj = write("commented.obj",
                                 "mtllib commented.mtl # materials\nv 0 0 0 # origin\nv 1 0 0\n"
                                 "v 0 1 0\nusemtl red\nf 1 2 3\n");
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   ASSERT_EQ(scene.meshes.size(), 1u);
-  const Material& m = scene.materials[scene.meshes[0].material];
+  const scene::Material& m = scene.materials[scene.meshes[0].material];
   EXPECT_NEAR(m.albedo.r, 0.63f, 1e-6f);
   EXPECT_NEAR(m.albedo.g, 0.065f, 1e-6f);
   write("bad.mtl", "newmtl red\nKd 0.5 0.5 # two numbers and a comment 3\n");
@@ -204,10 +204,10 @@ TEST_F(Loaders, ObjCommentsAfterNamesAndFaces) {
   const std::string obj = write("named.obj",
                                 "mtllib named.mtl # lib\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nvt 0 0\r\n"
                                 "usemtl blue # wall\r\nf 1/1 2/1 3/1 # one triangle\r\n");
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   ASSERT_EQ(scene.meshes.size(), 1u);
   EXPECT_EQ(scene.meshes[0].triangle_count(), 1u);
-  const Material& m = scene.materials[scene.meshes[0].material];
+  const scene::Material& m = scene.materials[scene.meshes[0].material];
   EXPECT_EQ(m.name, "blue");
   EXPECT_NEAR(m.albedo.b, 0.427f, 1e-6f);
   ASSERT_EQ(scene.textures.size(), 1u);
@@ -216,7 +216,7 @@ TEST_F(Loaders, ObjCommentsAfterNamesAndFaces) {
 }
 
 /// The albedo_texture map of a material, for comparing with an expected one.
-void expect_map(const TextureRef& ref, const std::array<float, 6>& expected) {
+void expect_map(const scene::TextureRef& ref, const std::array<float, 6>& expected) {
   for (size_t k = 0; k < 6; ++k) EXPECT_NEAR(ref.map[k], expected[k], 1e-6f) << "map[" << k << "]";
 }
 
@@ -243,20 +243,20 @@ TEST_F(Loaders, ObjMapKdBecomesAlbedoTexture) {
   write("textures/wood.png", "not read before commit");
   write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd textures/wood.png\nnewmtl other\nKd 1 1 1\n");
   const std::string obj = write("textured.obj", kTexturedQuad);
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   ASSERT_EQ(scene.textures.size(), 1u);
   EXPECT_EQ(scene.textures[0].file, (dir_ / "textures" / "wood.png").lexically_normal().string());
   EXPECT_TRUE(scene.textures[0].srgb);
-  EXPECT_EQ(scene.textures[0].wrap_s, TextureWrap::repeat);
-  EXPECT_EQ(scene.textures[0].wrap_t, TextureWrap::repeat);
-  const TriangleMesh& wood = mesh_named(scene, "textured:wood");
-  const Material& m = scene.materials[wood.material];
+  EXPECT_EQ(scene.textures[0].wrap_s, scene::TextureWrap::repeat);
+  EXPECT_EQ(scene.textures[0].wrap_t, scene::TextureWrap::repeat);
+  const scene::TriangleMesh& wood = mesh_named(scene, "textured:wood");
+  const scene::Material& m = scene.materials[wood.material];
   EXPECT_EQ(m.albedo, Rgb(0.5f));
   EXPECT_EQ(m.albedo_texture.image, 0);
   expect_map(m.albedo_texture, {1, 0, 0, 0, -1, 1});
   EXPECT_EQ(wood.uvs.size(), wood.positions.size());
   // Position 1 appears with two texture coordinates in `other`: the seam splits the vertex.
-  const TriangleMesh& other = mesh_named(scene, "textured:other");
+  const scene::TriangleMesh& other = mesh_named(scene, "textured:other");
   EXPECT_FALSE(scene.materials[other.material].is_textured());
   EXPECT_EQ(other.positions.size(), 5u);
   EXPECT_FALSE(has_warning(scene, "texture maps are ignored"));
@@ -269,11 +269,11 @@ TEST_F(Loaders, ObjMapKdScaleOffsetAndClamp) {
   write("wood.png", "not read before commit");
   write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd -s 2 2 -o 0.5 0 -clamp on wood.png\n");
   const std::string obj = write("textured.obj", kTexturedQuad);
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   ASSERT_EQ(scene.textures.size(), 1u);
-  EXPECT_EQ(scene.textures[0].wrap_s, TextureWrap::clamp);
-  EXPECT_EQ(scene.textures[0].wrap_t, TextureWrap::clamp);
-  const TextureRef& ref = scene.materials[mesh_named(scene, "textured:wood").material].albedo_texture;
+  EXPECT_EQ(scene.textures[0].wrap_s, scene::TextureWrap::clamp);
+  EXPECT_EQ(scene.textures[0].wrap_t, scene::TextureWrap::clamp);
+  const scene::TextureRef& ref = scene.materials[mesh_named(scene, "textured:wood").material].albedo_texture;
   expect_map(ref, {2, 0, 0.5f, 0, -2, 1});
   const Vec2 st = ref.st(Vec2(0.25f, 0.25f));  // s = 2·0.25 + 0.5 = 1, t = 1 − 2·0.25 = 0.5
   EXPECT_NEAR(st.x, 1.0f, 1e-6f);
@@ -289,11 +289,11 @@ TEST_F(Loaders, ObjMapKdScaleOffsetAndClamp) {
 TEST_F(Loaders, ObjMissingTextureWarnsAndLeavesMaterialUntextured) {
   write("textured.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd nothere.png\n");
   const std::string obj = write("textured.obj", kTexturedQuad);
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   EXPECT_TRUE(scene.textures.empty());
   EXPECT_FALSE(scene.materials[mesh_named(scene, "textured:wood").material].is_textured());
   EXPECT_TRUE(has_warning(scene, "nothere.png"));
-  const Scene committed = load_scene(obj);  // and the scene still commits
+  const scene::Scene committed = load_scene(obj);  // and the scene still commits
   EXPECT_EQ(committed.triangle_count(), 4u);
 }
 
@@ -309,11 +309,11 @@ TEST_F(Loaders, ObjMaterialsSharingATextureShareOneImage) {
   const std::string obj = write("shared.obj",
                                 "mtllib shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                                 "usemtl wall\nf 1/1 2/2 3/3\nusemtl pillar\nf 1/1 3/3 2/2\n");
-  const Scene scene = load_scene_file(obj);
+  const scene::Scene scene = load_scene_file(obj);
   // Two images: the stone (colour) and its bump map (data), each shared by both materials.
   ASSERT_EQ(scene.textures.size(), 2u);
-  const Material& wall = scene.materials[mesh_named(scene, "shared:wall").material];
-  const Material& pillar = scene.materials[mesh_named(scene, "shared:pillar").material];
+  const scene::Material& wall = scene.materials[mesh_named(scene, "shared:wall").material];
+  const scene::Material& pillar = scene.materials[mesh_named(scene, "shared:pillar").material];
   EXPECT_EQ(wall.albedo_texture.image, 0);
   EXPECT_EQ(pillar.albedo_texture.image, 0);
   EXPECT_EQ(wall.normal_texture.image, 1);
@@ -338,8 +338,8 @@ TEST_F(Loaders, ObjTexturedMeshWithSomeCornersLackingUvs) {
   const std::string obj = write("textured.obj",
                                 "mtllib textured.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0.5 0.5\n"
                                 "usemtl wood\nf 1/1 2/1 3/1\nf 2 4 3\n");
-  const Scene scene = load_scene_file(obj);
-  const TriangleMesh& mesh = mesh_named(scene, "textured:wood");
+  const scene::Scene scene = load_scene_file(obj);
+  const scene::TriangleMesh& mesh = mesh_named(scene, "textured:wood");
   ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
   EXPECT_EQ(mesh.positions.size(), 6u);  // (v, vt) and (v, none) are different vertices
   EXPECT_EQ(mesh.uvs[0], Vec2(0.5f, 0.5f));
@@ -348,8 +348,8 @@ TEST_F(Loaders, ObjTexturedMeshWithSomeCornersLackingUvs) {
 }
 
 /// The surface point of mesh `geom_id` whose texture coordinates are `uv`.
-SurfaceInteraction point_at_uv(const Scene& scene, uint32_t geom_id, Vec2 uv) {
-  const TriangleMesh& mesh = scene.meshes[geom_id];
+scene::SurfaceInteraction point_at_uv(const scene::Scene& scene, uint32_t geom_id, Vec2 uv) {
+  const scene::TriangleMesh& mesh = scene.meshes[geom_id];
   for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     const Vec2 a = mesh.uvs[mesh.indices[3 * t]], b = mesh.uvs[mesh.indices[3 * t + 1]],
                c = mesh.uvs[mesh.indices[3 * t + 2]];
@@ -368,23 +368,23 @@ SurfaceInteraction point_at_uv(const Scene& scene, uint32_t geom_id, Vec2 uv) {
 // remaining error is the linear copy's half floats and the bilinear weights at a texel's centre,
 // well inside 1e-3.
 TEST_F(Loaders, ObjTextureAlbedoAtPoints) {
-  Image image;
+  util::Image image;
   image.width = 2;
   image.height = 1;
   image.pixels = {Rgb(1, 0, 0), Rgb(0, 0, 1)};
-  write_image((dir_ / "redblue.png").string(), image);  // 8-bit sRGB
+  util::write_image((dir_ / "redblue.png").string(), image);  // 8-bit sRGB
   write("quad.mtl", "newmtl painted\nKd 0.5 0.8 0.6\nmap_Kd redblue.png\n");
   const std::string obj = write("quad.obj",
                                 "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                 "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl painted\nf 1/1 2/2 3/3 4/4\n");
-  const Scene scene = load_scene(obj);
+  const scene::Scene scene = load_scene(obj);
   ASSERT_EQ(scene.meshes.size(), 1u);
   ASSERT_NE(scene.texture_set(), nullptr);
   const auto albedo_at = [&](Vec2 uv) {
-    const SurfaceInteraction si = point_at_uv(scene, 0, uv);
+    const scene::SurfaceInteraction si = point_at_uv(scene, 0, uv);
     EXPECT_NEAR(si.uv.x, uv.x, 1e-6f);
     EXPECT_NEAR(si.uv.y, uv.y, 1e-6f);
-    Material scratch;
+    scene::Material scratch;
     return scene.shading_material(si, scratch).albedo;
   };
   // u = 0.25 and 0.75 are the texel centres; v = 0.5 the middle of the one row.
@@ -415,7 +415,7 @@ TEST_F(Loaders, ObjNonFiniteCoordinate) {
 
 TEST_F(Loaders, DegenerateTrianglesDroppedWithWarning) {
   const std::string obj = write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
-  const Scene scene = load_scene(obj);
+  const scene::Scene scene = load_scene(obj);
   EXPECT_EQ(scene.triangle_count(), 1u);
   EXPECT_TRUE(has_warning(scene, "1 degenerate"));
 }
@@ -488,23 +488,23 @@ std::string embedded_buffer(const std::vector<unsigned char>& bytes) {
          R"(, "uri": "data:application/octet-stream;base64,)" + base64(bytes) + "\"}";
 }
 
-void expect_gltf_contents(const Scene& scene) {
+void expect_gltf_contents(const scene::Scene& scene) {
   ASSERT_EQ(scene.meshes.size(), 2u);
   EXPECT_EQ(scene.meshes[0].positions[0], Vec3(10, 1, 0));  // root then child translation
   EXPECT_EQ(scene.meshes[1].positions[2], Vec3(12, 2, 0));  // scaled by 2, then moved by the root
   ASSERT_EQ(scene.materials.size(), 4u);
-  const Material& lamp = scene.materials[scene.meshes[0].material];
+  const scene::Material& lamp = scene.materials[scene.meshes[0].material];
   EXPECT_EQ(lamp.emission, Rgb(5.0f));
   EXPECT_TRUE(lamp.two_sided_emission);
-  const Material& glass = scene.materials[scene.meshes[1].material];
-  EXPECT_EQ(glass.kind, MaterialKind::dielectric);
+  const scene::Material& glass = scene.materials[scene.meshes[1].material];
+  EXPECT_EQ(glass.kind, scene::MaterialKind::dielectric);
   EXPECT_FLOAT_EQ(glass.ior, 1.4f);
-  EXPECT_EQ(scene.materials[2].kind, MaterialKind::mirror);
+  EXPECT_EQ(scene.materials[2].kind, scene::MaterialKind::mirror);
   EXPECT_TRUE(glass.thin_walled);  // no KHR_materials_volume: a sheet
   // No pbrMetallicRoughness: glTF's default roughnessFactor of 1, which its transmission shares.
   EXPECT_FLOAT_EQ(glass.roughness, 1.0f);
   EXPECT_TRUE(glass.is_rough_dielectric());
-  EXPECT_EQ(scene.materials[3].kind, MaterialKind::metallic_roughness);
+  EXPECT_EQ(scene.materials[3].kind, scene::MaterialKind::metallic_roughness);
   EXPECT_EQ(scene.materials[3].metallic, 0.0f);
   EXPECT_EQ(scene.materials[3].roughness, 0.5f);
 
@@ -515,17 +515,17 @@ void expect_gltf_contents(const Scene& scene) {
   EXPECT_EQ(scene.render.width, 768);
 
   ASSERT_EQ(scene.punctual_lights.size(), 3u);
-  const Light& point = scene.punctual_lights[0];
-  EXPECT_EQ(point.kind, LightKind::point);
+  const scene::Light& point = scene.punctual_lights[0];
+  EXPECT_EQ(point.kind, scene::LightKind::point);
   EXPECT_EQ(point.position, Vec3(0, 3, 0));
   EXPECT_EQ(point.intensity, Rgb(10.0f, 5.0f, 2.5f));
-  const Light& spot = scene.punctual_lights[1];
-  EXPECT_EQ(spot.kind, LightKind::spot);
+  const scene::Light& spot = scene.punctual_lights[1];
+  EXPECT_EQ(spot.kind, scene::LightKind::spot);
   EXPECT_FLOAT_EQ(spot.cos_inner, std::cos(0.2f));
   EXPECT_FLOAT_EQ(spot.cos_outer, std::cos(0.5f));
   EXPECT_EQ(spot.direction, Vec3(0, 0, -1));
-  const Light& sun = scene.punctual_lights[2];
-  EXPECT_EQ(sun.kind, LightKind::directional);
+  const scene::Light& sun = scene.punctual_lights[2];
+  EXPECT_EQ(sun.kind, scene::LightKind::directional);
   EXPECT_EQ(sun.irradiance, Rgb(3.0f));
   EXPECT_NEAR(sun.direction.y, -1.0f, 1e-6f);  // node −z turned by −90° about x
 }
@@ -543,7 +543,7 @@ TEST_F(Loaders, JsonSceneKeepsItsGltfsCameraUnlessItHasOne) {
   const std::string wrapped =
       write("wrapped.json", R"({"meshes": [{"file": "scene.gltf", "transform": {"translate": [1, 2, 3]}},
                                           {"file": "scene.gltf"}]})");
-  const Scene scene = load_scene_file(wrapped);
+  const scene::Scene scene = load_scene_file(wrapped);
   ASSERT_TRUE(scene.camera.has_value());
   EXPECT_EQ(scene.camera->look_from, Vec3(1, 2, 8));
   EXPECT_EQ(scene.camera->look_at, Vec3(1, 2, 7));
@@ -553,7 +553,7 @@ TEST_F(Loaders, JsonSceneKeepsItsGltfsCameraUnlessItHasOne) {
   EXPECT_TRUE(has_warning(scene, "an earlier file's is used"));
   const std::string own = write("own.json", R"({"meshes": [{"file": "scene.gltf"}],
       "camera": {"look_from": [0, 0, -3], "look_at": [0, 0, 0]}})");
-  const Scene with_own = load_scene_file(own);
+  const scene::Scene with_own = load_scene_file(own);
   ASSERT_TRUE(with_own.camera.has_value());
   EXPECT_EQ(with_own.camera->look_from, Vec3(0, 0, -3));
   EXPECT_TRUE(has_warning(with_own, "the scene's own is used"));
@@ -564,20 +564,20 @@ TEST_F(Loaders, GltfCamerasAreAllKeptAndChosenByNumberOrName) {
   // orthographic, 2·ymag = 4 high with aspect xmag / ymag = 2, on a node 4 above the origin
   // turned to look straight down.
   const std::string path = write("scene.gltf", gltf_json(embedded_buffer(quad_buffer())));
-  Scene scene = load_scene_file(path);
+  scene::Scene scene = load_scene_file(path);
   ASSERT_EQ(scene.cameras.size(), 2u);
   EXPECT_EQ(scene.cameras[0].name, "camera 0");
   EXPECT_EQ(scene.cameras[1].name, "plan");  // the camera's own name before its node's
   EXPECT_FALSE(scene.camera->orthographic);
-  const Camera& plan = scene.cameras[1].camera;
+  const scene::Camera& plan = scene.cameras[1].camera;
   EXPECT_TRUE(plan.orthographic);
   EXPECT_FLOAT_EQ(plan.ortho_height, 4.0f);
   EXPECT_FLOAT_EQ(scene.cameras[1].aspect, 2.0f);
   EXPECT_EQ(plan.look_from, Vec3(0, 4, 0));
   EXPECT_NEAR(plan.look_at.y, 3.0f, 1e-6f);
   // An orthographic camera's rays are parallel, from a film 4 × 8 centred on look_from.
-  const Ray left = plan.generate_ray(Vec2(0.0f, 0.5f), Vec2(0.5f), 2.0f);
-  const Ray right = plan.generate_ray(Vec2(1.0f, 0.5f), Vec2(0.5f), 2.0f);
+  const scene::Ray left = plan.generate_ray(Vec2(0.0f, 0.5f), Vec2(0.5f), 2.0f);
+  const scene::Ray right = plan.generate_ray(Vec2(1.0f, 0.5f), Vec2(0.5f), 2.0f);
   EXPECT_NEAR(glm::distance(left.direction, right.direction), 0.0f, 1e-6f);
   EXPECT_NEAR(glm::distance(left.origin, right.origin), 8.0f, 1e-5f);
   EXPECT_NEAR(left.direction.y, -1.0f, 1e-6f);
@@ -602,7 +602,7 @@ TEST_F(Loaders, GltfCamerasAreAllKeptAndChosenByNumberOrName) {
   // A JSON scene keeps every included file's cameras, moved with the file, after its own.
   const std::string own = write("own.json", R"({"meshes": [{"file": "scene.gltf", "transform": {"translate": [1, 2, 3]}}],
       "camera": {"name": "mine", "look_from": [0, 0, -3], "look_at": [0, 0, 0], "orthographic_height": 6}})");
-  Scene wrapped = load_scene_file(own);
+  scene::Scene wrapped = load_scene_file(own);
   ASSERT_EQ(wrapped.cameras.size(), 3u);
   EXPECT_EQ(wrapped.cameras[0].name, "mine");
   EXPECT_TRUE(wrapped.camera->orthographic);
@@ -665,7 +665,7 @@ TEST_F(Loaders, PlyAscii) {
       write("mesh.ply", std::string(kPlyHeader) +
                             "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n0.5 2 0 0 0 1\n"
                             "4 0 1 2 3\n3 3 2 4\n");
-  const Scene scene = load_scene(ply);
+  const scene::Scene scene = load_scene(ply);
   ASSERT_EQ(scene.meshes.size(), 1u);
   EXPECT_EQ(scene.triangle_count(), 3u);  // the quad fanned into two
   EXPECT_EQ(scene.meshes[0].normals.size(), 5u);
@@ -684,7 +684,7 @@ TEST_F(Loaders, JsonMaterialReplacesThePlyNote) {
   const std::string own = write("own.json", R"({"materials": {"marble": {"kind": "diffuse", "albedo": 0.6}},
     "meshes": [{"file": "mesh.ply", "material": "marble"}],
     "lights": [{"type": "environment", "radiance": 1}]})");
-  const Scene with_material = load_scene(own);
+  const scene::Scene with_material = load_scene(own);
   EXPECT_FALSE(has_warning(with_material, "geometry only"));
   EXPECT_FLOAT_EQ(with_material.materials[with_material.meshes[0].material].albedo.g, 0.6f);
   const std::string plain = write("plain.json", R"({"meshes": [{"file": "mesh.ply"}],
@@ -757,7 +757,7 @@ TEST_F(Loaders, PlyFaceWithARepeatedVertexKeepsItsRealTriangles) {
                                               "property float y\nproperty float z\nelement face 2\n"
                                               "property list uchar int vertex_indices\nend_header\n"
                                               "0 0 0\n1 0 0\n1 1 0\n0 1 0\n5 0 1 1 2 3\n3 0 0 1\n");
-  const Scene scene = load_scene(ply);
+  const scene::Scene scene = load_scene(ply);
   EXPECT_EQ(scene.meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
   EXPECT_TRUE(has_warning(scene, "2 face(s) name a vertex twice"));
   EXPECT_TRUE(scene.meshes[0].normals.empty());  // the file has none
@@ -785,26 +785,26 @@ TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
     "camera": {"look_from": [0, 1, 5], "look_at": [0, 1, 0], "vfov": 45, "aperture_radius": 0.1},
     "render": {"width": 320, "height": 240, "spp": 16}
   })");
-  const Scene scene = load_scene_file(path);
+  const scene::Scene scene = load_scene_file(path);
   ASSERT_EQ(scene.materials.size(), 5u);  // four of its own, plus the OBJ's red for the second mesh
   ASSERT_EQ(scene.meshes.size(), 3u);
-  const TriangleMesh& turned = scene.meshes[0];
+  const scene::TriangleMesh& turned = scene.meshes[0];
   EXPECT_EQ(scene.materials[turned.material].name, "white");
   EXPECT_NEAR(turned.positions[1].x, 1.0f, 1e-6f);  // (1,0,0) scaled, turned 90° about z, moved
   EXPECT_NEAR(turned.positions[1].y, 2.0f, 1e-6f);
   EXPECT_GT(triangle_normal(turned, 0).z, 0.0f);
-  const TriangleMesh& mirrored = scene.meshes[1];
+  const scene::TriangleMesh& mirrored = scene.meshes[1];
   EXPECT_EQ(scene.materials[mirrored.material].name, "red");
   EXPECT_EQ(mirrored.positions[1], Vec3(-1, 0, 0));
   EXPECT_GT(triangle_normal(mirrored, 0).z, 0.0f);  // the winding follows the mirror: front stays +z
   EXPECT_LT(triangle_normal(mesh_named(scene, "shapes:lamp"), 0).y, 0.0f);  // faces down
   ASSERT_EQ(scene.spheres.size(), 1u);
-  EXPECT_EQ(scene.materials[scene.spheres[0].material].kind, MaterialKind::dielectric);
+  EXPECT_EQ(scene.materials[scene.spheres[0].material].kind, scene::MaterialKind::dielectric);
   EXPECT_FLOAT_EQ(scene.materials[scene.spheres[0].material].roughness, 0.2f);
   ASSERT_EQ(scene.punctual_lights.size(), 4u);
   EXPECT_EQ(scene.punctual_lights[1].direction, Vec3(0, -1, 0));
   EXPECT_FLOAT_EQ(scene.punctual_lights[1].cos_outer, std::cos(glm::radians(30.0f)));
-  EXPECT_EQ(scene.punctual_lights[3].kind, LightKind::environment);
+  EXPECT_EQ(scene.punctual_lights[3].kind, scene::LightKind::environment);
   ASSERT_TRUE(scene.camera.has_value());
   EXPECT_FLOAT_EQ(scene.camera->aperture_radius, 0.1f);
   EXPECT_EQ(scene.render.width, 320);
@@ -815,19 +815,19 @@ TEST_F(Loaders, JsonSceneWithRelativeMeshes) {
 // An environment light from an image: its path relative to the JSON file, `scale` multiplying its
 // texels, `rotate_deg` turning it, `radiance` a tint (default 1). Misused fields are errors.
 TEST_F(Loaders, JsonEnvironmentImage) {
-  Image sky;
+  util::Image sky;
   sky.width = 8, sky.height = 4;
   sky.pixels.assign(32, Rgb(0.25f, 0.5f, 1.0f));
-  write_image(write("skies/sky.exr", ""), sky);
+  util::write_image(write("skies/sky.exr", ""), sky);
   const std::string path = write("env.json", R"({
     "lights": [{"type": "environment", "file": "skies/sky.exr", "scale": 2, "rotate_deg": 30}]})");
-  const Scene scene = load_scene_file(path);
+  const scene::Scene scene = load_scene_file(path);
   ASSERT_EQ(scene.punctual_lights.size(), 1u);
-  const Light& env = scene.punctual_lights[0];
+  const scene::Light& env = scene.punctual_lights[0];
   ASSERT_TRUE(env.map);
   EXPECT_EQ(env.radiance, Rgb(1.0f));
   EXPECT_EQ(env.map->rotate_degrees(), 30.0f);
-  EXPECT_EQ(environment_radiance(env, Vec3(0.0f, 1.0f, 0.0f)), Rgb(0.5f, 1.0f, 2.0f));
+  EXPECT_EQ(scene::environment_radiance(env, Vec3(0.0f, 1.0f, 0.0f)), Rgb(0.5f, 1.0f, 2.0f));
   EXPECT_CONTAINS(error_of([&] {
                     load_scene(write("a.json", R"({"lights": [{"type": "environment", "radiance": 1, "scale": 2}]})"));
                   }),
@@ -891,7 +891,7 @@ TEST(BuiltinScenes, AllLoadAndCommit) {
   ASSERT_EQ(builtin_scene_names().size(), 4u);
   for (const std::string& name : builtin_scene_names()) {
     EXPECT_TRUE(is_builtin_scene(name));
-    const Scene scene = load_scene(name);
+    const scene::Scene scene = load_scene(name);
     EXPECT_TRUE(scene.committed()) << name;
     EXPECT_TRUE(scene.camera.has_value()) << name;
   }
@@ -899,7 +899,7 @@ TEST(BuiltinScenes, AllLoadAndCommit) {
 }
 
 TEST(BuiltinScenes, CornellBox) {
-  const Scene scene = load_scene("cornell");
+  const scene::Scene scene = load_scene("cornell");
   EXPECT_EQ(scene.meshes.size(), 8u);
   EXPECT_EQ(scene.triangle_count(), 38u);
   EXPECT_EQ(scene.materials.size(), 4u);
@@ -910,13 +910,13 @@ TEST(BuiltinScenes, CornellBox) {
 
   const Vec3 inside(278.0f, 274.4f, 279.6f);
   for (const char* wall : {"floor", "ceiling", "back_wall", "left_wall", "right_wall"}) {
-    const TriangleMesh& mesh = mesh_named(scene, wall);
+    const scene::TriangleMesh& mesh = mesh_named(scene, wall);
     for (size_t t = 0; t < mesh.triangle_count(); ++t)
       EXPECT_GT(glm::dot(triangle_normal(mesh, t), inside - mesh.positions[mesh.indices[3 * t]]), 0.0f)
           << wall;
   }
   for (const char* block : {"short_block", "tall_block"}) {
-    const TriangleMesh& mesh = mesh_named(scene, block);
+    const scene::TriangleMesh& mesh = mesh_named(scene, block);
     EXPECT_EQ(mesh.triangle_count(), 10u);
     Vec3 center(0.0f);
     for (const Vec3& p : mesh.positions) center += p / float(mesh.positions.size());
@@ -925,8 +925,8 @@ TEST(BuiltinScenes, CornellBox) {
           << block;
   }
   // The light fills a hole in the ceiling: both at y = 548.8, areas adding up to the full ceiling.
-  const TriangleMesh& light = mesh_named(scene, "light");
-  const TriangleMesh& ceiling = mesh_named(scene, "ceiling");
+  const scene::TriangleMesh& light = mesh_named(scene, "light");
+  const scene::TriangleMesh& ceiling = mesh_named(scene, "ceiling");
   float light_area = 0.0f, ceiling_area = 0.0f;
   for (size_t t = 0; t < light.triangle_count(); ++t) {
     EXPECT_LT(triangle_normal(light, t).y, 0.0f);  // emits downwards
@@ -941,27 +941,28 @@ TEST(BuiltinScenes, CornellBox) {
 }
 
 TEST(BuiltinScenes, CausticsFurnaceSmallpt) {
-  const Scene caustics = load_scene("cornell-caustics");
+  const scene::Scene caustics = load_scene("cornell-caustics");
   EXPECT_EQ(caustics.meshes.size(), 6u);
   EXPECT_EQ(caustics.triangle_count(), 18u);
   ASSERT_EQ(caustics.spheres.size(), 2u);
-  for (const Sphere& s : caustics.spheres) EXPECT_FLOAT_EQ(s.center.y, s.radius);  // resting on the floor
-  EXPECT_EQ(caustics.materials[caustics.spheres[1].material].kind, MaterialKind::dielectric);
-  EXPECT_EQ(caustics.materials[caustics.spheres[0].material].kind, MaterialKind::mirror);
+  for (const scene::Sphere& s : caustics.spheres)
+    EXPECT_FLOAT_EQ(s.center.y, s.radius);  // resting on the floor
+  EXPECT_EQ(caustics.materials[caustics.spheres[1].material].kind, scene::MaterialKind::dielectric);
+  EXPECT_EQ(caustics.materials[caustics.spheres[0].material].kind, scene::MaterialKind::mirror);
 
-  const Scene furnace = load_scene("furnace");
+  const scene::Scene furnace = load_scene("furnace");
   EXPECT_EQ(furnace.triangle_count(), 12u);
   EXPECT_EQ(furnace.lights().size(), 12u);
-  const Material& wall = furnace.materials[0];
+  const scene::Material& wall = furnace.materials[0];
   EXPECT_EQ(wall.emission, Rgb(0.5f));
   EXPECT_EQ(wall.albedo, Rgb(0.8f));  // every pixel: 0.5 / (1 − 0.8) = 2.5
-  const TriangleMesh& box = furnace.meshes[0];
+  const scene::TriangleMesh& box = furnace.meshes[0];
   for (size_t t = 0; t < box.triangle_count(); ++t)
     EXPECT_LT(glm::dot(triangle_normal(box, t), box.positions[box.indices[3 * t]]), 0.0f);  // faces inwards
   EXPECT_EQ(furnace_scene(1.0f, 0.5f).materials[0].emission, Rgb(1.0f));
   EXPECT_CONTAINS(error_of([] { furnace_scene(1.0f, 1.0f); }), "furnace");
 
-  const Scene smallpt = load_scene("smallpt");
+  const scene::Scene smallpt = load_scene("smallpt");
   EXPECT_EQ(smallpt.spheres.size(), 8u);  // smallpt's nine less the black front wall
   EXPECT_EQ(smallpt.meshes.size(), 0u);
   EXPECT_EQ(smallpt.lights().size(), 1u);
@@ -971,18 +972,18 @@ TEST(BuiltinScenes, CausticsFurnaceSmallpt) {
 }
 
 TEST(BuiltinScenes, TransformScene) {
-  Scene cornell = builtin_scene("cornell");
+  scene::Scene cornell = builtin_scene("cornell");
   const Vec3 offset(1000.0f, -20.0f, 3.0f);
   const Vec3 p = cornell.meshes[0].positions[0];
   transform_scene(cornell, 2.0f, offset);
   EXPECT_EQ(cornell.meshes[0].positions[0], 2.0f * p + offset);
   EXPECT_EQ(cornell.camera->look_from, 2.0f * Vec3(278, 273, -800) + offset);
 
-  Scene caustics = builtin_scene("cornell-caustics");
-  Material& glass = caustics.materials[caustics.spheres[1].material];
+  scene::Scene caustics = builtin_scene("cornell-caustics");
+  scene::Material& glass = caustics.materials[caustics.spheres[1].material];
   glass.absorption = Rgb(0.5f);
   caustics.punctual_lights.push_back(
-      Light{.kind = LightKind::point, .position = Vec3(1.0f), .intensity = Rgb(1.0f)});
+      scene::Light{.kind = scene::LightKind::point, .position = Vec3(1.0f), .intensity = Rgb(1.0f)});
   transform_scene(caustics, 4.0f, offset);
   EXPECT_EQ(caustics.spheres[0].radius, 400.0f);
   EXPECT_EQ(caustics.spheres[0].center, 4.0f * Vec3(400, 100, 370) + offset);
@@ -991,11 +992,11 @@ TEST(BuiltinScenes, TransformScene) {
   EXPECT_EQ(caustics.punctual_lights[0].intensity, Rgb(16.0f));  // same irradiance at 4× the distance
   caustics.commit();
   EXPECT_CONTAINS(error_of([&] {
-                    Scene s = builtin_scene("furnace");
+                    scene::Scene s = builtin_scene("furnace");
                     transform_scene(s, 0.0f, offset);
                   }),
                   "scale");
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::io

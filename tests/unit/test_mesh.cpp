@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/error.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
@@ -27,10 +27,10 @@ using namespace mesh;
 namespace {
 
 using rc::DVec3;
-using rc::Material;
+using rc::scene::Material;
 using rc::Rgb;
-using rc::Scene;
-using rc::TriangleMesh;
+using rc::scene::Scene;
+using rc::scene::TriangleMesh;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -46,7 +46,7 @@ std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0, do
 }
 
 Scene committed_builtin(const std::string& name) {
-  Scene scene = rc::builtin_scene(name);
+  Scene scene = rc::io::builtin_scene(name);
   scene.commit();
   return scene;
 }
@@ -742,9 +742,10 @@ TEST(Mesh, InsideOutRoomsKeepTheirContents) {
     // Small inside the room with the camera in it; large (a third of the area) with it outside.
     scene.meshes.push_back(camera_inside ? closed_box("block", 0.5, 0.5, 0.3, 0.3, 0.2, 0.0f, 0.6f)
                                          : closed_box("block", 0.0, 0.0, 1.5, 1.5, 0.0, 0.0f, 2.0f));
-    scene.camera = rc::Camera{.look_from = camera_inside ? Vec3(0.0f, -1.5f, 2.5f) : Vec3(0.0f, -10.0f, 1.5f),
-                              .look_at = Vec3(0.5f, 0.5f, 0.3f),
-                              .up = Vec3(0.0f, 0.0f, 1.0f)};
+    scene.camera =
+        rc::scene::Camera{.look_from = camera_inside ? Vec3(0.0f, -1.5f, 2.5f) : Vec3(0.0f, -10.0f, 1.5f),
+                          .look_at = Vec3(0.5f, 0.5f, 0.3f),
+                          .up = Vec3(0.0f, 0.0f, 1.0f)};
     scene.commit();
     MeshReport report;
     const RadiosityMesh mesh = build_mesh(scene, MeshSettings{.max_edge = 0.25f}, &report);
@@ -915,7 +916,7 @@ TEST(Mesh, SameResultForAnyThreadCount) {
   const RadiosityMesh parallel = build_mesh(scene, MeshSettings{.elements = 2000});
   RadiosityMesh serial;
   {
-    rc::ThreadLimit one(1);
+    rc::util::ThreadLimit one(1);
     serial = build_mesh(scene, MeshSettings{.elements = 2000});
   }
   EXPECT_EQ(parallel.positions, serial.positions);

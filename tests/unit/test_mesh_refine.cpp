@@ -41,7 +41,7 @@ double total_area(const rad::mesh::RadiosityMesh& mesh) {
 }
 
 rad::mesh::RadiosityMesh cornell_mesh(int elements) {
-  rc::Scene scene = rc::load_scene("cornell");
+  rc::scene::Scene scene = rc::io::load_scene("cornell");
   rad::mesh::MeshSettings settings;
   settings.elements = elements;
   return rad::mesh::build_mesh(scene, settings);
@@ -83,7 +83,7 @@ TEST(MeshRefine, MinimumEdgeStopsSplitting) {
 }
 
 TEST(MeshRefine, SolverRefinesShadowBoundariesAndStaysConforming) {
-  const rc::Scene scene = rc::load_scene("cornell");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell");
   rad::solver::SolverSettings settings;
   settings.mesh.elements = 400;
   settings.tolerance = 1e-2;

@@ -26,7 +26,7 @@
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/mesh/mesh_detail.h"
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/mesh_builders.h"
 
@@ -36,10 +36,10 @@ using namespace solver;
 namespace {
 
 using rc::DVec3;
-using rc::Material;
+using rc::scene::Material;
 using rc::Rgb;
-using rc::Scene;
-using rc::TriangleMesh;
+using rc::scene::Scene;
+using rc::scene::TriangleMesh;
 using test::add_box;
 using test::add_quad;
 
@@ -93,7 +93,7 @@ TEST(MeshRobust, ImprintingGivesTheSameMeshEveryRunAndThreadCount) {
     for (int k = 0; k < 50 * (run + 1); ++k) clutter.emplace_back(new char[size_t(64 + 97 * k)]);
     RadiosityMesh again;
     {
-      rc::ThreadLimit limit(run % 2 == 0 ? 1 : 2);
+      rc::util::ThreadLimit limit(run % 2 == 0 ? 1 : 2);
       again = build_mesh(scene, MeshSettings{.elements = 1500});
     }
     EXPECT_EQ(again.positions, first.positions) << "run " << run;
@@ -109,7 +109,7 @@ TEST(MeshRobust, ImprintingGivesTheSameMeshEveryRunAndThreadCount) {
 TEST(MeshRobust, SibeniksContactLinesAreTheSameInEveryRun) {
   const std::string path = std::string(GILT_SOURCE_DIR) + "/../shared/scenes/wrap/sibenik-lit.json";
   if (!std::ifstream(path)) GTEST_SKIP() << "no " << path;
-  const Scene scene = rc::load_scene(path);
+  const Scene scene = rc::io::load_scene(path);
   MeshReport first_report;
   const RadiosityMesh first = build_mesh(scene, MeshSettings{}, &first_report);
   note("contact_edges", fmt("%.0f", double(first_report.contact_edges)));
@@ -124,7 +124,7 @@ TEST(MeshRobust, SibeniksContactLinesAreTheSameInEveryRun) {
     MeshReport report;
     RadiosityMesh again;
     {
-      rc::ThreadLimit limit(run % 2 == 0 ? 2 : 1);
+      rc::util::ThreadLimit limit(run % 2 == 0 ? 2 : 1);
       again = build_mesh(scene, MeshSettings{}, &report);
     }
     EXPECT_EQ(report.contact_edges, first_report.contact_edges) << "run " << run;
@@ -134,7 +134,7 @@ TEST(MeshRobust, SibeniksContactLinesAreTheSameInEveryRun) {
 }
 
 TEST(MeshRobust, CollinearPatchFromTheConferenceRoomMeshes) {
-  const Scene scene = rc::load_scene(std::string(GILT_TEST_DATA_DIR) + "/conference-collinear-patch.obj");
+  const Scene scene = rc::io::load_scene(std::string(GILT_TEST_DATA_DIR) + "/conference-collinear-patch.obj");
   MeshReport report;
   RadiosityMesh mesh;
   ASSERT_NO_THROW(mesh = build_mesh(scene, MeshSettings{.elements = 1000}, &report));
@@ -328,8 +328,8 @@ TEST(MeshRobust, VerticesOnRoundedEdgesReceiveTheSunTheyFace) {
   Scene scene;
   scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
   scene.meshes.push_back(rounded_box(0.08f, 48));  // radius as below
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(Vec3(-0.3f, -1.0f, -0.5f));
   sun.irradiance = Rgb(1.0f);
   scene.punctual_lights.push_back(sun);
@@ -375,9 +375,9 @@ TEST(MeshRobust, VisibilityOriginsSpreadOverTheVertexsSurface) {
   MeshSettings settings;
   settings.max_edge = 0.25f;
   const RadiosityMesh mesh = build_mesh(scene, settings);
-  const rc::Scene geometry = element_scene(scene, mesh);
+  const rc::scene::Scene geometry = element_scene(scene, mesh);
   const std::vector<Vec3> receivers = receiver_points(geometry, mesh);
-  const std::vector<rc::SurfacePoint> origins = visibility_origins(geometry, mesh, receivers);
+  const std::vector<rc::scene::SurfacePoint> origins = visibility_origins(geometry, mesh, receivers);
   ASSERT_EQ(origins.size(), kVisibilityOrigins * mesh.vertex_count());
   std::vector<float> radius(mesh.vertex_count(), std::numeric_limits<float>::max());
   std::vector<int> fan(mesh.vertex_count(), 0);

@@ -498,7 +498,7 @@ TEST(OntoInput, ASunShadowSmallerThanAFaceIsFittedByItsArea) {
     std::vector<double> e;
     for (const std::string& line : lines_of(slurp(dir / ("baked-" + fit + ".obj"))))
       if (line.rfind("v ", 0) == 0) {
-        const double encoded = std::stod(rc::tokens_of(line).at(4));
+        const double encoded = std::stod(rc::io::tokens_of(line).at(4));
         e.push_back(4.0 * (encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4)));
       }
     EXPECT_EQ(e.size(), 8u);
@@ -580,7 +580,7 @@ TEST(OntoInput, APlyKeepsItsPropertiesAndGainsColours) {
       const std::vector<std::string> a = lines_of(in.substr(in_body)), b = lines_of(out.substr(out_body));
       ASSERT_EQ(a.size(), b.size());
       for (size_t v = 0; v < 8; ++v) {
-        const std::vector<std::string> ta = rc::tokens_of(a[v]), tb = rc::tokens_of(b[v]);
+        const std::vector<std::string> ta = rc::io::tokens_of(a[v]), tb = rc::io::tokens_of(b[v]);
         ASSERT_EQ(tb.size(), 10u);
         EXPECT_EQ(std::vector<std::string>(tb.begin(), tb.begin() + 3), std::vector<std::string>(ta.begin(), ta.begin() + 3));
         EXPECT_EQ(tb[3], ta[6]);  // quality
@@ -618,14 +618,14 @@ TEST(OntoInput, SharedScenesKeepTheirStructure) {
   if (fs::exists(scenes / "bunny")) {
     const fs::path out = dir / "bunny.ply";
     run(quoted(scenes / "wrap" / "bunny-lit.json") + " --onto input --elements 2000 -o " + quoted(out), dir);
-    const rc::Scene in_scene = rc::load_scene((scenes / "wrap" / "bunny-lit.json").string());
-    const rc::Scene out_scene = rc::load_scene(out.string());
+    const rc::scene::Scene in_scene = rc::io::load_scene((scenes / "wrap" / "bunny-lit.json").string());
+    const rc::scene::Scene out_scene = rc::io::load_scene(out.string());
     ASSERT_EQ(out_scene.meshes.size(), 1u);
-    const rc::TriangleMesh &a = in_scene.meshes[0], &b = out_scene.meshes[0];
+    const rc::scene::TriangleMesh &a = in_scene.meshes[0], &b = out_scene.meshes[0];
     EXPECT_EQ(b.indices, a.indices);
     ASSERT_EQ(b.positions.size(), a.positions.size());
     // The wrapper may move the model: compare the output with the input file's own positions.
-    const rc::Scene raw = rc::load_scene(in_scene.model_files.at(0));
+    const rc::scene::Scene raw = rc::io::load_scene(in_scene.model_files.at(0));
     for (size_t v = 0; v < b.positions.size(); ++v) ASSERT_EQ(b.positions[v], raw.meshes[0].positions[v]) << v;
   }
   const fs::path sibenik = scenes / "sibenik" / "sibenik.obj";

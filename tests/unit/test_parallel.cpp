@@ -1,6 +1,6 @@
 // parallel_for visits every index exactly once, whatever the thread cap.
 
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/util/parallel.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 /// Runs parallel_for over `count` indices and checks each was visited once; returns the number of
@@ -67,4 +67,4 @@ TEST(Parallel, ExceptionsReachTheCaller) {
 TEST(Parallel, ReportsAtLeastOneHardwareThread) { EXPECT_GE(hardware_threads(), 1); }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -9,8 +9,8 @@
 
 #include "photonmap/coverage.h"
 #include "photonmap/photon_map.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/rng.h"
 
 namespace rc = gilt::raytrace_core;
 namespace pm = gilt::photonmap;
@@ -33,8 +33,8 @@ double brute_force(const rc::Vec3& a, const rc::Vec3& b, const rc::Vec3& c, cons
   return sum * piece;
 }
 
-rc::TriangleMesh quad(rc::Vec3 a, rc::Vec3 b, rc::Vec3 c, rc::Vec3 d) {
-  rc::TriangleMesh m;
+rc::scene::TriangleMesh quad(rc::Vec3 a, rc::Vec3 b, rc::Vec3 c, rc::Vec3 d) {
+  rc::scene::TriangleMesh m;
   m.name = "quad";
   m.positions = {a, b, c, d};
   m.indices = {0, 1, 2, 0, 2, 3};
@@ -42,9 +42,9 @@ rc::TriangleMesh quad(rc::Vec3 a, rc::Vec3 b, rc::Vec3 c, rc::Vec3 d) {
 }
 
 /// A 2 × 2 floor at y = 0 facing up, and a wall at x = 1 facing −x, both diffuse.
-rc::Scene floor_and_wall() {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+rc::scene::Scene floor_and_wall() {
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));  // (b−a)×(c−a) = +y
   scene.meshes.push_back(quad({1, 0, -1}, {1, 0, 1}, {1, 2, 1}, {1, 2, -1}));    // −x
   return scene;
@@ -64,7 +64,7 @@ TEST(PhotonCoverage, KernelIntegralIsExact) {
   EXPECT_NEAR(pm::kernel_integral(a, b, c, {1, 0, 2}, 4.0f), kPi * 4.0 / 2.0, 1e-9);
   EXPECT_NEAR(pm::kernel_integral(a, c, b, {1, 0.5f, 2}, 4.0f), kPi * 3.75 * 3.75 / 8.0, 1e-9);
   EXPECT_EQ(pm::kernel_integral(a, b, c, {1, 2.5f, 2}, 4.0f), 0.0);
-  rc::Rng rng = rc::Rng::for_item(3, 0, 0);
+  rc::util::Rng rng = rc::util::Rng::for_item(3, 0, 0);
   auto point = [&] { return rc::Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0f - 1.0f; };
   for (int i = 0; i < 40; ++i) {
     const rc::Vec3 ta = point(), tb = point(), tc = point(), p = point() * 0.5f;
@@ -80,7 +80,7 @@ TEST(PhotonCoverage, KernelIntegralIsExact) {
 // wall, at 90°, fails the 25° test) and a quarter where the wall meets the floor's open edge at
 // z = 1. A floor whose lit side holds no photon covers nothing.
 TEST(PhotonCoverage, CentreEdgeAndCornerOfAFloor) {
-  rc::Scene scene = floor_and_wall();
+  rc::scene::Scene scene = floor_and_wall();
   scene.commit();
   pm::SurfaceSides sides(scene);
   EXPECT_EQ(pm::disk_coverage(scene, sides, {0, 0, 0}, {0, 1, 0}, 0.25f, 0.9f), 0.0);
@@ -102,11 +102,11 @@ TEST(PhotonCoverage, CentreEdgeAndCornerOfAFloor) {
 // relative standard deviation is about 1.1 / √k ≈ 5.5 %, their mean's 1.4 %; the bound on the
 // mean is 5 %, over three of those.
 TEST(PhotonCoverage, EstimateAtAnOpenEdgeIsAsBrightAsInside) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = {0, -1, 0};
   sun.irradiance = rc::Rgb(3.0f);
   scene.punctual_lights.push_back(sun);
@@ -116,12 +116,13 @@ TEST(PhotonCoverage, EstimateAtAnOpenEdgeIsAsBrightAsInside) {
   pm::PhotonMap map;
   map.emitted = kPhotons;
   map.sides = pm::SurfaceSides(scene);
-  const rc::Light& light = scene.lights()[0];
+  const rc::scene::Light& light = scene.lights()[0];
   for (uint64_t i = 0; i < kPhotons; ++i) {
-    rc::Rng rng = rc::Rng::for_item(9, i, 0);
-    const rc::EmissionSample es = rc::sample_emission(scene, light, rng.uniform2(), rng.uniform2());
+    rc::util::Rng rng = rc::util::Rng::for_item(9, i, 0);
+    const rc::scene::EmissionSample es =
+        rc::scene::sample_emission(scene, light, rng.uniform2(), rng.uniform2());
     pm::trace_photon_path(scene, es.ray, es.power / float(kPhotons), rng, 4,
-                          [&](const pm::Photon& p, int depth, bool, const rc::Hit& hit) {
+                          [&](const pm::Photon& p, int depth, bool, const rc::scene::Hit& hit) {
                             if (depth == 0) {
                               map.photons.push_back(p);
                               map.sides.add(scene, hit.geom_id, hit.prim_id, pm::decode_direction(p.normal));
@@ -149,10 +150,10 @@ TEST(PhotonCoverage, EstimateAtAnOpenEdgeIsAsBrightAsInside) {
 // elsewhere: a side is reached or not as a whole.)
 TEST(PhotonCoverage, OpenSidesAreThoseLightFromOutsideReaches) {
   for (const bool inside_out : {false, true}) {
-    rc::Scene scene;
-    scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+    rc::scene::Scene scene;
+    scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
     scene.meshes.push_back(quad({-4, 0, -4}, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}));  // floor, front +y
-    rc::TriangleMesh cube;
+    rc::scene::TriangleMesh cube;
     cube.name = "cube";
     for (int i = 0; i < 8; ++i) cube.positions.push_back({float(i & 1), 0.5f + float((i >> 1) & 1), float((i >> 2) & 1)});
     // Faces wound with the front outwards: −x, +x, −y, +y, −z, +z.

@@ -17,8 +17,8 @@
 
 #include "photonmap/photon.h"
 #include "photonmap/photon_index.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
 
 // ---------------------------------------------------------------------------------------------
 // Counting global allocation functions (every replaceable form that allocates).
@@ -84,11 +84,11 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr size_t kPoints = 6000;
 constexpr int kQueries = 150;
 
-Vec3 uniform3(rc::Rng& rng) { return {rng.uniform(), rng.uniform(), rng.uniform()}; }
+Vec3 uniform3(rc::util::Rng& rng) { return {rng.uniform(), rng.uniform(), rng.uniform()}; }
 
 /// Uniform in the unit cube.
 std::vector<Vec3> cube_points(size_t n, uint64_t seed) {
-  rc::Rng rng(seed);
+  rc::util::Rng rng(seed);
   std::vector<Vec3> points(n);
   for (Vec3& p : points) p = uniform3(rng);
   return points;
@@ -97,7 +97,7 @@ std::vector<Vec3> cube_points(size_t n, uint64_t seed) {
 /// The floor, back wall and two side walls of a unit room: every point lies exactly on one of
 /// four planes, half of them on a regular lattice (so many distances tie exactly).
 std::vector<Vec3> room_points(size_t n, uint64_t seed) {
-  rc::Rng rng(seed);
+  rc::util::Rng rng(seed);
   std::vector<Vec3> points(n);
   for (size_t i = 0; i < n; ++i) {
     float u = rng.uniform(), v = rng.uniform();
@@ -126,7 +126,7 @@ std::vector<Vec3> room_points(size_t n, uint64_t seed) {
 /// A caustic: half of the points in a small dense blob (σ = 0.005) on the floor, the rest sparse
 /// over a 4 × 4 × 4 box.
 std::vector<Vec3> clustered_points(size_t n, uint64_t seed) {
-  rc::Rng rng(seed);
+  rc::util::Rng rng(seed);
   std::vector<Vec3> points(n);
   for (size_t i = 0; i < n; ++i) {
     if (i % 2 == 0) {
@@ -143,7 +143,7 @@ std::vector<Vec3> clustered_points(size_t n, uint64_t seed) {
 
 /// Queries: random points around the set's bounds, points of the set itself, and far outside.
 std::vector<Vec3> queries_for(const std::vector<Vec3>& points, uint64_t seed) {
-  rc::Rng rng(seed);
+  rc::util::Rng rng(seed);
   rc::Bounds3 bounds;
   for (const Vec3& p : points) bounds.extend(p);
   std::vector<Vec3> queries;
@@ -371,7 +371,7 @@ TEST(PhotonIndex, ParallelQueriesMatchSerialOnes) {
     const PhotonIndex index = make_index(points, variant);
     std::vector<Neighbour> parallel(queries.size() * k), serial(queries.size() * k);
     std::vector<size_t> parallel_count(queries.size()), serial_count(queries.size());
-    rc::parallel_for(queries.size(),
+    rc::util::parallel_for(queries.size(),
                      [&](size_t q) { parallel_count[q] = index.knn(queries[q], k, kInf, &parallel[q * k]); });
     for (size_t q = 0; q < queries.size(); ++q)
       serial_count[q] = index.knn(queries[q], k, kInf, &serial[q * k]);
@@ -433,7 +433,7 @@ TEST(DirectionEncoding, AxesRoundTripExactly) {
 }
 
 TEST(DirectionEncoding, RoundTripErrorBelowStatedBound) {
-  rc::Rng rng(99);
+  rc::util::Rng rng(99);
   double worst = 0.0;
   auto check = [&](Vec3 v) {
     v = glm::normalize(v);

@@ -9,8 +9,8 @@
 #include <numeric>
 
 #include "photonmap/photon_map.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/parallel.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -19,8 +19,8 @@ namespace pm = gilt::photonmap;
 namespace {
 
 /// A square of side 2·half in the plane y = height, facing +y (or −y), with a material.
-rc::TriangleMesh square(float half, float height, uint32_t material, bool up = true) {
-  rc::TriangleMesh m;
+rc::scene::TriangleMesh square(float half, float height, uint32_t material, bool up = true) {
+  rc::scene::TriangleMesh m;
   m.name = "square";
   m.positions = {{-half, height, -half}, {half, height, -half}, {half, height, half}, {-half, height, half}};
   m.indices = up ? std::vector<uint32_t>{0, 2, 1, 0, 3, 2} : std::vector<uint32_t>{0, 1, 2, 0, 2, 3};
@@ -29,11 +29,11 @@ rc::TriangleMesh square(float half, float height, uint32_t material, bool up = t
 }
 
 /// Mean of emission samples' power over n stratified samples.
-rc::Rgb mean_emitted_power(const rc::Scene& scene, const rc::Light& light, int n) {
+rc::Rgb mean_emitted_power(const rc::scene::Scene& scene, const rc::scene::Light& light, int n) {
   rc::Rgb sum(0.0f);
   for (int i = 0; i < n; ++i) {
-    rc::Rng rng = rc::Rng::for_item(5, uint64_t(i), 0);
-    sum += rc::sample_emission(scene, light, rng.uniform2(), rng.uniform2()).power;
+    rc::util::Rng rng = rc::util::Rng::for_item(5, uint64_t(i), 0);
+    sum += rc::scene::sample_emission(scene, light, rng.uniform2(), rng.uniform2()).power;
   }
   return sum / float(n);
 }
@@ -46,31 +46,32 @@ rc::Rgb mean_emitted_power(const rc::Scene& scene, const rc::Light& light, int n
 // falloff smoothstep in cos θ between the cones, whose mean over the band is ½; the standard
 // error of the mean over 2·10⁵ samples is below 0.2 %, and the bound 1 % is five of them.
 TEST(PhotonEmission, SamplesAddUpToTheLightsPower) {
-  rc::Scene scene = rc::builtin_scene("cornell");
-  rc::Light point;
-  point.kind = rc::LightKind::point;
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  rc::scene::Light point;
+  point.kind = rc::scene::LightKind::point;
   point.position = {278, 400, 278};
   point.intensity = rc::Rgb(100, 50, 25);
-  rc::Light directional;
-  directional.kind = rc::LightKind::directional;
+  rc::scene::Light directional;
+  directional.kind = rc::scene::LightKind::directional;
   directional.direction = glm::normalize(rc::Vec3(0.3f, -1.0f, 0.2f));
   directional.irradiance = rc::Rgb(2, 3, 4);
-  rc::Light environment;
-  environment.kind = rc::LightKind::environment;
+  rc::scene::Light environment;
+  environment.kind = rc::scene::LightKind::environment;
   environment.radiance = rc::Rgb(0.5f);
-  rc::Light spot = point;
-  spot.kind = rc::LightKind::spot;
+  rc::scene::Light spot = point;
+  spot.kind = rc::scene::LightKind::spot;
   spot.direction = {0, -1, 0};
   spot.cos_inner = std::cos(0.3f);
   spot.cos_outer = std::cos(0.5f);
   scene.punctual_lights = {point, directional, environment, spot};
   scene.commit();
-  for (const rc::Light& light : scene.lights()) {
-    const rc::Rgb expected = rc::light_power(scene, light);
+  for (const rc::scene::Light& light : scene.lights()) {
+    const rc::Rgb expected = rc::scene::light_power(scene, light);
     ASSERT_GT(expected.average(), 0.0f);
     // A constant sky's samples vary with the area of the bounding box's outline seen along
     // each: over 2·10⁵ directions their mean is as close as a spot light's.
-    const bool varies = light.kind == rc::LightKind::spot || light.kind == rc::LightKind::environment;
+    const bool varies =
+        light.kind == rc::scene::LightKind::spot || light.kind == rc::scene::LightKind::environment;
     const rc::Rgb mean = mean_emitted_power(scene, light, varies ? 200000 : 10000);
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(mean[c], expected[c], (varies ? 1e-2f : 1e-4f) * expected[c]) << "light kind " << int(light.kind);
@@ -82,7 +83,7 @@ TEST(PhotonEmission, SamplesAddUpToTheLightsPower) {
 // box; the share crossing a box of half the size at its centre is that box's outline area over
 // the whole's, a quarter (binomial standard error below 0.2 % at 10⁵ photons; bound four of them).
 TEST(PhotonEmission, DistantLightsStartOnTheBoundingBoxsOutline) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   const rc::Bounds3 b = scene.bounds();
   const rc::Vec3 c = 0.5f * (b.lo + b.hi), h = 0.5f * (b.hi - b.lo);
@@ -101,8 +102,8 @@ TEST(PhotonEmission, DistantLightsStartOnTheBoundingBoxsOutline) {
     return t0 <= t1 * (1.0f + 1e-5f) + 1e-3f;
   };
   for (const rc::Vec3 dir : {rc::Vec3(0.3f, -1.0f, 0.2f), rc::Vec3(1.0f, -1.0f, 1.0f), rc::Vec3(0.0f, -1.0f, 0.0f)}) {
-    rc::Light sun;
-    sun.kind = rc::LightKind::directional;
+    rc::scene::Light sun;
+    sun.kind = rc::scene::LightKind::directional;
     sun.direction = glm::normalize(dir);
     sun.irradiance = rc::Rgb(2.0f);
     const rc::Vec3 w = sun.direction, d = b.hi - b.lo;
@@ -110,8 +111,9 @@ TEST(PhotonEmission, DistantLightsStartOnTheBoundingBoxsOutline) {
     const int n = 100000;
     int inner = 0;
     for (int i = 0; i < n; ++i) {
-      rc::Rng rng = rc::Rng::for_item(3, uint64_t(i), 0);
-      const rc::EmissionSample es = rc::sample_emission(scene, sun, rng.uniform2(), rng.uniform2());
+      rc::util::Rng rng = rc::util::Rng::for_item(3, uint64_t(i), 0);
+      const rc::scene::EmissionSample es =
+          rc::scene::sample_emission(scene, sun, rng.uniform2(), rng.uniform2());
       ASSERT_NEAR(es.power.g, 2.0f * area, 1e-3f * 2.0f * area);
       ASSERT_TRUE(crosses(es.ray.origin, es.ray.direction, h * 1.0001f)) << i;
       inner += crosses(es.ray.origin, es.ray.direction, 0.5f * h);
@@ -127,11 +129,11 @@ TEST(PhotonEmission, DistantLightsStartOnTheBoundingBoxsOutline) {
 // deviation of about 1.1/√k ≈ 5.5 % (Epanechnikov weights; Poisson photon counts), their mean
 // 0.7 %. The bound is 2 %, about three standard deviations of the mean.
 TEST(PhotonEstimate, UniformlyLitPlaneGivesRhoEOverPi) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("plane", rc::Rgb(0.5f, 0.4f, 0.3f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("plane", rc::Rgb(0.5f, 0.4f, 0.3f)));
   scene.meshes.push_back(square(1.0f, 0.0f, 0));
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = {0, -1, 0};
   sun.irradiance = rc::Rgb(3.0f);
   scene.punctual_lights.push_back(sun);
@@ -140,17 +142,18 @@ TEST(PhotonEstimate, UniformlyLitPlaneGivesRhoEOverPi) {
   constexpr uint64_t kPhotons = 400000;
   pm::PhotonMap map;
   map.emitted = kPhotons;
-  const rc::Light& light = scene.lights()[0];
+  const rc::scene::Light& light = scene.lights()[0];
   for (uint64_t i = 0; i < kPhotons; ++i) {
-    rc::Rng rng = rc::Rng::for_item(9, i, 0);
-    const rc::EmissionSample es = rc::sample_emission(scene, light, rng.uniform2(), rng.uniform2());
+    rc::util::Rng rng = rc::util::Rng::for_item(9, i, 0);
+    const rc::scene::EmissionSample es =
+        rc::scene::sample_emission(scene, light, rng.uniform2(), rng.uniform2());
     pm::trace_photon_path(scene, es.ray, es.power / float(kPhotons), rng, 4, [&](const pm::Photon& p, int depth, bool) {
       if (depth == 0) map.photons.push_back(p);
       return false;
     });
   }
   map.build_index(pm::IndexKind::kd_tree);
-  const rc::Material& m = scene.materials[0];
+  const rc::scene::Material& m = scene.materials[0];
   const rc::Rgb expected = m.albedo * sun.irradiance * rc::kInvPi;
   pm::EstimateScratch scratch;
   rc::Rgb sum(0.0f);
@@ -187,13 +190,13 @@ TEST(PhotonCaustics, GlassSphereFocusesAtTheParaxialFocus) {
   float best_depth = 0.0f, best_spread = 1e30f;
   for (int step = 0; step <= 16; ++step) {
     const float depth = 1.2f + 0.05f * float(step);
-    rc::Scene scene;
-    scene.materials.push_back(rc::Material::make_diffuse("floor", rc::Rgb(0.5f)));
-    scene.materials.push_back(rc::Material::make_dielectric("glass", 1.5f));
+    rc::scene::Scene scene;
+    scene.materials.push_back(rc::scene::Material::make_diffuse("floor", rc::Rgb(0.5f)));
+    scene.materials.push_back(rc::scene::Material::make_dielectric("glass", 1.5f));
     scene.meshes.push_back(square(3.0f, -depth, 0));
     scene.spheres.push_back({{0, 0, 0}, 1.0f, 1});
-    rc::Light spot;
-    spot.kind = rc::LightKind::spot;
+    rc::scene::Light spot;
+    spot.kind = rc::scene::LightKind::spot;
     spot.position = {0, 100, 0};
     spot.direction = {0, -1, 0};
     spot.intensity = rc::Rgb(1e6f);
@@ -219,12 +222,12 @@ TEST(PhotonCaustics, GlassSphereFocusesAtTheParaxialFocus) {
 // Photon i draws from its own stream and the chunks are joined in order: one and two threads
 // give the same maps, photon for photon.
 TEST(PhotonTracing, MapsDoNotDependOnTheThreadCount) {
-  const rc::Scene scene = rc::load_scene("cornell-caustics");
+  const rc::scene::Scene scene = rc::io::load_scene("cornell-caustics");
   pm::PhotonSettings settings;
   settings.global_photons = 20000;
   settings.caustic_photons = 20000;
   auto trace = [&](int threads) {
-    const rc::ThreadLimit limit(threads);
+    const rc::util::ThreadLimit limit(threads);
     return pm::trace_photons(scene, settings);
   };
   const pm::PhotonMaps one = trace(1), two = trace(2);
@@ -243,16 +246,16 @@ namespace {
 
 /// A 2 × 2 floor with a 1 × 1 plate 0.5 above it, facing it, under a sun; a speck 20 away
 /// widens the bounds, so most photons from the bounding box's outline miss both.
-rc::Scene floor_far_under_a_sun() {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.8f)));
+rc::scene::Scene floor_far_under_a_sun() {
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.8f)));
   scene.meshes.push_back(square(1.0f, 0.0f, 0));
   scene.meshes.push_back(square(0.5f, 0.5f, 0, false));
-  rc::TriangleMesh speck = square(0.01f, 0.0f, 0);
+  rc::scene::TriangleMesh speck = square(0.01f, 0.0f, 0);
   for (rc::Vec3& p : speck.positions) p.x += 20.0f;
   scene.meshes.push_back(speck);
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(rc::Vec3(0.2f, -1.0f, 0.1f));
   sun.irradiance = rc::Rgb(1.0f);
   scene.punctual_lights.push_back(sun);
@@ -268,7 +271,7 @@ TEST(PhotonTracing, SparseGlobalMapsTakeMoreRoundsOfTheSamePhotons) {
   // diffuse bounce) are few per round, and rounds go on until half a round's count is stored.
   // Round k traces photons k·N … (k + 1)·N − 1, so r rounds of N are one round of r·N photons,
   // their power divided by r instead of by r·N at once: the same map up to rounding.
-  const rc::Scene scene = floor_far_under_a_sun();
+  const rc::scene::Scene scene = floor_far_under_a_sun();
   pm::PhotonSettings rounds;
   rounds.global_photons = 4000;
   rounds.caustic_photons = 0;
@@ -301,7 +304,7 @@ TEST(PhotonTracing, ATimeShareAddsRoundsOnlyWhereMostPathsStoreNothing) {
   settings.global_time_rounds = 40;
   settings.global_seconds = 1e9;
 
-  const rc::Scene open = floor_far_under_a_sun();
+  const rc::scene::Scene open = floor_far_under_a_sun();
   settings.global_photons = 400;
   const pm::PhotonMaps a = pm::trace_photons(open, settings);
   ASSERT_GT(a.global.photons.size(), 0u);
@@ -311,7 +314,7 @@ TEST(PhotonTracing, ATimeShareAddsRoundsOnlyWhereMostPathsStoreNothing) {
   no_share.global_seconds = 0.0;
   EXPECT_LT(pm::trace_photons(open, no_share).global.emitted, a.global.emitted) << "half a round was stored sooner";
 
-  const rc::Scene cornell = rc::load_scene("cornell");
+  const rc::scene::Scene cornell = rc::io::load_scene("cornell");
   settings.global_photons = 2000;
   const pm::PhotonMaps b = pm::trace_photons(cornell, settings);
   EXPECT_GE(2 * b.global.photons.size(), b.global.emitted);
@@ -320,7 +323,7 @@ TEST(PhotonTracing, ATimeShareAddsRoundsOnlyWhereMostPathsStoreNothing) {
 
 TEST(PhotonTracing, SkipsWhatTheSceneDoesNotNeed) {
   // cornell has no mirror or glass: no caustic map.
-  const rc::Scene cornell = rc::load_scene("cornell");
+  const rc::scene::Scene cornell = rc::io::load_scene("cornell");
   pm::PhotonSettings settings;
   settings.global_photons = 1000;
   settings.caustic_photons = 1000;
@@ -331,11 +334,11 @@ TEST(PhotonTracing, SkipsWhatTheSceneDoesNotNeed) {
   EXPECT_NE(maps.skipped[0].find("no specular surface"), std::string::npos) << maps.skipped[0];
 
   // Black surfaces only: nothing to interreflect, no global map.
-  rc::Scene black;
-  black.materials.push_back(rc::Material::make_diffuse("black", rc::Rgb(0.0f)));
+  rc::scene::Scene black;
+  black.materials.push_back(rc::scene::Material::make_diffuse("black", rc::Rgb(0.0f)));
   black.meshes.push_back(square(1.0f, 0.0f, 0));
-  rc::Light point;
-  point.kind = rc::LightKind::point;
+  rc::scene::Light point;
+  point.kind = rc::scene::LightKind::point;
   point.position = {0, 1, 0};
   point.intensity = rc::Rgb(1.0f);
   black.punctual_lights.push_back(point);

@@ -30,7 +30,7 @@ rad::solver::SolverSettings coarse(double tolerance, int elements) {
 TEST(Radiosity, FurnaceGivesLeOverOneMinusRho) {
   for (float rho : {0.5f, 0.9f}) {
     const float le = 0.5f;
-    rc::Scene scene = rc::furnace_scene(le, rho);
+    rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
     scene.commit();
     const rad::solver::Solution sol = rad::solver::solve(scene, coarse(1e-5, 300));
     ASSERT_GT(sol.mesh.vertex_count(), 0u);
@@ -55,7 +55,7 @@ TEST(Radiosity, FurnaceGivesLeOverOneMinusRho) {
 // left after the final answer's own 0.2 % bound). The exported values never include it.
 TEST(Radiosity, AmbientTermCompletesAPartialFurnace) {
   const float le = 0.5f, rho = 0.8f;
-  rc::Scene scene = rc::furnace_scene(le, rho);
+  rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
   scene.commit();
   const rad::solver::Solution sol = rad::solver::solve(scene, coarse(5e-2, 300));
   ASSERT_GT(sol.residual, 1e-2);
@@ -79,7 +79,7 @@ TEST(Radiosity, AmbientTermCompletesAPartialFurnace) {
 // Albedo 0.99: no divergence, no negative or non-finite value, and the solution still heads for
 // Le / (1 − ρ) = 100 Le. With a residual r the missing part is at most r of the answer.
 TEST(Radiosity, StableAtAlbedo099) {
-  rc::Scene scene = rc::furnace_scene(1.0f, 0.99f);
+  rc::scene::Scene scene = rc::io::furnace_scene(1.0f, 0.99f);
   scene.commit();
   const rad::solver::Solution sol = rad::solver::solve(scene, coarse(1e-3, 120));
   EXPECT_LT(sol.residual, 1e-3);
@@ -99,11 +99,11 @@ TEST(Radiosity, StableAtAlbedo099) {
 // in proportion to h: with 4× the elements (h/2) it must fall to 0.6 of its value or less (first
 // order gives 0.5; measured 8.1 % → 4.0 % → 1.3 % at 400, 1500, 6000 elements).
 double closed_cornell_imbalance(int elements) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   rc::Bounds3 box;
   for (const auto& m : scene.meshes)
     for (const auto& p : m.positions) box.extend(p);
-  rc::TriangleMesh front;
+  rc::scene::TriangleMesh front;
   front.name = "front_wall";
   const float z = box.lo.z;
   front.positions = {{box.lo.x, box.lo.y, z}, {box.hi.x, box.lo.y, z}, {box.hi.x, box.hi.y, z}, {box.lo.x, box.hi.y, z}};
@@ -117,7 +117,7 @@ double closed_cornell_imbalance(int elements) {
   double emitted = 0.0, absorbed = 0.0;
   for (size_t e = 0; e < sol.mesh.element_count(); ++e) {
     const auto& el = sol.mesh.elements[e];
-    const rc::Material& m = scene.materials[sol.mesh.element_material[e]];
+    const rc::scene::Material& m = scene.materials[sol.mesh.element_material[e]];
     const rc::Rgb irradiance = (sol.vertex_irradiance[el[0]] + sol.vertex_irradiance[el[1]] +
                                 sol.vertex_irradiance[el[2]]) * (1.0f / 3.0f);
     emitted += double((m.emission * rc::kPi).average()) * sol.mesh.element_area[e];

@@ -35,7 +35,7 @@ TEST(RadiosityBudget, FittedCountGrowsAsTheSquareRootOfTheTime) {
 
 // A long budget gets the default mesh, not a finer one.
 TEST(RadiosityBudget, ALongBudgetGetsTheDefaultMesh) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::BudgetFit fit;
   const rad::solver::Solution fitted = rad::solver::solve_within(scene, quiet(), 1e5, &fit);
@@ -47,7 +47,7 @@ TEST(RadiosityBudget, ALongBudgetGetsTheDefaultMesh) {
 
 // A mesh size the user set is kept: no pilot runs.
 TEST(RadiosityBudget, AMeshSizeTheUserSetIsKept) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = quiet();
   s.mesh.elements = 600;
@@ -62,7 +62,7 @@ TEST(RadiosityBudget, AMeshSizeTheUserSetIsKept) {
 // On a scene of few triangles the pilot runs at about kPilotElements, and the solve returned is
 // either the pilot (too little time for a finer mesh) or one at the count the fit asked for.
 TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::BudgetFit fit;
   const rad::solver::Solution sol = rad::solver::solve_within(scene, quiet(), 2.0, &fit);
@@ -90,16 +90,16 @@ TEST(RadiosityBudget, ASmallSceneIsFittedFromAPilot) {
 
 // Without a budget, or on an input whose own triangles set the element count, one solve runs.
 TEST(RadiosityBudget, NoPilotWithoutABudgetOrOnALargeInput) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::BudgetFit fit;
   rad::solver::solve_within(scene, quiet(), 0.0, &fit);
   EXPECT_EQ(fit.pilot_elements, 0u);
 
-  rc::Scene fine;
-  fine.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.5f)));
-  fine.materials.push_back(rc::Material::make_emitter("lamp", rc::Rgb(1.0f)));
-  rc::TriangleMesh grid;  // a 16 × 16 floor of 512 triangles
+  rc::scene::Scene fine;
+  fine.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.5f)));
+  fine.materials.push_back(rc::scene::Material::make_emitter("lamp", rc::Rgb(1.0f)));
+  rc::scene::TriangleMesh grid;  // a 16 × 16 floor of 512 triangles
   for (int j = 0; j <= 16; ++j)
     for (int i = 0; i <= 16; ++i) grid.positions.push_back({float(i) / 16.0f, 0.0f, float(j) / 16.0f});
   for (uint32_t j = 0; j < 16; ++j)
@@ -108,7 +108,7 @@ TEST(RadiosityBudget, NoPilotWithoutABudgetOrOnALargeInput) {
       grid.indices.insert(grid.indices.end(), {a, d, c, a, c, b});
     }
   fine.meshes.push_back(grid);
-  rc::TriangleMesh lamp;
+  rc::scene::TriangleMesh lamp;
   lamp.positions = {{0.4f, 1.0f, 0.4f}, {0.6f, 1.0f, 0.4f}, {0.6f, 1.0f, 0.6f}, {0.4f, 1.0f, 0.6f}};
   lamp.indices = {0, 1, 2, 0, 2, 3};  // facing down
   lamp.material = 1;

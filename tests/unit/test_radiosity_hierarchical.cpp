@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "radiosity/solver/solver.h"
-#include "raytrace_core/parallel.h"
-#include "raytrace_core/rng.h"
+#include "raytrace_core/util/parallel.h"
+#include "raytrace_core/util/rng.h"
 #include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
@@ -39,7 +39,7 @@ double mean_radiance(const rad::solver::Solution& sol) {
 }
 
 /// Appends the axis-aligned box [lo, hi], its faces outwards or (inward) towards its inside.
-void box(rc::TriangleMesh& m, rc::Vec3 lo, rc::Vec3 hi, bool inward) {
+void box(rc::scene::TriangleMesh& m, rc::Vec3 lo, rc::Vec3 hi, bool inward) {
   const rc::Vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {lo.x, hi.y, lo.z}, {hi.x, hi.y, lo.z},
                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}};
   const uint32_t base = uint32_t(m.positions.size());
@@ -55,15 +55,15 @@ void box(rc::TriangleMesh& m, rc::Vec3 lo, rc::Vec3 hi, bool inward) {
 
 /// A closed 6 × 3 × 6 room of white (ρ = 0.7) boxes around a 0.8 × 0.8 lamp of radiance 20 under
 /// its ceiling, holding `boxes`.
-rc::Scene lit_room(const rc::TriangleMesh& boxes) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.7f)));
-  scene.materials.push_back(rc::Material::make_emitter("lamp", rc::Rgb(20.0f)));
-  rc::TriangleMesh room;
+rc::scene::Scene lit_room(const rc::scene::TriangleMesh& boxes) {
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.7f)));
+  scene.materials.push_back(rc::scene::Material::make_emitter("lamp", rc::Rgb(20.0f)));
+  rc::scene::TriangleMesh room;
   box(room, {-3, 0, -3}, {3, 3, 3}, true);
   scene.meshes.push_back(room);
   scene.meshes.push_back(boxes);
-  rc::TriangleMesh lamp;
+  rc::scene::TriangleMesh lamp;
   lamp.material = 1;
   lamp.positions = {{-0.4f, 2.99f, -0.4f}, {0.4f, 2.99f, -0.4f}, {0.4f, 2.99f, 0.4f}, {-0.4f, 2.99f, 0.4f}};
   lamp.indices = {0, 1, 2, 0, 2, 3};
@@ -77,7 +77,7 @@ rc::Scene lit_room(const rc::TriangleMesh& boxes) {
 /// Worst relative error of any vertex's radiance against Le / (1 − ρ) in the furnace.
 double furnace_error(float rho, const rad::solver::SolverSettings& s) {
   const float le = 0.5f;
-  rc::Scene scene = rc::furnace_scene(le, rho);
+  rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
   scene.commit();
   const rad::solver::Solution sol = rad::solver::solve(scene, s);
   EXPECT_EQ(sol.solver, rad::solver::SolverKind::hierarchical);
@@ -125,7 +125,7 @@ TEST(HierarchicalRadiosity, FurnaceGivesLeOverOneMinusRho) {
 // outside what the average gives.
 TEST(HierarchicalRadiosity, CoarseLinksDoNotBrightenTheFurnace) {
   const float le = 0.5f, rho = 0.8f;
-  rc::Scene scene = rc::furnace_scene(le, rho);
+  rc::scene::Scene scene = rc::io::furnace_scene(le, rho);
   scene.commit();
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 3000, 0);
   s.tolerance = 1e-5;
@@ -150,7 +150,7 @@ TEST(HierarchicalRadiosity, CoarseLinksDoNotBrightenTheFurnace) {
 // the solution stopped at T = 10⁻² must lie within 1 % of the converged one (measured 0.32 %),
 // and take fewer gathers.
 TEST(HierarchicalRadiosity, StoppedIterationKeepsItsTolerance) {
-  rc::Scene scene = rc::furnace_scene(0.5f, 0.8f);
+  rc::scene::Scene scene = rc::io::furnace_scene(0.5f, 0.8f);
   scene.commit();
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 600, 0);
   s.hierarchical.final_gather = rad::solver::FinalGather::never;
@@ -187,7 +187,7 @@ double mean_relative_difference(const rad::solver::Solution& a, const rad::solve
 // noise is of the same kind, may differ from one of them by at most 1.5 d per vertex, and on the mean by 1 %
 // (the noise plus the clusters' point-source error, which the oracle bounds).
 TEST(HierarchicalRadiosity, AgreesWithProgressiveOnCornell) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::progressive, 1500, 0);
   const rad::solver::Solution p0 = rad::solver::solve(scene, s);
@@ -208,7 +208,7 @@ TEST(HierarchicalRadiosity, AgreesWithProgressiveOnCornell) {
 
 // The same scene and settings give the same solution bit for bit, for 1 and 2 threads.
 TEST(HierarchicalRadiosity, IdenticalForAnyThreadCount) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 800);
   s.threads = 1;
@@ -226,7 +226,7 @@ TEST(HierarchicalRadiosity, IdenticalForAnyThreadCount) {
 // at most n log n (8 · log 8000 / log 1000 = 10.4×); linking pairs of elements would give 64×.
 // (Measured: 6.6×, the linear growth of Hanrahan et al.'s fixed-tolerance oracle.)
 TEST(HierarchicalRadiosity, LinksGrowSlowerThanTheElements) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   const rad::solver::Solution small = rad::solver::solve(scene, settings(rad::solver::SolverKind::hierarchical, 1000, 0));
   const rad::solver::Solution large = rad::solver::solve(scene, settings(rad::solver::SolverKind::hierarchical, 8000, 0));
@@ -262,8 +262,8 @@ TEST(HierarchicalRadiosity, AutomaticChoosesByElementCount) {
 // 3 % is well clear of it and well short of the 18 % a sharing error caused.) The vertex final
 // gather is off, so what the links deliver is what the vertices get.
 TEST(HierarchicalRadiosity, PartlyHiddenFacesAgreeWithProgressive) {
-  rc::TriangleMesh boxes;
-  rc::Rng rng(17);
+  rc::scene::TriangleMesh boxes;
+  rc::util::Rng rng(17);
   for (int i = 0; i < 36; ++i) {
     // A 6 × 6 grid of boxes, jittered but apart (at most 0.8 wide on a 0.9 pitch).
     const rc::Vec3 c(-2.25f + 0.9f * float(i % 6) + 0.05f * (rng.uniform() - 0.5f), 0.0f,
@@ -271,7 +271,7 @@ TEST(HierarchicalRadiosity, PartlyHiddenFacesAgreeWithProgressive) {
     const rc::Vec3 half(0.15f + 0.25f * rng.uniform(), 0.2f + 0.8f * rng.uniform(), 0.15f + 0.25f * rng.uniform());
     box(boxes, c - rc::Vec3(half.x, 0.0f, half.z), c + half * rc::Vec3(1.0f, 2.0f, 1.0f), false);
   }
-  const rc::Scene scene = lit_room(boxes);
+  const rc::scene::Scene scene = lit_room(boxes);
 
   rad::solver::SolverSettings hs = settings(rad::solver::SolverKind::hierarchical, 4000, 0);
   hs.hierarchical.final_gather = rad::solver::FinalGather::never;
@@ -297,14 +297,14 @@ TEST(HierarchicalRadiosity, PartlyHiddenFacesAgreeWithProgressive) {
 // 10³³. It must converge, and no vertex that does not emit may leave more than the geometric
 // series allows: B ≤ ρ / (1 − ρ) · B_lamp, with B_lamp = π · 20.
 TEST(HierarchicalRadiosity, OverlappingBoxesOverTheFloorConverge) {
-  rc::TriangleMesh boxes;
-  rc::Rng rng(17);
+  rc::scene::TriangleMesh boxes;
+  rc::util::Rng rng(17);
   for (int i = 0; i < 60; ++i) {
     const rc::Vec3 c(rng.uniform() * 5.0f - 2.5f, 0.0f, rng.uniform() * 5.0f - 2.5f);
     const rc::Vec3 half(0.15f + 0.25f * rng.uniform(), 0.2f + 0.8f * rng.uniform(), 0.15f + 0.25f * rng.uniform());
     box(boxes, c - rc::Vec3(half.x, -0.001f, half.z), c + half * rc::Vec3(1.0f, 2.0f, 1.0f), false);
   }
-  const rc::Scene scene = lit_room(boxes);
+  const rc::scene::Scene scene = lit_room(boxes);
   const rad::solver::Solution sol = rad::solver::solve(scene, settings(rad::solver::SolverKind::hierarchical, 4000, 0));
   std::printf("%d iterations, residual %g\n", sol.iterations, sol.residual);
   EXPECT_LT(sol.residual, 1e-3);
@@ -320,7 +320,7 @@ TEST(HierarchicalRadiosity, OverlappingBoxesOverTheFloorConverge) {
 // rays than the links traced) and then gives what `always` gives, bit for bit; `never` leaves
 // each vertex its elements' gathered mean, and every mode says what it did.
 TEST(HierarchicalRadiosity, FinalGatherModes) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 1000, 0);
   const rad::solver::Solution automatic = rad::solver::solve(scene, s);
@@ -350,7 +350,7 @@ TEST(HierarchicalRadiosity, FinalGatherModes) {
 // 10⁻³ / (1 − 0.8) = 0.5 %, so 1 % on the mean). With no time at all it stops early and the
 // result is still finite and non-negative (the direct light, and what little was gathered).
 TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 1500, 0);
   const rad::solver::Solution untimed = rad::solver::solve(scene, s);
@@ -398,18 +398,18 @@ TEST(HierarchicalRadiosity, TimeLimitRefinesLinksWhileTimeAllows) {
 // 0.73 of that before (the whole leak is about one link's allowance), 0.008 now. The test allows
 // a tenth: the exact answer is zero, and a leak of one link's allowance is what it rules out.
 TEST(HierarchicalRadiosity, NoLightLeaksThroughAThickRoof) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", rc::Rgb(0.7f)));
-  rc::TriangleMesh walls;
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.7f)));
+  rc::scene::TriangleMesh walls;
   box(walls, {-3, 0, -3}, {3, 3, 3}, true);
   box(walls, {-3.3f, -0.3f, -3.3f}, {3.3f, 3.3f, 3.3f}, false);
   scene.meshes.push_back(walls);
-  rc::Light sun, sky;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun, sky;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(rc::Vec3(0.35f, -1.0f, 0.45f));
   sun.irradiance = rc::Rgb(8.0f);
   scene.punctual_lights.push_back(sun);
-  sky.kind = rc::LightKind::environment;
+  sky.kind = rc::scene::LightKind::environment;
   sky.radiance = rc::Rgb(1.0f);
   scene.punctual_lights.push_back(sky);
   scene.commit();
@@ -443,7 +443,7 @@ TEST(HierarchicalRadiosity, NoLightLeaksThroughAThickRoof) {
 // where no cluster link reaches the ball). The tolerance is the agreement the two solvers are
 // allowed on the same room in PartlyHiddenFacesAgreeWithProgressive.
 TEST(HierarchicalRadiosity, ABallsFacesTakeTheLightOfTheirOwnSide) {
-  rc::TriangleMesh ball;
+  rc::scene::TriangleMesh ball;
   const rc::Vec3 centre(1.2f, 1.0f, 0.8f);
   constexpr int kRings = 6, kSegments = 8;
   constexpr float kRadius = 0.35f;
@@ -460,7 +460,7 @@ TEST(HierarchicalRadiosity, ABallsFacesTakeTheLightOfTheirOwnSide) {
       if (i > 0) ball.indices.insert(ball.indices.end(), {a, b, c});
       if (i + 1 < kRings) ball.indices.insert(ball.indices.end(), {b, d, c});
     }
-  const rc::Scene scene = lit_room(ball);
+  const rc::scene::Scene scene = lit_room(ball);
 
   rad::solver::SolverSettings hs = settings(rad::solver::SolverKind::hierarchical, 4000, 0);
   hs.hierarchical.final_gather = rad::solver::FinalGather::never;

@@ -10,7 +10,7 @@
 #include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
 #include "radiosity/mesh/element_scene.h"
-#include "raytrace_core/path_tracer.h"
+#include "raytrace_core/render/path_tracer.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -20,8 +20,8 @@ using rc::Vec3;
 namespace {
 
 /// A quad (a, b, c, d), counter-clockwise seen from its front.
-rc::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-  rc::TriangleMesh m;
+rc::scene::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+  rc::scene::TriangleMesh m;
   m.positions = {a, b, c, d};
   m.indices = {0, 1, 2, 0, 2, 3};
   return m;
@@ -30,10 +30,10 @@ rc::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 /// Gives `scene` (its meshes added, all of material 0) a white diffuse material (0.8) and a sun
 /// of unit irradiance travelling along `sun_direction`, commits it, and solves it with elements
 /// of at most `max_edge`.
-rad::solver::Solution solve_sunlit(rc::Scene& scene, Vec3 sun_direction, float max_edge) {
-  scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+rad::solver::Solution solve_sunlit(rc::scene::Scene& scene, Vec3 sun_direction, float max_edge) {
+  scene.materials.push_back(rc::scene::Material::make_diffuse("white", Rgb(0.8f)));
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(sun_direction);
   sun.irradiance = Rgb(1.0f);
   scene.punctual_lights.push_back(sun);
@@ -53,7 +53,7 @@ rad::solver::Solution solve_sunlit(rc::Scene& scene, Vec3 sun_direction, float m
 // 7 % of gather rays met such sides, and those that read another surface's light read 15 times
 // what a shadow ray found there.)
 TEST(RadiosityView, DoesNotReadTheSolutionThroughASurface) {
-  rc::Scene scene;
+  rc::scene::Scene scene;
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));        // floor, up
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 2, -1}, {-1, 2, 1}, {-1, 0, 1}));      // wall, +x
   scene.meshes.push_back(quad({-0.5f, -0.3f, -0.5f}, {0.5f, -0.3f, -0.5f}, {0.5f, -0.3f, 0.5f},
@@ -63,7 +63,7 @@ TEST(RadiosityView, DoesNotReadTheSolutionThroughASurface) {
   const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f);
-  const rc::SurfacePoint on_floor{Vec3(0.2f, 0.0f, 0.1f), Vec3(1e-6f), up};
+  const rc::scene::SurfacePoint on_floor{Vec3(0.2f, 0.0f, 0.1f), Vec3(1e-6f), up};
   const std::optional<Rgb> floor = view.indirect_irradiance(on_floor, up);
   ASSERT_TRUE(floor.has_value());
   EXPECT_GT(floor->average(), 0.0f) << "the floor gathers the wall's light";
@@ -73,7 +73,7 @@ TEST(RadiosityView, DoesNotReadTheSolutionThroughASurface) {
   ASSERT_TRUE(at.has_value());
   EXPECT_NEAR(at->distance, 0.3f, 1e-4f);
   // ... but its light is not the plate's.
-  EXPECT_FALSE(view.indirect_irradiance(rc::SurfacePoint{below, Vec3(1e-6f), up}, up).has_value());
+  EXPECT_FALSE(view.indirect_irradiance(rc::scene::SurfacePoint{below, Vec3(1e-6f), up}, up).has_value());
 }
 
 // The view and the vertex bake read the solution by the element a ray or a nearest-point query
@@ -82,14 +82,14 @@ TEST(RadiosityView, DoesNotReadTheSolutionThroughASurface) {
 // Scene::commit's dropping of degenerate triangles once did: on Šibenik the bake read the light of
 // an element 11 m from where its gather rays landed.
 TEST(RadiosityView, ElementSceneKeepsEveryElementsIndex) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("white", Rgb(0.8f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("white", Rgb(0.8f)));
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));
   scene.commit();
   rad::mesh::RadiosityMesh mesh;
   mesh.positions = {{-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {0, 0, 0}, {0.5f, 0, 0}, {1, 0, 0}};
   mesh.elements = {{4, 5, 6}, {0, 1, 2}, {0, 2, 3}};  // the first is a segment, not a triangle
-  const rc::Scene geometry = rad::mesh::element_scene(scene, mesh);
+  const rc::scene::Scene geometry = rad::mesh::element_scene(scene, mesh);
   ASSERT_EQ(geometry.meshes[0].triangle_count(), 3u);
   const Vec3 up(0.0f, 1.0f, 0.0f);
   const struct {
@@ -97,10 +97,10 @@ TEST(RadiosityView, ElementSceneKeepsEveryElementsIndex) {
     uint32_t element;
   } points[] = {{{-0.5f, 0.0f, 0.5f}, 1u}, {{0.5f, 0.0f, -0.5f}, 2u}};
   for (const auto& c : points) {
-    const std::optional<rc::Hit> hit = geometry.intersect(rc::Ray{c.p + up, -up});
+    const std::optional<rc::scene::Hit> hit = geometry.intersect(rc::scene::Ray{c.p + up, -up});
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->prim_id, c.element);
-    const std::optional<rc::Hit> near = geometry.nearest_triangle(0, c.p + 0.01f * up, 1.0f, up, 0.5f);
+    const std::optional<rc::scene::Hit> near = geometry.nearest_triangle(0, c.p + 0.01f * up, 1.0f, up, 0.5f);
     ASSERT_TRUE(near.has_value());
     EXPECT_EQ(near->prim_id, c.element);
   }
@@ -129,20 +129,20 @@ struct GatherAgainstTrace {
   /// Four standard errors of the difference, both estimated from the samples.
   double tolerance() const { return 4.0 * std::hypot(gather_error, trace_error); }
 };
-GatherAgainstTrace gather_against_trace(const rc::Scene& scene, const rad::bake::RadiosityView& view, Vec3 p, Vec3 n) {
-  static const rc::Material white = rc::Material::make_diffuse("irradiance probe", Rgb(1.0f));
-  rc::PathSettings probe;
+GatherAgainstTrace gather_against_trace(const rc::scene::Scene& scene, const rad::bake::RadiosityView& view, Vec3 p, Vec3 n) {
+  static const rc::scene::Material white = rc::scene::Material::make_diffuse("irradiance probe", Rgb(1.0f));
+  rc::render::PathSettings probe;
   probe.first_surface = &white;
   constexpr int kSamples = 1 << 15;
   GatherAgainstTrace g;
   std::tie(g.gathered, g.gather_error) = mean_and_error(kSamples, [&](int i) {
-    rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(1, 0, uint64_t(i))), 0};
+    rc::render::SampleContext ctx{rc::render::Sampler(rc::util::Rng::for_item(1, 0, uint64_t(i))), 0};
     return double(view.gathered_sample(rad::mesh::mesh_surface_point(p, n), ctx).g);
   });
   std::tie(g.traced, g.trace_error) = mean_and_error(kSamples, [&](int i) {
-    rc::SampleContext ctx{rc::Sampler(rc::Rng::for_item(2, 0, uint64_t(i))), 0};
-    const rc::Ray in{p + 0.01f * n, -n, 0.02f};
-    return double(rc::path_radiance(scene, in, ctx, probe).g) * rc::kPi;
+    rc::render::SampleContext ctx{rc::render::Sampler(rc::util::Rng::for_item(2, 0, uint64_t(i))), 0};
+    const rc::scene::Ray in{p + 0.01f * n, -n, 0.02f};
+    return double(rc::render::path_radiance(scene, in, ctx, probe).g) * rc::kPi;
   });
   return g;
 }
@@ -158,8 +158,8 @@ GatherAgainstTrace gather_against_trace(const rc::Scene& scene, const rad::bake:
 // from the samples. (Reading the underside where the rays land, the floor point came out
 // 1.6 times the path tracer's.)
 TEST(RadiosityView, AGatherUnderALowSlabAgreesWithThePathTracer) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", Rgb(0.6f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", Rgb(0.6f)));
   scene.meshes.push_back(quad({-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}));  // floor, up
   const float s = 0.75f, lo = 0.05f, hi = 0.1f;
   scene.meshes.push_back(quad({-s, lo, -s}, {s, lo, -s}, {s, lo, s}, {-s, lo, s}));  // underside, down
@@ -168,12 +168,12 @@ TEST(RadiosityView, AGatherUnderALowSlabAgreesWithThePathTracer) {
   scene.meshes.push_back(quad({-s, lo, -s}, {-s, lo, s}, {-s, hi, s}, {-s, hi, -s})); // -x
   scene.meshes.push_back(quad({-s, lo, s}, {s, lo, s}, {s, hi, s}, {-s, hi, s}));    // +z
   scene.meshes.push_back(quad({-s, lo, -s}, {-s, hi, -s}, {s, hi, -s}, {s, lo, -s})); // -z
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(Vec3(0.3f, -1.0f, 0.2f));
   sun.irradiance = Rgb(2.0f);
-  rc::Light sky;
-  sky.kind = rc::LightKind::environment;
+  rc::scene::Light sky;
+  sky.kind = rc::scene::LightKind::environment;
   sky.radiance = Rgb(0.3f);
   scene.punctual_lights = {sun, sky};
   scene.commit();
@@ -206,19 +206,19 @@ TEST(RadiosityView, AGatherUnderALowSlabAgreesWithThePathTracer) {
 // agree with the path tracer within four standard errors of the difference (both estimated from
 // the samples).
 TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", Rgb(0.6f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", Rgb(0.6f)));
   scene.meshes.push_back(quad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}));              // floor, up
   scene.meshes.push_back(quad({1, -0.5f, -3}, {1, 2.5f, -3}, {1, 2.5f, 3}, {1, -0.5f, 3}));  // wall, facing -x
   scene.meshes.push_back(quad({1, -0.5f, -3}, {1, -0.5f, 3}, {1, 2.5f, 3}, {1, 2.5f, -3}));  // wall, facing +x
   scene.meshes.push_back(quad({-3, 2.5f, -3}, {1, 2.5f, -3}, {1, 2.5f, 3}, {-3, 2.5f, 3}));  // roof, down
   scene.meshes.push_back(quad({-3, 2.5f, -3}, {-3, 2.5f, 3}, {1, 2.5f, 3}, {1, 2.5f, -3}));  // roof, up
-  rc::Light sun;
-  sun.kind = rc::LightKind::directional;
+  rc::scene::Light sun;
+  sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(Vec3(-0.6f, -1.0f, 0.0f));
   sun.irradiance = Rgb(3.0f);
-  rc::Light sky;
-  sky.kind = rc::LightKind::environment;
+  rc::scene::Light sky;
+  sky.kind = rc::scene::LightKind::environment;
   sky.radiance = Rgb(0.1f);
   scene.punctual_lights = {sun, sky};
   scene.commit();
@@ -251,11 +251,11 @@ TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
 // not. (In Šibenik's carved stone, rays that entered a moulding from behind read the lit face
 // outside this way.)
 TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
-  rc::Scene scene;
+  rc::scene::Scene scene;
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));                  // floor, up
   scene.meshes.push_back(quad({-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f},
                               {-0.5f, 0.5f, 0.5f}));                                              // canopy, down
-  rc::TriangleMesh chip;  // a small plate, up, its edge 0.1
+  rc::scene::TriangleMesh chip;  // a small plate, up, its edge 0.1
   chip.positions = {{-0.05f, 0.53f, -0.05f}, {-0.05f, 0.53f, 0.05f}, {0.05f, 0.53f, 0.0f}};
   chip.indices = {0, 1, 2};
   scene.meshes.push_back(chip);
@@ -269,9 +269,10 @@ TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
   EXPECT_NEAR(at->distance, 0.03f, 1e-4f) << "the chip's element is the nearest facing up";
   // A point whose face normal is up reads the chip's element 3 cm away: it could lie on a curved
   // surface the element is a chord of.
-  EXPECT_TRUE(view.indirect_irradiance(rc::SurfacePoint{on_canopy, Vec3(1e-6f), up}, up).has_value());
+  EXPECT_TRUE(view.indirect_irradiance(rc::scene::SurfacePoint{on_canopy, Vec3(1e-6f), up}, up).has_value());
   // The canopy's top, lit side up but face normal down, is its back: nothing to read there.
-  EXPECT_FALSE(view.indirect_irradiance(rc::SurfacePoint{on_canopy, Vec3(1e-6f), down}, up).has_value());
+  EXPECT_FALSE(
+      view.indirect_irradiance(rc::scene::SurfacePoint{on_canopy, Vec3(1e-6f), down}, up).has_value());
 }
 
 // An element lies over a point of a curved surface it is a chord of; one beside it, however
@@ -281,7 +282,7 @@ TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
 // back of its moulding read an element of the lit outside 0.5 m away whose plane passed 4 cm
 // from the hit.)
 TEST(RadiosityView, AnElementBesideThePointIsNotItsChord) {
-  rc::Scene scene;
+  rc::scene::Scene scene;
   scene.meshes.push_back(quad({0.5f, 0.02f, -0.25f}, {0.5f, 0.02f, 0.25f}, {1.0f, 0.02f, 0.25f},
                               {1.0f, 0.02f, -0.25f}));  // ledge, up
   const rad::solver::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);  // the bound for chords: 0.07
@@ -291,7 +292,8 @@ TEST(RadiosityView, AnElementBesideThePointIsNotItsChord) {
   const auto at = view.locate(Vec3(0.0f), up);
   ASSERT_TRUE(at.has_value());
   EXPECT_NEAR(at->distance, std::sqrt(0.25f + 0.0004f), 1e-4f);
-  EXPECT_FALSE(view.indirect_irradiance(rc::SurfacePoint{Vec3(0.0f), Vec3(1e-6f), up}, up).has_value());
+  EXPECT_FALSE(
+      view.indirect_irradiance(rc::scene::SurfacePoint{Vec3(0.0f), Vec3(1e-6f), up}, up).has_value());
   // On the ledge's own plane, over it, the point reads it.
-  EXPECT_TRUE(view.indirect_irradiance(rc::SurfacePoint{Vec3(0.75f, 0.0f, 0.0f), Vec3(1e-6f), up}, up).has_value());
+  EXPECT_TRUE(view.indirect_irradiance(rc::scene::SurfacePoint{Vec3(0.75f, 0.0f, 0.0f), Vec3(1e-6f), up}, up).has_value());
 }

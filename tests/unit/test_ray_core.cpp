@@ -9,9 +9,9 @@
 
 #include <optional>
 
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sampling.h"
-#include "raytrace_core/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
+#include "raytrace_core/scene/scene.h"
 #include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;
@@ -40,7 +40,7 @@ std::optional<double> hit_triangle(const DVec3& o, const DVec3& d, const DVec3& 
   return t > 0.0 ? std::optional<double>(t) : std::nullopt;
 }
 
-std::optional<double> hit_sphere(const DVec3& o, const DVec3& d, const rc::Sphere& s) {
+std::optional<double> hit_sphere(const DVec3& o, const DVec3& d, const rc::scene::Sphere& s) {
   const DVec3 f = o - DVec3(s.center);
   const double a = glm::dot(d, d), b = glm::dot(f, d), c = glm::dot(f, f) - double(s.radius) * s.radius;
   const double disc = b * b - a * c;
@@ -52,7 +52,7 @@ std::optional<double> hit_sphere(const DVec3& o, const DVec3& d, const rc::Spher
 }
 
 /// All hits along the ray, nearest first.
-std::vector<BruteHit> brute_hits(const rc::Scene& scene, const rc::Ray& ray) {
+std::vector<BruteHit> brute_hits(const rc::scene::Scene& scene, const rc::scene::Ray& ray) {
   std::vector<BruteHit> hits;
   const DVec3 o(ray.origin), d(ray.direction);
   for (size_t g = 0; g < scene.meshes.size(); ++g) {
@@ -69,12 +69,12 @@ std::vector<BruteHit> brute_hits(const rc::Scene& scene, const rc::Ray& ray) {
   return hits;
 }
 
-rc::Scene random_scene(uint64_t seed) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
-  rc::Rng rng(seed);
+rc::scene::Scene random_scene(uint64_t seed) {
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+  rc::util::Rng rng(seed);
   for (int g = 0; g < 3; ++g) {
-    rc::TriangleMesh mesh;
+    rc::scene::TriangleMesh mesh;
     for (int t = 0; t < 200; ++t) {
       const Vec3 c(rng.uniform() * 10 - 5, rng.uniform() * 10 - 5, rng.uniform() * 10 - 5);
       for (int k = 0; k < 3; ++k) {
@@ -99,13 +99,13 @@ rc::Scene random_scene(uint64_t seed) {
 // (single-precision ray-triangle tests carry relative errors of a few ulps ~ 1e-6; 1e-4 leaves
 // room for grazing angles). Such ties are counted and must stay rare.
 TEST(RayCore, ClosestHitMatchesBruteForce) {
-  const rc::Scene scene = random_scene(7);
-  rc::Rng rng(11);
+  const rc::scene::Scene scene = random_scene(7);
+  rc::util::Rng rng(11);
   int ties = 0, hits = 0;
   const int n = 20000;
   for (int i = 0; i < n; ++i) {
     const Vec3 o(rng.uniform() * 16 - 8, rng.uniform() * 16 - 8, rng.uniform() * 16 - 8);
-    const rc::Ray ray{o, rc::sample_uniform_sphere(rng.uniform2()), rc::kInfinity};
+    const rc::scene::Ray ray{o, rc::util::sample_uniform_sphere(rng.uniform2()), rc::kInfinity};
     const auto hit = scene.intersect(ray);
     const auto brute = brute_hits(scene, ray);
     ASSERT_EQ(hit.has_value(), !brute.empty()) << "ray " << i;
@@ -129,11 +129,11 @@ TEST(RayCore, ClosestHitMatchesBruteForce) {
 
 // The Ray's tmax bounds the search: a hit beyond it is not reported.
 TEST(RayCore, RespectsTmax) {
-  const rc::Scene scene = random_scene(3);
-  rc::Rng rng(5);
+  const rc::scene::Scene scene = random_scene(3);
+  rc::util::Rng rng(5);
   for (int i = 0; i < 2000; ++i) {
-    rc::Ray ray{Vec3(rng.uniform() * 16 - 8, rng.uniform() * 16 - 8, rng.uniform() * 16 - 8),
-                rc::sample_uniform_sphere(rng.uniform2()), rc::kInfinity};
+    rc::scene::Ray ray{Vec3(rng.uniform() * 16 - 8, rng.uniform() * 16 - 8, rng.uniform() * 16 - 8),
+                rc::util::sample_uniform_sphere(rng.uniform2()), rc::kInfinity};
     const auto hit = scene.intersect(ray);
     if (!hit) continue;
     ray.tmax = hit->t * 0.999f;
@@ -147,8 +147,8 @@ TEST(RayCore, RespectsTmax) {
 // outside, must hit it. Embree's robust mode uses a watertight ray-triangle test (Woop et al.
 // 2013), so the tolerated miss count is zero.
 TEST(RayCore, ClosedMeshIsWatertight) {
-  rc::Scene scene;
-  scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+  rc::scene::Scene scene;
+  scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
   scene.meshes.push_back(gilt::test::icosphere(3));
   scene.commit();
   const auto& mesh = scene.meshes[0];
@@ -156,12 +156,12 @@ TEST(RayCore, ClosedMeshIsWatertight) {
   for (size_t t = 0; t < mesh.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k)
       targets.push_back(0.5f * (mesh.positions[mesh.indices[3 * t + k]] + mesh.positions[mesh.indices[3 * t + (k + 1) % 3]]));
-  rc::Rng rng(1);
+  rc::util::Rng rng(1);
   int misses = 0, rays = 0;
   for (const Vec3& target : targets) {
     // From inside: from the centre and from random interior points.
     for (int k = 0; k < 4; ++k) {
-      const Vec3 o = k == 0 ? Vec3(0.0f) : 0.3f * rc::sample_uniform_sphere(rng.uniform2());
+      const Vec3 o = k == 0 ? Vec3(0.0f) : 0.3f * rc::util::sample_uniform_sphere(rng.uniform2());
       misses += !scene.intersect({o, target - o, rc::kInfinity}).has_value();
       ++rays;
     }
@@ -169,7 +169,7 @@ TEST(RayCore, ClosedMeshIsWatertight) {
     // origin: a ray that grazes a silhouette edge may touch it or pass it, either is correct.
     // Facet normals of this icosphere stay within ~7° of the radial direction, so a ray within
     // 70° of the radial direction (cos > 0.34) meets only front faces around the target.
-    const Vec3 o = 3.0f * rc::sample_uniform_sphere(rng.uniform2());
+    const Vec3 o = 3.0f * rc::util::sample_uniform_sphere(rng.uniform2());
     if (glm::dot(glm::normalize(o - target), glm::normalize(target)) > 0.34f) {
       misses += !scene.intersect({o, target - o, rc::kInfinity}).has_value();
       ++rays;
@@ -186,31 +186,31 @@ TEST(RayCore, SpawnedRaysDoNotSelfIntersect) {
   const std::pair<float, float> cases[] = {{1.0f, 0.0f}, {1e-4f, 0.0f}, {1e4f, 0.0f}, {1.0f, 1e5f}};
   for (const auto& [scale, offset] : cases) {
     {
-      rc::Scene scene;
-      scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
-      rc::TriangleMesh mesh = gilt::test::icosphere(2);
+      rc::scene::Scene scene;
+      scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+      rc::scene::TriangleMesh mesh = gilt::test::icosphere(2);
       for (Vec3& p : mesh.positions) p = p * scale + Vec3(offset);
       scene.meshes.push_back(std::move(mesh));
       scene.spheres.push_back({Vec3(3.0f * scale + offset, offset, offset), scale, 0});
       scene.commit();
-      rc::Rng rng(2);
+      rc::util::Rng rng(2);
       int self_hits = 0;
       for (int i = 0; i < 4000; ++i) {
         const bool sphere = i % 2;
         const Vec3 centre = sphere ? scene.spheres[0].center : Vec3(offset);
-        const Vec3 o = centre + 4.0f * scale * rc::sample_uniform_sphere(rng.uniform2());
-        const rc::Ray ray{o, centre - o + 0.5f * scale * rc::sample_uniform_sphere(rng.uniform2()), rc::kInfinity};
+        const Vec3 o = centre + 4.0f * scale * rc::util::sample_uniform_sphere(rng.uniform2());
+        const rc::scene::Ray ray{o, centre - o + 0.5f * scale * rc::util::sample_uniform_sphere(rng.uniform2()), rc::kInfinity};
         const auto hit = scene.intersect(ray);
         if (!hit) continue;
-        const rc::SurfaceInteraction si = scene.surface(ray, *hit);
-        Vec3 out = rc::sample_cosine_hemisphere(rng.uniform2());
+        const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
+        Vec3 out = rc::util::sample_cosine_hemisphere(rng.uniform2());
         const rc::Frame frame = rc::Frame::from_normal(si.ng);
         // Outward: the convex surface must not be hit again.
-        const auto again = scene.intersect(rc::spawn_ray(si, frame.to_world(out)));
+        const auto again = scene.intersect(rc::scene::spawn_ray(si, frame.to_world(out)));
         if (again && again->geom_id == hit->geom_id && again->prim_id == hit->prim_id) ++self_hits;
         // Inward: the far side, at a distance comparable to the diameter.
         out.z = -out.z;
-        const auto inner = scene.intersect(rc::spawn_ray(si, frame.to_world(out)));
+        const auto inner = scene.intersect(rc::scene::spawn_ray(si, frame.to_world(out)));
         if (!inner || inner->t < 1e-3f * scale) ++self_hits;
       }
       EXPECT_EQ(self_hits, 0) << "scale " << scale << ", offset " << offset;
@@ -227,21 +227,21 @@ TEST(RayCore, ShadowRayBetweenSurfacesIsClear) {
   for (float scale : {1e-3f, 1.0f, 1e3f}) {
     _MM_SET_FLUSH_ZERO_MODE(ftz ? _MM_FLUSH_ZERO_ON : _MM_FLUSH_ZERO_OFF);
     _MM_SET_DENORMALS_ZERO_MODE(ftz ? _MM_DENORMALS_ZERO_ON : _MM_DENORMALS_ZERO_OFF);
-    rc::Scene scene;
-    scene.materials.push_back(rc::Material::make_diffuse("grey", rc::Rgb(0.5f)));
-    rc::TriangleMesh box;
+    rc::scene::Scene scene;
+    scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
+    rc::scene::TriangleMesh box;
     // Two facing unit squares at z = 0 (facing +z) and z = 1 (facing −z).
     box.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
     for (Vec3& p : box.positions) p *= scale;
     box.indices = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6};
     scene.meshes.push_back(box);
     scene.commit();
-    rc::Rng rng(9);
+    rc::util::Rng rng(9);
     int blocked = 0;
     for (int i = 0; i < 2000; ++i) {
-      const rc::SurfaceInteraction a = scene.triangle_point(0, i % 2, rc::sample_uniform_triangle(rng.uniform2()));
-      const rc::SurfaceInteraction b = scene.triangle_point(0, 2 + i % 2, rc::sample_uniform_triangle(rng.uniform2()));
-      blocked += scene.occluded(rc::spawn_shadow_ray(a, b));
+      const rc::scene::SurfaceInteraction a = scene.triangle_point(0, i % 2, rc::util::sample_uniform_triangle(rng.uniform2()));
+      const rc::scene::SurfaceInteraction b = scene.triangle_point(0, 2 + i % 2, rc::util::sample_uniform_triangle(rng.uniform2()));
+      blocked += scene.occluded(rc::scene::spawn_shadow_ray(a, b));
     }
     EXPECT_EQ(blocked, 0) << "scale " << scale << (ftz ? ", flush-to-zero" : "");
   }

@@ -1,7 +1,7 @@
 // The camera-sample samplers: the Sobol points' stratification, their scrambling's randomness,
 // the independence of dimensions and pixels, and the dimension layout along a path.
 
-#include "raytrace_core/sampler.h"
+#include "raytrace_core/render/sampler.h"
 
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 #include <set>
 #include <vector>
 
-#include "raytrace_core/error.h"
-#include "raytrace_core/render.h"
+#include "raytrace_core/util/error.h"
+#include "raytrace_core/render/render.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::render {
 namespace {
 
 Sampler sobol_sample(uint64_t pixel, uint32_t index, uint64_t seed = 3) {
@@ -20,16 +20,16 @@ Sampler sobol_sample(uint64_t pixel, uint32_t index, uint64_t seed = 3) {
 }
 
 TEST(Sobol, BitReversalAndTheFirstPoints) {
-  EXPECT_EQ(sobol::reverse_bits(1u), 0x80000000u);
-  EXPECT_EQ(sobol::reverse_bits(0x80000000u), 1u);
-  EXPECT_EQ(sobol::reverse_bits(0x12345678u), 0x1e6a2c48u);
+  EXPECT_EQ(util::sobol::reverse_bits(1u), 0x80000000u);
+  EXPECT_EQ(util::sobol::reverse_bits(0x80000000u), 1u);
+  EXPECT_EQ(util::sobol::reverse_bits(0x12345678u), 0x1e6a2c48u);
   // The unscrambled sequence: (0,0), (½,½), (¼,¾), (¾,¼), (⅛,⅝), (⅝,⅛), …
   const float expect[6][2] = {{0, 0}, {0.5f, 0.5f}, {0.25f, 0.75f}, {0.75f, 0.25f}, {0.125f, 0.625f}, {0.625f, 0.125f}};
   for (uint32_t i = 0; i < 6; ++i) {
-    EXPECT_EQ(sobol::to_unit_float(sobol::dimension0(i)), expect[i][0]) << i;
-    EXPECT_EQ(sobol::to_unit_float(sobol::dimension1(i)), expect[i][1]) << i;
+    EXPECT_EQ(util::sobol::to_unit_float(util::sobol::dimension0(i)), expect[i][0]) << i;
+    EXPECT_EQ(util::sobol::to_unit_float(util::sobol::dimension1(i)), expect[i][1]) << i;
   }
-  EXPECT_LT(sobol::to_unit_float(0xffffffffu), 1.0f);
+  EXPECT_LT(util::sobol::to_unit_float(0xffffffffu), 1.0f);
 }
 
 TEST(Sobol, OwenScramblingIsABijectionThatKeepsLeadingDigitsTogether) {
@@ -38,7 +38,8 @@ TEST(Sobol, OwenScramblingIsABijectionThatKeepsLeadingDigitsTogether) {
   std::set<uint32_t> seen;
   for (uint32_t x = 0; x < 4096; ++x) {
     const uint32_t a = x << 20, b = (x << 20) | 0x000fffffu;
-    const uint32_t sa = sobol::owen_scramble(a, 0x9e3779b9u), sb = sobol::owen_scramble(b, 0x9e3779b9u);
+    const uint32_t sa = util::sobol::owen_scramble(a, 0x9e3779b9u),
+                   sb = util::sobol::owen_scramble(b, 0x9e3779b9u);
     EXPECT_EQ(sa >> 20, sb >> 20) << x;
     seen.insert(sa >> 20);
   }
@@ -140,13 +141,13 @@ TEST(SobolSampler, DimensionsAreFixedPerBounceAndFallBackToTheStream) {
   // Past the Sobol bounces the values are the independent stream's.
   Sampler deep = sobol_sample(9, 5);
   deep.start_bounce(int(Sampler::kSobolBounces));
-  Rng stream = Rng::for_item(3, 9, 5);
+  util::Rng stream = util::Rng::for_item(3, 9, 5);
   EXPECT_EQ(deep.uniform(), stream.uniform());
 }
 
 TEST(SobolSampler, IndependentKindIsThePcgStream) {
   Sampler s = Sampler::for_pixel_sample(SamplerKind::independent, 11, 22, 33);
-  Rng r = Rng::for_item(11, 22, 33);
+  util::Rng r = util::Rng::for_item(11, 22, 33);
   for (int i = 0; i < 20; ++i) EXPECT_EQ(s.uniform(), r.uniform());
 }
 
@@ -182,4 +183,4 @@ TEST(SobolSampler, ConvergesFasterOnASmoothIntegrand) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::render

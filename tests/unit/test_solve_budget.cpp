@@ -89,7 +89,7 @@ TEST(SolveBudget, TrialsAndTheFinalGatherKeepWithinTheTimeLeft) {
 // stops (meshing, the direct light) and one shot of milliseconds on a machine loaded by a
 // parallel test run, and still 2 s short of what ignoring the kept-back time would give.
 TEST(SolveBudget, AProgressiveSolveEndsItsKeptBackTimeBeforeItsLimit) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = timed(6.0, 4.0, 0.0);
   s.solver = rad::solver::SolverKind::progressive;
@@ -107,7 +107,7 @@ TEST(SolveBudget, AProgressiveSolveEndsItsKeptBackTimeBeforeItsLimit) {
 // half the time kept back): what no budget stops (meshing, the direct light, the tree) and one
 // gather or the final gather's probe, on a loaded machine, with 2 s to spare either way.
 TEST(SolveBudget, AHierarchicalSolveEndsItsKeptBackTimeBeforeItsLimit) {
-  rc::Scene scene = rc::builtin_scene("cornell");
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
   scene.commit();
   rad::solver::SolverSettings s = timed(5.0, 4.0, 0.0);
   s.solver = rad::solver::SolverKind::hierarchical;

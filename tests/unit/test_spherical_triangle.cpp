@@ -1,4 +1,4 @@
-// Solid-angle sampling of triangles (raytrace_core/spherical_triangle.h): the solid angle against
+// Solid-angle sampling of triangles (raytrace_core/util/spherical_triangle.h): the solid angle against
 // the spherical excess (Girard's theorem), and every sampled direction inside the triangle. The
 // distribution itself is chi-square tested through sample_light (tests/statistical/test_light_sampling.cpp).
 
@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "raytrace_core/rng.h"
-#include "raytrace_core/spherical_triangle.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/spherical_triangle.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::util {
 namespace {
 
 /// The spherical excess α + β + γ − π of the triangle spanned by the directions a, b, c (Girard's
@@ -61,4 +61,4 @@ TEST(SphericalTriangle, SolidAngleAndSamplesAgreeWithTheTriangle) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::util

@@ -1,4 +1,4 @@
-// The command line's daylight (raytrace_core/sun_sky.h): the sun's direction convention, its
+// The command line's daylight (raytrace_core/scene/sun_sky.h): the sun's direction convention, its
 // disk, and Preetham's sky against the paper's own zenith formula, its horizon and its sun side.
 
 #include <gtest/gtest.h>
@@ -8,15 +8,15 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/path_tracer.h"
-#include "raytrace_core/scene.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/sun_sky.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/render/path_tracer.h"
+#include "raytrace_core/scene/scene.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/sun_sky.h"
 
-namespace gilt::raytrace_core {
+namespace gilt::raytrace_core::scene {
 namespace {
 
 float luminance(const Rgb& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }  // Rec.709's Y
@@ -54,11 +54,11 @@ TEST(SunSky, ZenithIsThePapersFormulaAndTheGroundIsBlack) {
 }
 
 TEST(SunSky, SunIsADiskOfTheSunsSizeWithItsIrradiance) {
-  ExtraLighting extra;
+  io::ExtraLighting extra;
   extra.sun = true;
   extra.sun_elevation_degrees = 40.0f, extra.sun_azimuth_degrees = 120.0f, extra.sun_irradiance = 3.0f;
   extra.sky_turbidity = 3.0f;
-  const Scene scene = load_scene("cornell", extra);
+  const Scene scene = io::load_scene("cornell", extra);
   const Light* sun = nullptr;
   int environments = 0;
   for (const Light& l : scene.punctual_lights) {
@@ -72,7 +72,7 @@ TEST(SunSky, SunIsADiskOfTheSunsSizeWithItsIrradiance) {
   SurfacePoint ref;
   ref.p = Vec3(0.0f);
   ref.ng = Vec3(0.0f, 1.0f, 0.0f);
-  Rng rng(3);
+  util::Rng rng(3);
   Vec3 mean(0.0f);
   float widest = 1.0f;
   for (int k = 0; k < 4000; ++k) {
@@ -87,9 +87,9 @@ TEST(SunSky, SunIsADiskOfTheSunsSizeWithItsIrradiance) {
   EXPECT_LT(widest, 1.0f - 0.5f * (1.0f - cos_radius));  // and spread over it, not a point
   EXPECT_GT(glm::dot(glm::normalize(mean), to_sun), 1.0f - 1e-6f);
   // A sky needs the sun's position; an image and a sky are one sky too many.
-  ExtraLighting no_sun;
+  io::ExtraLighting no_sun;
   no_sun.sky_turbidity = 3.0f;
-  EXPECT_THROW(load_scene("cornell", no_sun), InputError);
+  EXPECT_THROW(io::load_scene("cornell", no_sun), InputError);
 }
 
 TEST(SunSky, TheDiskIsSeenByCameraRaysAndThroughMirrors) {
@@ -121,23 +121,24 @@ TEST(SunSky, TheDiskIsSeenByCameraRaysAndThroughMirrors) {
   const double solid_angle = 2.0 * std::numbers::pi * (1.0 - std::cos(double(alpha)));
 
   // A camera ray into the disk sees its radiance; one just outside it sees nothing.
-  SampleContext ctx{Sampler(Rng(5)), 0};
-  EXPECT_NEAR(path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), to_sun}, ctx, {}).g, 1.0 / solid_angle, 1e-4);
+  render::SampleContext ctx{render::Sampler(util::Rng(5)), 0};
+  EXPECT_NEAR(render::path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), to_sun}, ctx, {}).g, 1.0 / solid_angle,
+              1e-4);
   const Vec3 outside = glm::normalize(glm::rotate(glm::mat4(1.0f), 1.1f * alpha, Vec3(0, 0, 1)) * glm::vec4(to_sun, 0.0f));
-  EXPECT_EQ(path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), outside}, ctx, {}), Rgb(0.0f));
+  EXPECT_EQ(render::path_radiance(scene, Ray{Vec3(0.0f, 2.0f, 0.0f), outside}, ctx, {}), Rgb(0.0f));
 
   // The plate's underside, probed by a white Lambertian: π L is its irradiance. A sample finds
   // the disk with probability about cos 45° sin²α = 0.021 and then reads π/Ω = 32.9, so one
   // sample's standard deviation is about 4.8; 10⁶ samples give a standard error of 0.0048, and
   // the test allows four of them.
   static const Material white = Material::make_diffuse("probe", Rgb(1.0f));
-  PathSettings probe;
+  render::PathSettings probe;
   probe.first_surface = &white;
   const int n = 1000000;
   double sum = 0.0, sum2 = 0.0;
   for (int i = 0; i < n; ++i) {
-    SampleContext c{Sampler(Rng::for_item(9, 0, uint64_t(i))), 0};
-    const double e = std::numbers::pi * path_radiance(scene, Ray{Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0)}, c, probe).g;
+    render::SampleContext c{render::Sampler(util::Rng::for_item(9, 0, uint64_t(i))), 0};
+    const double e = std::numbers::pi * render::path_radiance(scene, Ray{Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0)}, c, probe).g;
     sum += e, sum2 += e * e;
   }
   const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
@@ -147,4 +148,4 @@ TEST(SunSky, TheDiskIsSeenByCameraRaysAndThroughMirrors) {
 }
 
 }  // namespace
-}  // namespace gilt::raytrace_core
+}  // namespace gilt::raytrace_core::scene

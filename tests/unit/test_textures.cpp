@@ -18,13 +18,13 @@
 
 #include "radiosity/mesh/element_albedo.h"
 #include "radiosity/mesh/mesh.h"
-#include "raytrace_core/error.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/scene_io.h"
-#include "raytrace_core/light.h"
-#include "raytrace_core/normal_map.h"
-#include "raytrace_core/rng.h"
-#include "raytrace_core/scene.h"
-#include "raytrace_core/texture.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/scene/normal_map.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/scene/scene.h"
+#include "raytrace_core/scene/texture.h"
 
 namespace gilt {
 namespace {
@@ -58,8 +58,8 @@ class Textures : public ::testing::Test {
 constexpr float kHalfTolerance = 1e-3f;
 
 /// A unit quad in the z = 0 plane facing +z, UVs (x, y), with `material`.
-rc::TriangleMesh quad(uint32_t material) {
-  rc::TriangleMesh m;
+rc::scene::TriangleMesh quad(uint32_t material) {
+  rc::scene::TriangleMesh m;
   m.name = "quad";
   m.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -69,9 +69,9 @@ rc::TriangleMesh quad(uint32_t material) {
 }
 
 /// The unit quad of quad() with one diffuse material of albedo `albedo` × `image`, committed.
-rc::Scene textured_quad(const rc::TextureImage& image, rc::Rgb albedo) {
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("textured", albedo);
+rc::scene::Scene textured_quad(const rc::scene::TextureImage& image, rc::Rgb albedo) {
+  rc::scene::Scene scene;
+  rc::scene::Material m = rc::scene::Material::make_diffuse("textured", albedo);
   scene.textures.push_back(image);
   m.albedo_texture.image = 0;
   scene.materials.push_back(m);
@@ -83,10 +83,11 @@ rc::Scene textured_quad(const rc::TextureImage& image, rc::Rgb albedo) {
 TEST_F(Textures, DecodesSrgbBeforeReading) {
   // Texels red, blue and the sRGB code 188, read at their centres (bilinear is exact there).
   const std::string file = ppm("rb.ppm", 3, 1, {255, 0, 0, 0, 0, 255, 188, 188, 188});
-  rc::TextureSet set({rc::TextureImage{file, true, rc::TextureWrap::clamp, rc::TextureWrap::clamp}});
-  const rc::Texel red = set.lookup(0, {1.0f / 6.0f, 0.5f});
-  const rc::Texel blue = set.lookup(0, {0.5f, 0.5f});
-  const rc::Texel grey = set.lookup(0, {5.0f / 6.0f, 0.5f});
+  rc::scene::TextureSet set(
+      {rc::scene::TextureImage{file, true, rc::scene::TextureWrap::clamp, rc::scene::TextureWrap::clamp}});
+  const rc::scene::Texel red = set.lookup(0, {1.0f / 6.0f, 0.5f});
+  const rc::scene::Texel blue = set.lookup(0, {0.5f, 0.5f});
+  const rc::scene::Texel grey = set.lookup(0, {5.0f / 6.0f, 0.5f});
   EXPECT_NEAR(red.rgb.r, 1.0f, kHalfTolerance);
   EXPECT_NEAR(red.rgb.b, 0.0f, kHalfTolerance);
   EXPECT_NEAR(blue.rgb.b, 1.0f, kHalfTolerance);
@@ -94,7 +95,8 @@ TEST_F(Textures, DecodesSrgbBeforeReading) {
   // sRGB's curve at 188/255: ((0.73725 + 0.055) / 1.055)^2.4 = 0.50289.
   EXPECT_NEAR(grey.rgb.g, 0.50289f, kHalfTolerance);
   // The same file read as data is not decoded: 188/255 = 0.7373.
-  rc::TextureSet data({rc::TextureImage{file, false, rc::TextureWrap::clamp, rc::TextureWrap::clamp}});
+  rc::scene::TextureSet data(
+      {rc::scene::TextureImage{file, false, rc::scene::TextureWrap::clamp, rc::scene::TextureWrap::clamp}});
   EXPECT_NEAR(data.lookup(0, {5.0f / 6.0f, 0.5f}).rgb.g, 188.0f / 255.0f, kHalfTolerance);
 }
 
@@ -105,47 +107,47 @@ TEST_F(Textures, FiltersLinearValuesNotCodes) {
   for (int y = 0; y < 4; ++y)
     for (int x = 0; x < 4; ++x)
       for (int c = 0; c < 3; ++c) texels.push_back((x + y) % 2 ? 255 : 0);
-  rc::TextureSet set({rc::TextureImage{ppm("checker.ppm", 4, 4, texels)}});
+  rc::scene::TextureSet set({rc::scene::TextureImage{ppm("checker.ppm", 4, 4, texels)}});
   // A footprint as large as the image reads its coarsest level, the mean.
-  const rc::Texel whole = set.lookup(0, {0.5f, 0.5f}, {1.0f, 0.0f}, {0.0f, 1.0f});
+  const rc::scene::Texel whole = set.lookup(0, {0.5f, 0.5f}, {1.0f, 0.0f}, {0.0f, 1.0f});
   EXPECT_NEAR(whole.rgb.g, 0.5f, kHalfTolerance);
   // The stratified mean over a triangle covering half the image: each half of a 4 × 4 checker
   // split along the diagonal is black and white in equal parts but for the diagonal's own
   // texels; 64 strata filtered over their shares give the mean within a few per cent.
-  const rc::Texel half = set.triangle_mean(0, {0, 0}, {1, 0}, {1, 1});
+  const rc::scene::Texel half = set.triangle_mean(0, {0, 0}, {1, 0}, {1, 1});
   EXPECT_NEAR(half.rgb.g, 0.5f, 0.05f);
 }
 
 TEST_F(Textures, ShadingMaterialMultipliesTheAlbedoByTheTexel) {
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("textured", rc::Rgb(0.8f, 0.6f, 0.4f));
-  scene.textures.push_back(rc::TextureImage{ppm("rb.ppm", 2, 1, {255, 0, 0, 0, 0, 255})});
+  rc::scene::Scene scene;
+  rc::scene::Material m = rc::scene::Material::make_diffuse("textured", rc::Rgb(0.8f, 0.6f, 0.4f));
+  scene.textures.push_back(rc::scene::TextureImage{ppm("rb.ppm", 2, 1, {255, 0, 0, 0, 0, 255})});
   m.albedo_texture.image = 0;
   scene.materials.push_back(m);
   scene.meshes.push_back(quad(0));
   scene.commit();
   ASSERT_NE(scene.texture_set(), nullptr);
-  rc::Material scratch;
+  rc::scene::Material scratch;
   // (u, v) = (0.25, 0.5) is in the red texel, (0.75, 0.5) in the blue one.
-  rc::SurfaceInteraction at_left = scene.triangle_point(0, 0, {0.25f, 0.25f});
+  rc::scene::SurfaceInteraction at_left = scene.triangle_point(0, 0, {0.25f, 0.25f});
   at_left.uv = {0.25f, 0.5f};
-  const rc::Material& red = scene.shading_material(at_left, scratch);
+  const rc::scene::Material& red = scene.shading_material(at_left, scratch);
   EXPECT_NEAR(red.albedo.r, 0.8f, 0.8f * kHalfTolerance);
   EXPECT_NEAR(red.albedo.g, 0.0f, kHalfTolerance);
   EXPECT_NEAR(red.albedo.b, 0.0f, kHalfTolerance);
-  rc::SurfaceInteraction at_right = at_left;
+  rc::scene::SurfaceInteraction at_right = at_left;
   at_right.uv = {0.75f, 0.5f};
-  const rc::Material& blue = scene.shading_material(at_right, scratch);
+  const rc::scene::Material& blue = scene.shading_material(at_right, scratch);
   EXPECT_NEAR(blue.albedo.b, 0.4f, 0.4f * kHalfTolerance);
   EXPECT_NEAR(blue.albedo.r, 0.0f, kHalfTolerance);
   // The surface point's own UVs come from the mesh: barycentrics (0.5, 0.25) of triangle 0
   // (corners (0,0), (1,0), (1,1)) are uv (0.75, 0.25), in the blue half.
-  const rc::SurfaceInteraction hit = scene.triangle_point(0, 0, {0.5f, 0.25f});
+  const rc::scene::SurfaceInteraction hit = scene.triangle_point(0, 0, {0.5f, 0.25f});
   EXPECT_NEAR(hit.uv.x, 0.75f, 1e-6f);
   EXPECT_NEAR(scene.shading_material(hit, scratch).albedo.b, 0.4f, 0.4f * kHalfTolerance);
   // An untextured material is returned as it is, not copied.
-  rc::Scene plain;
-  plain.materials.push_back(rc::Material::make_diffuse("plain", rc::Rgb(0.5f)));
+  rc::scene::Scene plain;
+  plain.materials.push_back(rc::scene::Material::make_diffuse("plain", rc::Rgb(0.5f)));
   plain.meshes.push_back(quad(0));
   plain.commit();
   EXPECT_EQ(&plain.shading_material(plain.triangle_point(0, 0, {0.2f, 0.2f}), scratch), &plain.materials[0]);
@@ -153,16 +155,16 @@ TEST_F(Textures, ShadingMaterialMultipliesTheAlbedoByTheTexel) {
 
 TEST_F(Textures, MetallicRoughnessTextureScalesTheFactors) {
   // glTF's channels: roughness in green, metalness in blue (read as data, not decoded).
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_metallic_roughness("mr", rc::Rgb(0.5f), 0.8f, 0.6f);
-  scene.textures.push_back(rc::TextureImage{ppm("mr.ppm", 1, 1, {0, 128, 255}), false});
+  rc::scene::Scene scene;
+  rc::scene::Material m = rc::scene::Material::make_metallic_roughness("mr", rc::Rgb(0.5f), 0.8f, 0.6f);
+  scene.textures.push_back(rc::scene::TextureImage{ppm("mr.ppm", 1, 1, {0, 128, 255}), false});
   m.metallic_roughness_texture.image = 0;
   scene.materials.push_back(m);
   scene.meshes.push_back(quad(0));
   scene.commit();
-  rc::Material scratch;
-  const rc::Material& at = scene.shading_material(scene.triangle_point(0, 0, {0.3f, 0.3f}), scratch);
-  EXPECT_EQ(at.kind, rc::MaterialKind::metallic_roughness);
+  rc::scene::Material scratch;
+  const rc::scene::Material& at = scene.shading_material(scene.triangle_point(0, 0, {0.3f, 0.3f}), scratch);
+  EXPECT_EQ(at.kind, rc::scene::MaterialKind::metallic_roughness);
   EXPECT_NEAR(at.roughness, 0.6f * 128.0f / 255.0f, kHalfTolerance);
   EXPECT_NEAR(at.metallic, 0.8f, kHalfTolerance);
   EXPECT_EQ(at.albedo, rc::Rgb(0.5f));
@@ -173,18 +175,18 @@ TEST_F(Textures, EmissionTextureSetsRadianceAndLightPower) {
   // bilinear filtering makes it 1 for s ≤ 1/4, a ramp down to 0 at s = 3/4, then 0, whose mean
   // over the quad is 1/2. What a camera sees, what light sampling returns and the light's power
   // all follow the texture.
-  rc::Scene scene;
-  rc::Material lamp = rc::Material::make_emitter("lamp", rc::Rgb(2.0f));
+  rc::scene::Scene scene;
+  rc::scene::Material lamp = rc::scene::Material::make_emitter("lamp", rc::Rgb(2.0f));
   scene.textures.push_back(
-      rc::TextureImage{ppm("half.ppm", 2, 1, {255, 255, 255, 0, 0, 0}), true, rc::TextureWrap::clamp, rc::TextureWrap::clamp});
+      rc::scene::TextureImage{ppm("half.ppm", 2, 1, {255, 255, 255, 0, 0, 0}), true, rc::scene::TextureWrap::clamp, rc::scene::TextureWrap::clamp});
   lamp.emission_texture.image = 0;
   scene.materials.push_back(lamp);
   scene.meshes.push_back(quad(0));
   scene.commit();
-  rc::Material scratch;
-  rc::SurfaceInteraction left = scene.triangle_point(0, 0, {0.1f, 0.05f});
+  rc::scene::Material scratch;
+  rc::scene::SurfaceInteraction left = scene.triangle_point(0, 0, {0.1f, 0.05f});
   left.uv = {0.2f, 0.5f};
-  rc::SurfaceInteraction right = left;
+  rc::scene::SurfaceInteraction right = left;
   right.uv = {0.8f, 0.5f};
   EXPECT_NEAR(scene.shading_material(left, scratch).emission.g, 2.0f, 2.0f * kHalfTolerance);
   EXPECT_NEAR(scene.shading_material(right, scratch).emission.g, 0.0f, kHalfTolerance);
@@ -192,20 +194,20 @@ TEST_F(Textures, EmissionTextureSetsRadianceAndLightPower) {
   // (the triangles split it 0.27 : 0.73; each mean is a 64-stratum estimate of a piecewise
   // linear function, within 1 %).
   double total = 0.0;
-  for (const rc::Light& light : scene.lights()) total += rc::light_power(scene, light).g;
+  for (const rc::scene::Light& light : scene.lights()) total += rc::scene::light_power(scene, light).g;
   EXPECT_NEAR(total, 2.0 * rc::kPi * 0.5, 0.01 * 2.0 * rc::kPi * 0.5);
   // Light samples carry the radiance where they land: uniform points on the quad (both
   // triangles alike, equal areas) average Le · 1/2 = 1. Values lie in [0, 2], so the standard
   // error of 4000 samples is at most 1/√4000 = 0.016; 4 of them is 0.064.
-  rc::SurfacePoint ref;
+  rc::scene::SurfacePoint ref;
   ref.p = rc::Vec3(0.5f, 0.5f, 1.0f);
   ref.ng = rc::Vec3(0.0f, 0.0f, -1.0f);
-  rc::Rng rng(3);
+  rc::util::Rng rng(3);
   double sum = 0.0;
   constexpr int kSamples = 4000;
   for (int k = 0; k < kSamples; ++k) {
-    const rc::Light& light = scene.lights()[size_t(k) % scene.lights().size()];
-    sum += rc::sample_light(scene, light, ref, rng.uniform2()).radiance.g;
+    const rc::scene::Light& light = scene.lights()[size_t(k) % scene.lights().size()];
+    sum += rc::scene::sample_light(scene, light, ref, rng.uniform2()).radiance.g;
   }
   EXPECT_NEAR(sum / kSamples, 1.0, 0.064);
 }
@@ -220,22 +222,22 @@ TEST_F(Textures, MaskCutsOutWhereAlphaIsBelowTheCutoff) {
     out << "P5\n2 1\n255\n";
     out.put(char(0)).put(char(255));
   }
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("leaf", rc::Rgb(0.5f));
-  scene.textures.push_back(rc::TextureImage{file.string(), false, rc::TextureWrap::clamp, rc::TextureWrap::clamp});
-  m.alpha_mode = rc::AlphaMode::mask;
+  rc::scene::Scene scene;
+  rc::scene::Material m = rc::scene::Material::make_diffuse("leaf", rc::Rgb(0.5f));
+  scene.textures.push_back(rc::scene::TextureImage{file.string(), false, rc::scene::TextureWrap::clamp, rc::scene::TextureWrap::clamp});
+  m.alpha_mode = rc::scene::AlphaMode::mask;
   m.alpha_texture.image = 0;
   m.alpha_in_colour = true;
   scene.materials.push_back(m);
   scene.meshes.push_back(quad(0));
   scene.commit();
   for (float x : {0.05f, 0.2f, 0.4f}) {
-    const rc::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    const rc::scene::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
     EXPECT_FALSE(scene.intersect(ray).has_value()) << x;
     EXPECT_FALSE(scene.occluded(ray)) << x;
   }
   for (float x : {0.6f, 0.8f, 0.95f}) {
-    const rc::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    const rc::scene::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
     EXPECT_TRUE(scene.intersect(ray).has_value()) << x;
     EXPECT_TRUE(scene.occluded(ray)) << x;
   }
@@ -252,13 +254,13 @@ TEST_F(Textures, ObjMapDIsACutout) {
   std::ofstream(dir_ / "leaf.mtl") << "newmtl leaf\nKd 0.5 0.5 0.5\nmap_d mask.pgm\n";
   std::ofstream(dir_ / "leaf.obj") << "mtllib leaf.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3 4/4\n";
-  rc::Scene scene = rc::load_scene((dir_ / "leaf.obj").string());
+  rc::scene::Scene scene = rc::io::load_scene((dir_ / "leaf.obj").string());
   ASSERT_EQ(scene.materials.size(), 1u);
-  EXPECT_EQ(scene.materials[0].alpha_mode, rc::AlphaMode::mask);
+  EXPECT_EQ(scene.materials[0].alpha_mode, rc::scene::AlphaMode::mask);
   ASSERT_EQ(scene.textures.size(), 1u);
   EXPECT_FALSE(scene.textures[0].srgb);
-  EXPECT_FALSE(scene.occluded(rc::Ray{{0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
-  EXPECT_TRUE(scene.occluded(rc::Ray{{0.75f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
+  EXPECT_FALSE(scene.occluded(rc::scene::Ray{{0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
+  EXPECT_TRUE(scene.occluded(rc::scene::Ray{{0.75f, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f}));
 }
 
 TEST_F(Textures, ObjPbrFieldsAndMapKe) {
@@ -275,15 +277,15 @@ TEST_F(Textures, ObjPbrFieldsAndMapKe) {
   std::ofstream(dir_ / "pbr.obj") << "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
                                      "usemtl brass\nf 1/1 2/2 3/3\nusemtl panel\nf 1/1 2/2 3/3\n"
                                      "usemtl plain\nf 1/1 2/2 3/3\n";
-  rc::Scene scene = rc::load_scene((dir_ / "pbr.obj").string());
+  rc::scene::Scene scene = rc::io::load_scene((dir_ / "pbr.obj").string());
   ASSERT_EQ(scene.materials.size(), 3u);
-  const rc::Material& brass = scene.materials[0];
-  EXPECT_EQ(brass.kind, rc::MaterialKind::metallic_roughness);
+  const rc::scene::Material& brass = scene.materials[0];
+  EXPECT_EQ(brass.kind, rc::scene::MaterialKind::metallic_roughness);
   EXPECT_FLOAT_EQ(brass.roughness, 0.4f);
   EXPECT_FLOAT_EQ(brass.metallic, 1.0f);
   EXPECT_EQ(brass.albedo, rc::Rgb(0.8f, 0.6f, 0.2f));
-  const rc::Material& panel = scene.materials[1];
-  EXPECT_EQ(panel.kind, rc::MaterialKind::diffuse);
+  const rc::scene::Material& panel = scene.materials[1];
+  EXPECT_EQ(panel.kind, rc::scene::MaterialKind::diffuse);
   ASSERT_TRUE(panel.emission_texture.valid());
   EXPECT_TRUE(scene.textures[size_t(panel.emission_texture.image)].srgb);
   // A black Ke leaves map_Ke unused, and says so.
@@ -306,9 +308,9 @@ TEST_F(Textures, JsonSceneKeepsEachFilesImages) {
   std::ofstream(dir_ / "b.mtl") << "newmtl b\nKd 0.5 0.5 0.5\nKe 1 1 1\nmap_Ke glow.pgm\nbump bumps.pgm\nmap_Kd red.pgm\n";
   std::ofstream(dir_ / "b.obj") << "mtllib b.mtl\n" << quad_obj << "usemtl b\nf 1/1 2/2 3/3\n";
   std::ofstream(dir_ / "ab.json") << R"({"meshes": [{"file": "a.obj"}, {"file": "b.obj"}]})";
-  const rc::Scene scene = rc::load_scene((dir_ / "ab.json").string());
+  const rc::scene::Scene scene = rc::io::load_scene((dir_ / "ab.json").string());
   ASSERT_EQ(scene.materials.size(), 2u);
-  const auto file_of = [&](const rc::TextureRef& t) {
+  const auto file_of = [&](const rc::scene::TextureRef& t) {
     return t.valid() ? fs::path(scene.textures[size_t(t.image)].file).filename().string() : std::string("none");
   };
   EXPECT_EQ(file_of(scene.materials[0].albedo_texture), "red.pgm");
@@ -327,24 +329,24 @@ TEST_F(Textures, CameraRaysFilterOverTheirPixelsFootprint) {
   std::vector<unsigned char> texels;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) texels.insert(texels.end(), 3, (x + y) % 2 ? (unsigned char)255 : (unsigned char)0);
-  const rc::Scene scene = textured_quad(
-      rc::TextureImage{ppm("checker.ppm", 64, 64, texels), false, rc::TextureWrap::repeat, rc::TextureWrap::repeat},
+  const rc::scene::Scene scene = textured_quad(
+      rc::scene::TextureImage{ppm("checker.ppm", 64, 64, texels), false, rc::scene::TextureWrap::repeat, rc::scene::TextureWrap::repeat},
       rc::Rgb(1.0f));
-  const auto albedo = [&](const rc::Ray& ray) {
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+  const auto albedo = [&](const rc::scene::Ray& ray) {
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     EXPECT_TRUE(hit.has_value());
-    rc::Material scratch;
+    rc::scene::Material scratch;
     return hit ? scene.shading_material(scene.surface(ray, *hit), scratch).albedo.r : -1.0f;
   };
   constexpr float kMipCode = 1.0f / 255.0f;
   const rc::Vec3 texel_centre((20 + 0.5f) / 64.0f, (31 + 0.5f) / 64.0f, 0.0f);
-  rc::Ray ray{texel_centre + rc::Vec3(0, 0, 2), {0.0f, 0.0f, -1.0f}, 4.0f};
+  rc::scene::Ray ray{texel_centre + rc::Vec3(0, 0, 2), {0.0f, 0.0f, -1.0f}, 4.0f};
   const float sharp = albedo(ray);
   EXPECT_TRUE(std::fabs(sharp) < 1e-4f || std::fabs(sharp - 1.0f) < 1e-4f) << sharp;
   ray.spread = 0.125f / 2.0f;
   EXPECT_NEAR(albedo(ray), 0.5f, kMipCode);
   const rc::Vec3 tilted = glm::normalize(rc::Vec3(0.0f, std::sin(1.047f), -std::cos(1.047f)));
-  ray = rc::Ray{texel_centre - 2.0f * tilted, tilted, 4.0f};
+  ray = rc::scene::Ray{texel_centre - 2.0f * tilted, tilted, 4.0f};
   ray.spread = 0.125f / 2.0f;
   EXPECT_NEAR(albedo(ray), 0.5f, kMipCode);
 }
@@ -352,9 +354,9 @@ TEST_F(Textures, CameraRaysFilterOverTheirPixelsFootprint) {
 TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
   // Constant alpha 0.3, BLEND: each ray stops with probability 0.3, fixed by the ray itself. Over
   // n = 20,000 rays the fraction's standard deviation is √(0.3 · 0.7 / n) = 0.0032; 4 of them.
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("veil", rc::Rgb(0.5f));
-  m.alpha_mode = rc::AlphaMode::blend;
+  rc::scene::Scene scene;
+  rc::scene::Material m = rc::scene::Material::make_diffuse("veil", rc::Rgb(0.5f));
+  m.alpha_mode = rc::scene::AlphaMode::blend;
   m.alpha = 0.3f;
   scene.materials.push_back(m);
   scene.meshes.push_back(quad(0));
@@ -363,7 +365,7 @@ TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
   int hits = 0, blocked = 0;
   for (int i = 0; i < n; ++i) {
     const float x = (float(i % 200) + 0.5f) / 200.0f, y = (float(i / 200) + 0.5f) / 100.0f;
-    const rc::Ray ray{{x, y, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    const rc::scene::Ray ray{{x, y, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
     hits += scene.intersect(ray).has_value();
     blocked += scene.occluded(ray);
   }
@@ -374,9 +376,9 @@ TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
 
 TEST_F(Textures, TransformMapsUvToImage) {
   // OBJ's convention (t = 1 − v) composed with a scale of 2 in s.
-  rc::TextureRef flip;
+  rc::scene::TextureRef flip;
   flip.map = {1, 0, 0, 0, -1, 1};
-  const rc::TextureRef scaled = flip.then({2, 0, 0, 0, 1, 0});
+  const rc::scene::TextureRef scaled = flip.then({2, 0, 0, 0, 1, 0});
   const rc::Vec2 st = scaled.st({0.25f, 0.25f});
   EXPECT_FLOAT_EQ(st.x, 0.5f);
   EXPECT_FLOAT_EQ(st.y, 0.75f);
@@ -386,11 +388,11 @@ TEST_F(Textures, TransformMapsUvToImage) {
 }
 
 TEST_F(Textures, UnreadableImageIsAnInputError) {
-  rc::Scene scene;
-  rc::Material m = rc::Material::make_diffuse("textured", rc::Rgb(0.5f));
+  rc::scene::Scene scene;
+  rc::scene::Material m = rc::scene::Material::make_diffuse("textured", rc::Rgb(0.5f));
   m.albedo_texture.image = 0;
   scene.materials.push_back(m);
-  scene.textures.push_back(rc::TextureImage{(dir_ / "missing.png").string()});
+  scene.textures.push_back(rc::scene::TextureImage{(dir_ / "missing.png").string()});
   scene.meshes.push_back(quad(0));
   try {
     scene.commit();
@@ -399,7 +401,7 @@ TEST_F(Textures, UnreadableImageIsAnInputError) {
     EXPECT_NE(std::string(e.what()).find("missing.png"), std::string::npos) << e.what();
   }
   // A reference past the scene's textures is refused too.
-  rc::Scene bad;
+  rc::scene::Scene bad;
   bad.materials.push_back(m);
   bad.meshes.push_back(quad(0));
   EXPECT_THROW(bad.commit(), rc::InputError);
@@ -415,9 +417,10 @@ TEST_F(Textures, ElementsReflectTheTexturesMeanOverThem) {
   std::vector<unsigned char> texels;
   for (int x = 0; x < 64; ++x) texels.insert(texels.end(), {x < 32 ? (unsigned char)255 : (unsigned char)0, 0, x < 32 ? (unsigned char)0 : (unsigned char)255});
   // Clamped: repeating would blend the blue right edge into the red left one.
-  const rc::Scene scene = textured_quad(
-      rc::TextureImage{ppm("rb.ppm", 64, 1, texels), true, rc::TextureWrap::clamp, rc::TextureWrap::clamp},
-      rc::Rgb(0.9f));
+  const rc::scene::Scene scene =
+      textured_quad(rc::scene::TextureImage{ppm("rb.ppm", 64, 1, texels), true, rc::scene::TextureWrap::clamp,
+                                            rc::scene::TextureWrap::clamp},
+                    rc::Rgb(0.9f));
   const radiosity::mesh::RadiosityMesh mesh = radiosity::mesh::build_mesh(scene, radiosity::mesh::MeshSettings{.max_edge = 0.1f});
   const std::vector<rc::Rgb> rho = radiosity::mesh::element_reflectance(scene, mesh);
   ASSERT_EQ(rho.size(), mesh.element_count());
@@ -454,27 +457,27 @@ TEST(NormalMaps, TangentsFollowTheImageAxes) {
   // A quad facing +z whose image has its top at y = 1: the tangent runs along +s and the
   // bitangent w·(n × t) up the image, +y. Mirrored (s = 1 − x), the tangent turns to −x and w to
   // −1, so the bitangent still runs up the image. Exact up to rounding.
-  rc::TriangleMesh m = quad(0);
+  rc::scene::TriangleMesh m = quad(0);
   m.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-  const rc::TextureRef identity;
+  const rc::scene::TextureRef identity;
   for (const bool mirrored : {false, true}) {
     if (mirrored)
       for (rc::Vec2& uv : m.uvs) uv.x = 1.0f - uv.x;
-    const std::vector<glm::vec4> t = rc::generate_tangents(m, identity);
+    const std::vector<glm::vec4> t = rc::scene::generate_tangents(m, identity);
     ASSERT_EQ(t.size(), 4u);
     for (const glm::vec4& v : t) {
       EXPECT_NEAR(v.x, mirrored ? -1.0f : 1.0f, 1e-6f);
       EXPECT_NEAR(v.y, 0.0f, 1e-6f);
       EXPECT_NEAR(v.z, 0.0f, 1e-6f);
       EXPECT_EQ(v.w, mirrored ? -1.0f : 1.0f);
-      const rc::Vec3 up = rc::tangent_to_world(rc::Vec3(0, 0, 1), v, rc::Vec3(0, 1, 0));
+      const rc::Vec3 up = rc::scene::tangent_to_world(rc::Vec3(0, 0, 1), v, rc::Vec3(0, 1, 0));
       EXPECT_NEAR(up.y, 1.0f, 1e-6f) << "mirrored " << mirrored;
     }
   }
   // A face without a usable (s, t) frame still gets a unit tangent orthogonal to the normal.
-  rc::TriangleMesh flat = quad(0);
+  rc::scene::TriangleMesh flat = quad(0);
   flat.uvs.assign(4, rc::Vec2(0.5f));
-  for (const glm::vec4& v : rc::generate_tangents(flat, identity)) {
+  for (const glm::vec4& v : rc::scene::generate_tangents(flat, identity)) {
     EXPECT_NEAR(glm::length(rc::Vec3(v)), 1.0f, 1e-6f);
     EXPECT_NEAR(v.z, 0.0f, 1e-6f);
   }
@@ -492,15 +495,15 @@ TEST_F(Textures, ObjNormalMapTiltsTheShadingNormal) {
   std::ofstream(dir_ / "n.mtl") << "newmtl stone\nKd 0.5 0.5 0.5\nnorm tilt.ppm\n";
   std::ofstream(dir_ / "n.obj") << "mtllib n.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl stone\nf 1/1 2/2 3/3 4/4\n";
-  rc::Scene scene = rc::load_scene((dir_ / "n.obj").string());
+  rc::scene::Scene scene = rc::io::load_scene((dir_ / "n.obj").string());
   ASSERT_TRUE(scene.materials[0].normal_texture.valid());
   EXPECT_FALSE(scene.materials[0].normal_is_height);
   EXPECT_FALSE(scene.textures[0].srgb);
   const rc::Vec3 expected = glm::normalize(rc::Vec3(2 * 191 / 255.0f - 1, 2 * 128 / 255.0f - 1, 2 * 238 / 255.0f - 1));
-  const rc::Ray ray{{0.3f, 0.6f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
-  const std::optional<rc::Hit> hit = scene.intersect(ray);
+  const rc::scene::Ray ray{{0.3f, 0.6f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+  const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
   ASSERT_TRUE(hit.has_value());
-  const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+  const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
   EXPECT_NEAR(si.ns.x, expected.x, 1e-5f);
   EXPECT_NEAR(si.ns.y, expected.y, 1e-5f);
   EXPECT_NEAR(si.ns.z, expected.z, 1e-5f);
@@ -519,16 +522,16 @@ TEST_F(Textures, ObjBumpMapSlopesByItsHeights) {
   std::ofstream(dir_ / "b.mtl") << "newmtl stone\nKd 0.5 0.5 0.5\nbump -bm 4 ramp.pgm\n";
   std::ofstream(dir_ / "b.obj") << "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl stone\nf 1/1 2/2 3/3 4/4\n";
-  rc::Scene scene = rc::load_scene((dir_ / "b.obj").string());
+  rc::scene::Scene scene = rc::io::load_scene((dir_ / "b.obj").string());
   ASSERT_TRUE(scene.materials[0].normal_texture.valid());
   EXPECT_TRUE(scene.materials[0].normal_is_height);
   EXPECT_FLOAT_EQ(scene.materials[0].normal_scale, 4.0f);
   const rc::Vec3 expected = glm::normalize(rc::Vec3(-4.0f * 16.0f / 255.0f, 0.0f, 1.0f));
   for (const float x : {3.5f / 8.0f, 4.0f / 8.0f}) {
-    const rc::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
-    const std::optional<rc::Hit> hit = scene.intersect(ray);
+    const rc::scene::Ray ray{{x, 0.5f, 1.0f}, {0.0f, 0.0f, -1.0f}, 2.0f};
+    const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     ASSERT_TRUE(hit.has_value());
-    const rc::SurfaceInteraction si = scene.surface(ray, *hit);
+    const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
     EXPECT_NEAR(si.ns.x, expected.x, 1e-5f) << x;
     EXPECT_NEAR(si.ns.y, expected.y, 1e-5f) << x;
     EXPECT_NEAR(si.ns.z, expected.z, 1e-5f) << x;
