@@ -492,8 +492,8 @@ std::string encode_gltf(const rc::scene::Scene& scene, const RadiosityMesh& mesh
 
 }  // namespace
 
-RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const RadiosityMesh& mesh, float reach, SnapStats* stats,
-                               rc::util::Progress* progress) {
+RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const RadiosityMesh& mesh, float reach,
+                               SnapStats* stats, rc::util::Progress* progress) {
   RadiosityMesh out = mesh;
   if (mesh.element_surface.size() != mesh.element_count() || mesh.element_normal.size() != mesh.element_count() ||
       mesh.normals.size() != mesh.vertex_count()) {
@@ -679,9 +679,10 @@ void write_solution(const std::string& path, const rc::scene::Scene& scene, cons
   require_folder(destination);
   // Vertices on the input's own surface: remeshing, contact imprints and repairs leave some a
   // little off it, and a viewer shows the model, not gilt's approximation of it.
-  rc::util::Progress snapping("export: snapping onto the input", solution.mesh.vertex_count(), "vertices", settings.progress);
-  const RadiosityMesh mesh =
-      without_coincident(snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap, &snapping), snap);
+  rc::util::Progress snapping("export: snapping onto the input", solution.mesh.vertex_count(), "vertices",
+                              settings.progress);
+  const RadiosityMesh mesh = without_coincident(
+      snapped_to_input(scene, solution.mesh, 0.5f * solution.mesh_report.max_edge, snap, &snapping), snap);
   check_mesh(mesh, scene.materials.size());
   const std::vector<Rgb> colours = vertex_colours(solution, settings.quantity);
   const auto groups = elements_by_material(mesh, scene.materials.size());

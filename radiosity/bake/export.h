@@ -64,8 +64,9 @@ struct SnapStats {
 /// with none keep their place, and so do the vertices of an element the moves would turn over
 /// (and every vertex of a mesh without element_surface and element_normal for each element).
 /// write_solution exports this. Advances `progress` (if any) by one per vertex.
-mesh::RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const mesh::RadiosityMesh& mesh, float reach,
-                               SnapStats* stats = nullptr, rc::util::Progress* progress = nullptr);
+mesh::RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const mesh::RadiosityMesh& mesh,
+                                     float reach, SnapStats* stats = nullptr,
+                                     rc::util::Progress* progress = nullptr);
 
 /// The mesh without elements that repeat an earlier element: the same three corner positions (to
 /// the bit, after snapping) in the same turning order, so the same face facing the same way, which

@@ -19,8 +19,8 @@
 #include "raytrace_core/io/gltf_file.h"
 
 #include "radiosity/bake/onto_input.h"
-#include "raytrace_core/util/error.h"
 #include "raytrace_core/io/loaders.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/progress.h"
 

@@ -7,15 +7,15 @@
 #include <filesystem>
 #include <limits>
 
-#include "radiosity/mesh/element_scene.h"
 #include "radiosity/bake/view.h"
+#include "radiosity/mesh/element_scene.h"
+#include "raytrace_core/io/loaders.h"
 #include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/progress.h"
 #include "raytrace_core/util/sampling.h"
-#include "raytrace_core/scene/light.h"
-#include "raytrace_core/util/error.h"
-#include "raytrace_core/io/loaders.h"
 
 namespace gilt::radiosity::bake {
 
@@ -137,9 +137,11 @@ InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& so
         if (buried[face]) return std::nullopt;
         return value(material, p, n);
       };
-      rc::util::Progress progress("bake: onto " + mesh.name, fit == VertexFit::point ? mesh.positions.size() : mesh.triangle_count(),
-                            fit == VertexFit::point ? "vertices" : "faces", gather.progress);
-      out.per_mesh[m] = fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats, &progress);
+      rc::util::Progress progress("bake: onto " + mesh.name,
+                                  fit == VertexFit::point ? mesh.positions.size() : mesh.triangle_count(),
+                                  fit == VertexFit::point ? "vertices" : "faces", gather.progress);
+      out.per_mesh[m] =
+          fit_vertex_colours(mesh.positions, mesh.indices, field, fit, spacing, &out.stats, &progress);
     }
   } else {  // OBJ, PLY: the file's vertices, shared by the meshes of its materials
     std::vector<Vec3> positions;
@@ -164,8 +166,9 @@ InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& so
       if (buried[face]) return std::nullopt;
       return value(scene.materials[face_material[face]], p, n);
     };
-    rc::util::Progress progress("bake: onto the input", fit == VertexFit::point ? positions.size() : indices.size() / 3,
-                          fit == VertexFit::point ? "vertices" : "faces", gather.progress);
+    rc::util::Progress progress("bake: onto the input",
+                                fit == VertexFit::point ? positions.size() : indices.size() / 3,
+                                fit == VertexFit::point ? "vertices" : "faces", gather.progress);
     out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats, &progress);
   }
   out.gather = at_input.gather_count();

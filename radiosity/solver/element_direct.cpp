@@ -14,8 +14,8 @@
 
 namespace gilt::radiosity::solver {
 
-using mesh::RadiosityMesh;
 using mesh::mesh_surface_point;
+using mesh::RadiosityMesh;
 using rc::kPi;
 using rc::Rgb;
 using rc::Vec3;
@@ -23,7 +23,9 @@ using rc::Vec3;
 namespace {
 
 /// The side of the grid of points element_punctual_irradiance takes for `samples`.
-int element_grid_side(int samples) { return std::max(1, int(std::lround(std::sqrt(double(std::max(1, samples)))))); }
+int element_grid_side(int samples) {
+  return std::max(1, int(std::lround(std::sqrt(double(std::max(1, samples))))));
+}
 
 /// The mean element area of the mesh (0 without elements).
 double mean_element_area(const RadiosityMesh& mesh) {
@@ -69,7 +71,8 @@ std::vector<Rgb> element_punctual_irradiance(const rc::scene::Scene& scene, cons
           std::swap(pairing[k - 1], pairing[std::min(k - 1, size_t(rng.uniform() * float(k)))]);
         for (int i = 0; i < side; ++i)
           for (int j = 0; j < side; ++j) {
-            const rc::Vec2 b = rc::util::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
+            const rc::Vec2 b =
+                rc::util::sample_uniform_triangle({(i + rng.uniform()) / side, (j + rng.uniform()) / side});
             const Vec3 q = (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] +
                            b.y * mesh.positions[el[2]];
             const rc::scene::SurfacePoint at = mesh_surface_point(q, n);
@@ -78,7 +81,8 @@ std::vector<Rgb> element_punctual_irradiance(const rc::scene::Scene& scene, cons
               const int k = pairing[size_t(i * side + j)];
               const rc::Vec2 u((k / side + rng.uniform()) / side, (k % side + rng.uniform()) / side);
               const Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(u));
-              if (!geometry.occluded(rc::scene::spawn_shadow_ray_to_infinity(at, w))) sum += rc::scene::environment_radiance(light, w) * kPi;
+              if (!geometry.occluded(rc::scene::spawn_shadow_ray_to_infinity(at, w)))
+                sum += rc::scene::environment_radiance(light, w) * kPi;
               continue;
             }
             const rc::scene::LightSample ls = rc::scene::sample_light(scene, light, at, rng.uniform2());

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh.h"
+#include "raytrace_core/scene/scene.h"
 #include "raytrace_core/util/progress.h"
 #include "raytrace_core/util/rgb.h"
-#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::solver {
 
@@ -32,15 +32,16 @@ namespace gilt::radiosity::solver {
 /// with 16 points on every element, the two-pass render's mean moved as a whole with the seed
 /// (a standard deviation of 2.2 % over six seeds, 0.6 % now; bench/README.md, "Direct light on
 /// large elements: the seed's spread"). Advances `progress` (if any) by one per element.
-std::vector<rc::Rgb> element_punctual_irradiance(const rc::scene::Scene& scene, const rc::scene::Scene& geometry,
-                                             const mesh::RadiosityMesh& mesh, int samples, uint64_t seed,
-                                             uint64_t& rays, rc::util::Progress* progress = nullptr);
+std::vector<rc::Rgb> element_punctual_irradiance(const rc::scene::Scene& scene,
+                                                 const rc::scene::Scene& geometry,
+                                                 const mesh::RadiosityMesh& mesh, int samples, uint64_t seed,
+                                                 uint64_t& rays, rc::util::Progress* progress = nullptr);
 
 /// Under a time limit: the most samples per element and light, up to `samples` and a square as
 /// element_punctual_irradiance takes them, whose rays fit in `seconds` at `rays_per_second`; at
 /// least one. A mesh of a million elements takes one: its elements are small, so the noise of
 /// the light they reflect in all (Σ A² σ² / n over them) stays small with one ray each.
-int element_samples_within(const mesh::RadiosityMesh& mesh, size_t lights, int samples, double rays_per_second,
-                           double seconds);
+int element_samples_within(const mesh::RadiosityMesh& mesh, size_t lights, int samples,
+                           double rays_per_second, double seconds);
 
 }  // namespace gilt::radiosity::solver

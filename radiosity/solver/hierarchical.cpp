@@ -45,12 +45,12 @@
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/ladder_forecast.h"
 #include "radiosity/solver/probe_fraction.h"
+#include "raytrace_core/scene/scene.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
 #include "raytrace_core/util/progress.h"
 #include "raytrace_core/util/rng.h"
 #include "raytrace_core/util/sampling.h"
-#include "raytrace_core/scene/scene.h"
 
 namespace gilt::radiosity::solver {
 
@@ -1410,8 +1410,9 @@ struct HierarchicalSolve {
     result.tail_added = false;
     // The count of gathers is not known ahead (the iteration stops at the tolerance): the
     // progress counts them against the most there may be.
-    rc::util::Progress progress("radiosity: iterating", uint64_t(std::max(0, settings.max_iterations - result.iterations)),
-                          "gathers", settings.progress);
+    rc::util::Progress progress("radiosity: iterating",
+                                uint64_t(std::max(0, settings.max_iterations - result.iterations)), "gathers",
+                                settings.progress);
     while (result.iterations < settings.max_iterations) {
       if (out_of_time()) break;
       // Under a time limit a gather takes about as long as the last: none starts that would end past it.
@@ -1613,7 +1614,10 @@ struct HierarchicalSolve {
     char label[64];
     std::snprintf(label, sizeof label, "radiosity: linking at tolerance %.3g", plan.tolerance);
     rc::util::Progress progress(label, 0, "chunks of pairs", settings.progress);
-    linker.owned_by(cut.owner, group.rank()).keeping_open_pairs(!plan.last).keeping_back(plan.reserve).reporting(&progress);
+    linker.owned_by(cut.owner, group.rank())
+        .keeping_open_pairs(!plan.last)
+        .keeping_back(plan.reserve)
+        .reporting(&progress);
     const auto link_start = std::chrono::steady_clock::now();
     std::optional<LinkLevel> made = linker.link(plan.expanded ? std::span<const OpenPair>(plan.start)
                                                                : std::span<const OpenPair>(open_pairs));

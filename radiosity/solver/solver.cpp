@@ -26,8 +26,8 @@
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/probe_fraction.h"
 #include "raytrace_core/scene/bsdf.h"
-#include "raytrace_core/util/error.h"
 #include "raytrace_core/scene/light.h"
+#include "raytrace_core/util/error.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
 #include "raytrace_core/util/progress.h"
@@ -104,7 +104,8 @@ int backs_seen(const rc::scene::Scene& scene, const Vec3& p, const Vec3& n, floa
 /// (backs_seen, reaching twice the element's size) meet no back is taken, or else the one that
 /// meets fewest. (Traced against the input instead of the elements, the milk truck's rounded
 /// roof edge came out as a ragged black band.)
-std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const RadiosityMesh& mesh, rc::util::Progress* progress) {
+std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const RadiosityMesh& mesh,
+                                  rc::util::Progress* progress) {
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<Vec3> origin(mesh.positions);
@@ -138,8 +139,10 @@ std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const Radios
   return origin;
 }
 
-std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& geometry, const RadiosityMesh& mesh,
-                                                 std::span<const Vec3> receivers, rc::util::Progress* progress) {
+std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& geometry,
+                                                        const RadiosityMesh& mesh,
+                                                        std::span<const Vec3> receivers,
+                                                        rc::util::Progress* progress) {
   const size_t nv = mesh.vertex_count();
   const auto [offsets, fan] = element_fans(mesh);
   std::vector<rc::scene::SurfacePoint> out(kVisibilityOrigins * nv);
@@ -163,7 +166,8 @@ std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& 
         if (!(size > 0.0f)) continue;
         const Vec3 n = mesh.element_normal[e];
         const Vec3 q = p + towards * (radius / size) + (1e-3f * size) * n;
-        if (backs_seen(geometry, q, n, 2.0f * size, 1) == 0) out[kVisibilityOrigins * v + taken++] = surface_point(q, n);
+        if (backs_seen(geometry, q, n, 2.0f * size, 1) == 0)
+          out[kVisibilityOrigins * v + taken++] = surface_point(q, n);
       }
       if (taken == 0) out[kVisibilityOrigins * v + taken++] = surface_point(receivers[v], mesh.normals[v]);
       for (size_t k = taken; k < kVisibilityOrigins; ++k) out[kVisibilityOrigins * v + k] = out[kVisibilityOrigins * v + k % taken];
@@ -420,7 +424,7 @@ struct Receivers {
       spread;  ///< kVisibilityOrigins per vertex, where its shadow rays start
   std::vector<rc::Bounds3> occluders;
 
-  bool progress = false;                    ///< report placing the receivers on stderr
+  bool progress = false;  ///< report placing the receivers on stderr
 
   Receivers(const rc::scene::Scene& s, const RadiosityMesh& m, bool report)
       : scene(s), mesh(m), occluders(occluder_boxes(s, m)), progress(report) {
@@ -626,8 +630,14 @@ struct Shooting {
 
 /// The state of one solve (below), on the mesh it made, which its passes read and write in turn.
 struct SolveState {
-  SolveState(const rc::scene::Scene& s, const SolverSettings& st, Solution& so, std::chrono::steady_clock::time_point t)
-      : scene(s), settings(st), sol(so), start(t), mesh(so.mesh), receivers(s, so.mesh, st.progress),
+  SolveState(const rc::scene::Scene& s, const SolverSettings& st, Solution& so,
+             std::chrono::steady_clock::time_point t)
+      : scene(s),
+        settings(st),
+        sol(so),
+        start(t),
+        mesh(so.mesh),
+        receivers(s, so.mesh, st.progress),
         strata(std::max(1, int(std::round(std::sqrt(double(st.visibility_samples)))))) {
     sol.convex_enclosure = receivers.occluders.empty();
     // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
@@ -1019,12 +1029,13 @@ struct SolveState {
     if (settings.time_limit > 0.0 && direct_rays_per_second > 0.0) {
       const double seconds = kElementDirectShare * std::max(0.0, solve_limit() - elapsed());
       // Rank 0's choice, so that every process traces its elements alike.
-      samples = group.broadcast_value(
-          element_samples_within(mesh, scene.punctual_lights.size(), samples, direct_rays_per_second, seconds));
+      samples = group.broadcast_value(element_samples_within(mesh, scene.punctual_lights.size(), samples,
+                                                             direct_rays_per_second, seconds));
       if (samples < settings.visibility_samples)
         sol.mesh_report.warnings.push_back("the direct light on elements took " + std::to_string(samples) +
                                            " sample(s) per element and light, not " +
-                                           std::to_string(settings.visibility_samples) + ": --time left no more");
+                                           std::to_string(settings.visibility_samples) +
+                                           ": --time left no more");
     }
     sol.element_direct_samples = samples;
     return samples;
@@ -1039,8 +1050,8 @@ struct SolveState {
     // and the mean of its vertices' for emitting surfaces (resolved by refinement there).
     uint64_t element_rays = 0;
     rc::util::Progress progress("radiosity: direct light on elements", ne, "elements", settings.progress);
-    std::vector<Rgb> element_direct = element_punctual_irradiance(scene, receivers.geometry, mesh, element_direct_samples(),
-                                                                  settings.seed, element_rays, &progress);
+    std::vector<Rgb> element_direct = element_punctual_irradiance(
+        scene, receivers.geometry, mesh, element_direct_samples(), settings.seed, element_rays, &progress);
     progress.finish();
     rays += element_rays;
     for (size_t e = 0; e < ne; ++e) {

@@ -12,8 +12,8 @@
 
 #include <string>
 
-#include "radiosity/solver/hierarchical.h"
 #include "radiosity/mesh/mesh.h"
+#include "radiosity/solver/hierarchical.h"
 #include "raytrace_core/util/progress.h"
 #include "raytrace_core/util/rgb.h"
 
@@ -101,7 +101,8 @@ struct Solution {
   /// hierarchical under a time limit: no level of links fitted, so the reflected light was shot
   /// by progressive refinement for the time left instead (`shots`, `residual`)
   bool shot_without_links = false;
-  int element_direct_samples = 0;  ///< hierarchical: samples per element and light of the elements' direct light
+  int element_direct_samples =
+      0;  ///< hierarchical: samples per element and light of the elements' direct light
   double residual = 0.0;         ///< progressive: unshot power / emitted power at the end;
                                  ///< hierarchical: relative change of the last iteration
   bool tail_added = false;       ///< hierarchical: the iteration's geometric tail was added
@@ -133,13 +134,14 @@ std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const mesh::
 /// Where each vertex's visibility rays start: kVisibilityOrigins points per vertex (vertex v's at
 /// [v · kVisibilityOrigins, (v + 1) · kVisibilityOrigins)), towards the centroids of elements
 /// spread around its fan, half as far as the nearest centroid, just above those elements and in
-/// front of the mesh around them (the receiver point of receiver_points stands in where none is). A vertex colour
-/// stands for the surface around the vertex, and a ray from the vertex alone decides on a line:
-/// on Šibenik, vertices where a moulding meets a wall saw every light through the wall's edge
-/// and came out black while the surface on either side was lit. Advances `progress` (if any)
-/// by one per vertex.
-std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& geometry, const mesh::RadiosityMesh& mesh,
-                                                 std::span<const Vec3> receivers, rc::util::Progress* progress = nullptr);
+/// front of the mesh around them (the receiver point of receiver_points stands in where none is). A vertex
+/// colour stands for the surface around the vertex, and a ray from the vertex alone decides on a line: on
+/// Šibenik, vertices where a moulding meets a wall saw every light through the wall's edge and came out black
+/// while the surface on either side was lit. Advances `progress` (if any) by one per vertex.
+std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& geometry,
+                                                        const mesh::RadiosityMesh& mesh,
+                                                        std::span<const Vec3> receivers,
+                                                        rc::util::Progress* progress = nullptr);
 
 /// The solver `settings` asks for on a mesh of `elements` elements, and why.
 SolverKind choose_solver(const SolverSettings& settings, size_t elements, std::string* why = nullptr);

@@ -75,7 +75,8 @@ TEST(NearestPoint, SceneQueryMatchesALinearScan) {
       // element's vertex is to the face it was meshed from.
       const size_t t = size_t(rng.uniform() * float(m.triangle_count())) % m.triangle_count();
       const Vec2 uv = rc::util::sample_uniform_triangle(rng.uniform2());
-      p = at(m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]], uv) +
+      p = at(m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]],
+             m.positions[m.indices[3 * t + 2]], uv) +
           rc::util::sample_uniform_sphere(rng.uniform2()) * (radius * 0.01f * rng.uniform());
     }
     const float min_cosine = i % 3 == 0 ? -2.0f : 0.5f;  // every third query accepts any facing
