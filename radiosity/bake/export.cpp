@@ -68,7 +68,7 @@ enum class Format { ply, obj, gltf, glb, unsupported };
 
 /// write_forecast's fixed part and its parts per element, binary files and OBJ's text (see
 /// write_forecast).
-constexpr double kWriteSeconds = 0.3, kWriteSecondsPerElement = 2.5e-6, kObjSecondsPerElement = 3e-6;
+constexpr double kWriteSeconds = 0.3, kWriteSecondsPerElement = 4.5e-6, kObjSecondsPerElement = 5.5e-6;
 /// onto_input_forecast's parts per input triangle and per lightmap texel.
 constexpr double kOntoSecondsPerTriangle = 8e-6, kLightmapSecondsPerTexel = 1.7e-6;
 
@@ -649,9 +649,10 @@ RadiosityMesh without_coincident(const RadiosityMesh& mesh, SnapStats* stats) {
 }
 
 WriteForecast write_forecast(const std::string& path) {
-  // The slowest rate measured, 0.11-1.0 M elements on four scenes, with 30 % for the machine's
-  // noise (bench/README.md, "The solver's budget" and "The biggest rooms under --time 20"):
-  // 1.6 µs per element for binary PLY, 1.9 for glTF, 2.3 for OBJ's text.
+  // The slowest rate measured, 0.11-3.0 M elements on four scenes, with 30 % for the machine's
+  // noise (bench/README.md, "The solver's budget" and "The biggest rooms under --time"): 1.6 µs
+  // per element for binary PLY on a room whose furniture kept its input triangles, 3.5 µs where
+  // it was imprinted and remeshed (the snap onto the input is most of it), OBJ's text a fifth more.
   switch (format_of(fs::path(path))) {
     case Format::ply:
     case Format::gltf:
