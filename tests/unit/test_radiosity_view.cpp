@@ -297,3 +297,28 @@ TEST(RadiosityView, AnElementBesideThePointIsNotItsChord) {
   // On the ledge's own plane, over it, the point reads it.
   EXPECT_TRUE(view.indirect_irradiance(rc::scene::SurfacePoint{Vec3(0.75f, 0.0f, 0.0f), Vec3(1e-6f), up}, up).has_value());
 }
+
+// Overshooting leaves some of the unshot light negative, and the ambient term the views add for a
+// partial solution with it. Light is never negative: with an ambient term far below zero, every
+// vertex the mesh view reads and every indirect irradiance the two-pass view reads is zero or
+// more, in every channel.
+TEST(RadiosityView, ANegativeAmbientNeverMakesLightNegative) {
+  rc::scene::Scene scene;
+  scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));    // floor, up
+  scene.meshes.push_back(quad({-1, 0, -1}, {-1, 2, -1}, {-1, 2, 1}, {-1, 0, 1}));  // wall, +x
+  rad::solver::Solution sol = solve_sunlit(scene, Vec3(-1.0f, -1.0f, 0.2f), 0.5f);
+  sol.ambient = Rgb(-100.0f);
+  for (rad::bake::ViewMode mode : {rad::bake::ViewMode::mesh, rad::bake::ViewMode::two_pass}) {
+    const rad::bake::RadiosityView view(scene, sol, mode, /*ambient=*/true);
+    for (int i = 0; i < 64; ++i) {
+      // Rays from above down onto the floor and across onto the wall.
+      const float x = -0.9f + 1.8f * float(i % 8) / 7.0f, z = -0.9f + 1.8f * float(i / 8) / 7.0f;
+      for (const rc::scene::Ray& ray : {rc::scene::Ray{Vec3(x, 1.5f, z), Vec3(0.0f, -1.0f, 0.0f), 10.0f},
+                                        rc::scene::Ray{Vec3(0.5f, 0.1f + x + 1.0f, z), Vec3(-1.0f, 0.0f, 0.0f), 10.0f}}) {
+        rc::render::SampleContext ctx{rc::render::Sampler(rc::util::Rng::for_item(3, 0, uint64_t(i))), 0};
+        const Rgb l = view.radiance(ray, ctx);
+        for (int k = 0; k < 3; ++k) EXPECT_GE(l[k], 0.0f) << "ray " << i << ", channel " << k;
+      }
+    }
+  }
+}
