@@ -42,6 +42,7 @@
 
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/solver/cluster_kernel.h"
+#include "radiosity/solver/cluster_tree.h"
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/ladder_forecast.h"
 #include "radiosity/solver/probe_fraction.h"
@@ -55,15 +56,10 @@
 namespace gilt::radiosity::solver {
 
 using mesh::RadiosityMesh;
-using mesh::mesh_surface_point;
 namespace {
 
-constexpr float kPi = rc::kPi;
-constexpr uint32_t kNone = ~0u;
-/// Slack of the "sends nothing" tests, as a slope over the nearest distance between the two: a
-/// source within 10⁻⁴ rad of the receiver's plane, as seen from every point of the receiver,
-/// sends at most 10⁻⁴ of its light (the same bound as kTangentSlope).
-constexpr float kPlaneSlack = 1e-4f;
+using namespace detail;
+
 /// How many levels a far link's mixed end (elements facing both ways) is split into children
 /// that share its visibility.
 constexpr int kMixedDepth = 3;
@@ -94,324 +90,6 @@ constexpr size_t kTrialStride = 50;
 constexpr uint32_t kGatherProbeStride = 61;
 /// `auto` skips the final gather when it would trace more than this many times the links' rays.
 constexpr double kGatherRayShare = 4.0;
-
-/// One vector per colour channel: Σ B A n and the irradiance vector W.
-struct RgbVec {
-  Vec3 c[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};
-  void add(const Rgb& w, const Vec3& d) {
-    for (int k = 0; k < 3; ++k) c[k] += w[k] * d;
-  }
-  void add(const RgbVec& o) {
-    for (int k = 0; k < 3; ++k) c[k] += o.c[k];
-  }
-  Rgb dot(const Vec3& d) const { return Rgb(glm::dot(c[0], d), glm::dot(c[1], d), glm::dot(c[2], d)); }
-};
-
-struct Node {
-  uint32_t first = 0, count = 0;  ///< elements order[first .. first + count)
-  uint32_t right = kNone;         ///< second child (the first is the next node); kNone for a leaf
-  rc::Bounds3 box;                ///< of the elements' vertices
-  Vec3 center{0.0f};              ///< area-weighted centroid
-  float radius = 0.0f;            ///< of a sphere about center holding every vertex
-  Vec3 normal{0.0f};              ///< unit area-weighted mean normal (0 when it cancels)
-  float spread = 2.0f;            ///< max |n_k − normal| over the elements
-  float low = 0.0f, high = 0.0f;  ///< least and greatest normal·(x − center) over the vertices
-  float area = 0.0f;
-  Vec3 area_vector{0.0f};  ///< Σ A_k n_k
-  float albedo = 0.0f;     ///< area-weighted mean reflectance (channel mean)
-  glm::mat3 covariance{0.0f};  ///< of its points about center, uniform by area
-
-  bool leaf() const { return right == kNone; }
-};
-
-/// How a node's elements face a direction ω: all in front (n_k·ω ≥ 0 for every k, since
-/// n_k·ω ≥ n̄·ω − |n_k − n̄|), all behind, or some each way.
-enum class Facing { front, back, mixed };
-
-/// With `margin` = sin of the largest angle between ω and the directions it stands for, the
-/// answer holds for all of them.
-Facing facing(const Node& node, const Vec3& omega, float margin = 0.0f) {
-  if (node.spread >= 2.0f) return Facing::mixed;
-  const float c = glm::dot(node.normal, omega), bound = node.spread + margin;
-  return c >= bound ? Facing::front : (c <= -bound ? Facing::back : Facing::mixed);
-}
-
-/// The element hierarchy, nodes in depth-first pre-order (a parent before its children).
-struct Tree {
-  std::vector<Node> nodes;
-  std::vector<uint32_t> order;  ///< elements in leaf order
-  std::vector<SourceTriangle> triangles;
-
-  uint32_t element(const Node& leaf) const { return order[leaf.first]; }
-};
-
-class TreeBuilder {
- public:
-  TreeBuilder(const RadiosityMesh& mesh, std::span<const Rgb> albedo) : mesh_(mesh), albedo_(albedo) {
-    const size_t n = mesh.element_count();
-    centroid_.resize(n);
-    for (size_t e = 0; e < n; ++e) {
-      const auto& el = mesh.elements[e];
-      centroid_[e] = (mesh.positions[el[0]] + mesh.positions[el[1]] + mesh.positions[el[2]]) / 3.0f;
-    }
-  }
-
-  Tree build() {
-    const size_t n = mesh_.element_count();
-    tree_.order.resize(n);
-    std::iota(tree_.order.begin(), tree_.order.end(), 0u);
-    tree_.nodes.reserve(2 * n);
-    if (n > 0) add(0, uint32_t(n));
-    tree_.triangles.resize(n);
-    for (size_t e = 0; e < n; ++e) {
-      const auto& el = mesh_.elements[e];
-      tree_.triangles[e] =
-          SourceTriangle(mesh_.positions[el[0]], mesh_.positions[el[1]], mesh_.positions[el[2]]);
-    }
-    return std::move(tree_);
-  }
-
- private:
-  uint32_t add(uint32_t first, uint32_t count) {
-    const uint32_t index = uint32_t(tree_.nodes.size());
-    tree_.nodes.push_back(summarise(first, count));
-    if (count > 1) {
-      // Median split along the longest extent of the centroids; ties broken by element index so
-      // the tree, and everything after it, is the same on every run.
-      rc::Bounds3 cb;
-      for (uint32_t i = first; i < first + count; ++i) cb.extend(centroid_[tree_.order[i]]);
-      const Vec3 ext = cb.diagonal();
-      const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-      uint32_t half = count / 2;
-      auto begin = tree_.order.begin() + first;
-      std::nth_element(begin, begin + half, begin + count, [&](uint32_t a, uint32_t b) {
-        const float ca = centroid_[a][axis], cb2 = centroid_[b][axis];
-        return ca < cb2 || (ca == cb2 && a < b);
-      });
-      if (tree_.nodes[index].spread >= 1.0f) half = split_by_facing(first, count, half);
-      add(first, half);
-      const uint32_t right = add(first + half, count - half);
-      tree_.nodes[index].right = right;
-    }
-    return index;
-  }
-
-  /// A node whose elements face both ways (two faces of a wall or a roof slab, a column) is
-  /// split by the side its elements face rather than by position when that leaves much less of
-  /// its area in children that still face both ways. Such a child can be neither wholly in front
-  /// of a direction nor wholly behind it, so its links take the cluster models, which share
-  /// one visible fraction among all its elements: a slab's sunlit top and its ceiling, a few
-  /// centimetres apart with nothing between them, read the same open rays, and the sun on the
-  /// roof leaked into the room below (a closed box under a sun at link tolerance 2e-4). The side
-  /// is the sign of n·a for the principal axis a of Σ A n nᵀ. `half` is the positional split, already
-  /// applied; returns the size of the first child.
-  uint32_t split_by_facing(uint32_t first, uint32_t count, uint32_t half) {
-    auto begin = tree_.order.begin() + first;
-    const float positional = mixed_area(first, half) + mixed_area(first + half, count - half);
-    // Principal axis of the normals by power iteration, from the axis of the largest diagonal.
-    double m[3][3] = {};
-    for (uint32_t i = first; i < first + count; ++i) {
-      const uint32_t e = tree_.order[i];
-      const DVec3 n(mesh_.element_normal[e]);
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) m[r][c] += mesh_.element_area[e] * n[r] * n[c];
-    }
-    DVec3 a(0.0);
-    a[m[0][0] >= m[1][1] && m[0][0] >= m[2][2] ? 0 : (m[1][1] >= m[2][2] ? 1 : 2)] = 1.0;
-    for (int it = 0; it < 32; ++it) {
-      const DVec3 b(m[0][0] * a.x + m[0][1] * a.y + m[0][2] * a.z, m[1][0] * a.x + m[1][1] * a.y + m[1][2] * a.z,
-                    m[2][0] * a.x + m[2][1] * a.y + m[2][2] * a.z);
-      const double len = glm::length(b);
-      if (!(len > 0.0)) return half;
-      a = b / len;
-    }
-    std::vector<uint32_t> trial(begin, begin + count);
-    const auto front = std::stable_partition(trial.begin(), trial.end(), [&](uint32_t e) {
-      return glm::dot(DVec3(mesh_.element_normal[e]), a) >= 0.0;
-    });
-    const uint32_t split = uint32_t(front - trial.begin());
-    if (split == 0 || split == count) return half;
-    std::vector<uint32_t> positional_order(begin, begin + count);
-    std::copy(trial.begin(), trial.end(), begin);
-    const float facing_split = mixed_area(first, split) + mixed_area(first + split, count - split);
-    if (facing_split < 0.5f * positional) return split;
-    std::copy(positional_order.begin(), positional_order.end(), begin);
-    return half;
-  }
-
-  /// The unit area-weighted mean normal of elements [first, first + count) of the order (0 where
-  /// the normals cancel) and their spread about it, the largest |n_k − mean| (2 where they
-  /// cancel): Node::normal and Node::spread.
-  std::pair<Vec3, float> normal_and_spread(uint32_t first, uint32_t count) const {
-    double area = 0.0;
-    DVec3 sum(0.0);
-    for (uint32_t i = first; i < first + count; ++i) {
-      const uint32_t e = tree_.order[i];
-      area += mesh_.element_area[e];
-      sum += double(mesh_.element_area[e]) * DVec3(mesh_.element_normal[e]);
-    }
-    const double len = glm::length(sum);
-    if (!(len > 1e-6 * area && len > 0.0)) return {Vec3(0.0f), 2.0f};
-    const Vec3 mean(sum / len);
-    float spread = 0.0f;
-    for (uint32_t i = first; i < first + count; ++i)
-      spread = std::max(spread, glm::length(mesh_.element_normal[tree_.order[i]] - mean));
-    return {mean, spread};
-  }
-
-  /// The area of elements [first, first + count) of the order when they face both ways (their
-  /// normals' spread is 1 or more, as Node::spread), else 0.
-  float mixed_area(uint32_t first, uint32_t count) const {
-    if (normal_and_spread(first, count).second < 1.0f) return 0.0f;
-    double area = 0.0;
-    for (uint32_t i = first; i < first + count; ++i) area += mesh_.element_area[tree_.order[i]];
-    return float(area);
-  }
-
-  Node summarise(uint32_t first, uint32_t count) const {
-    Node node;
-    node.first = first;
-    node.count = count;
-    double area = 0.0, albedo = 0.0;
-    DVec3 weighted_centroid(0.0), weighted_normal(0.0);
-    for (uint32_t i = first; i < first + count; ++i) {
-      const uint32_t e = tree_.order[i];
-      const double a = mesh_.element_area[e];
-      area += a;
-      albedo += a * albedo_[e].average();
-      weighted_centroid += a * DVec3(centroid_[e]);
-      weighted_normal += a * DVec3(mesh_.element_normal[e]);
-      for (uint32_t v : mesh_.elements[e]) node.box.extend(mesh_.positions[v]);
-    }
-    node.area = float(area);
-    node.area_vector = Vec3(weighted_normal);
-    node.albedo = area > 0.0 ? float(albedo / area) : 0.0f;
-    node.center = area > 0.0 ? Vec3(weighted_centroid / area) : node.box.center();
-    std::tie(node.normal, node.spread) = normal_and_spread(first, count);
-    float radius2 = 0.0f;
-    float low = 0.0f, high = 0.0f;
-    glm::dmat3 second(0.0);
-    for (uint32_t i = first; i < first + count; ++i) {
-      const uint32_t e = tree_.order[i];
-      const auto& el = mesh_.elements[e];
-      const DVec3 g = DVec3(centroid_[e]) - DVec3(node.center);
-      second += double(mesh_.element_area[e]) *
-                (triangle_covariance(DVec3(mesh_.positions[el[0]]), DVec3(mesh_.positions[el[1]]),
-                                     DVec3(mesh_.positions[el[2]])) +
-                 glm::outerProduct(g, g));
-      for (uint32_t v : mesh_.elements[e]) {
-        const Vec3 d = mesh_.positions[v] - node.center;
-        radius2 = std::max(radius2, glm::dot(d, d));
-        const float h = glm::dot(node.normal, d);
-        low = std::min(low, h), high = std::max(high, h);
-      }
-    }
-    if (area > 0.0) node.covariance = glm::mat3(second / area);
-    node.radius = std::sqrt(radius2) * (1.0f + 1e-6f);
-    node.low = low, node.high = high;
-    return node;
-  }
-
-  const RadiosityMesh& mesh_;
-  std::span<const Rgb> albedo_;
-  std::vector<Vec3> centroid_;
-  Tree tree_;
-};
-
-/// True when no point of `to` lies in front of any element of `from` (beyond the slack): from
-/// then sends nothing to `to`, and receives nothing from it. Bounds n_k·(x − y) for x in `to`,
-/// y in `from`, by n̄·(x − y) plus the normals' spread times the largest |x − y|.
-bool behind(const Node& from, const Node& to) {
-  const Vec3 d = to.center - from.center;
-  const float dist = glm::length(d), far = dist + from.radius + to.radius;
-  const float near = std::max(0.0f, dist - from.radius - to.radius);
-  // The greatest n̄_from·(x − c_to) over `to`: its radius, or less when the two face alike.
-  const float to_high = std::min(to.radius, to.high + glm::length(from.normal - to.normal) * to.radius);
-  const float reach = glm::dot(from.normal, d) + to_high - from.low + from.spread * far;
-  return reach <= kPlaneSlack * near;
-}
-
-/// The same with a point receiver (p, n) as `to`: the node sends nothing to it.
-bool sends_nothing(const Node& s, const Vec3& p, const Vec3& n) {
-  const Vec3 d = s.center - p;
-  const float dist = glm::length(d), far = dist + s.radius, near = std::max(0.0f, dist - s.radius);
-  if (glm::dot(n, d) + s.radius <= kPlaneSlack * near) return true;  // behind the receiver's plane
-  return glm::dot(s.normal, -d) - s.low + s.spread * far <= kPlaneSlack * near;
-}
-
-/// Six direction bins: ±x, ±y, ±z by w's largest component.
-constexpr int kDirectionBins = 6;
-int direction_bin(const Vec3& w) {
-  const Vec3 a = glm::abs(w);
-  const int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
-  return 2 * axis + (w[axis] < 0.0f ? 1 : 0);
-}
-
-/// Σ B A n of a node's elements, per bin of their normals.
-struct Moments {
-  RgbVec bins[kDirectionBins];
-  void add(const Rgb& power, const Vec3& n) { bins[direction_bin(n)].add(power, n); }
-  void add(const Moments& o) {
-    for (int b = 0; b < kDirectionBins; ++b) bins[b].add(o.bins[b]);
-  }
-  RgbVec total() const {
-    RgbVec t;
-    for (const RgbVec& b : bins) t.add(b);
-    return t;
-  }
-};
-
-/// Radiant intensity (W·sr⁻¹) of a node towards unit direction ω: Σ B A max(0, n·ω) / π over its
-/// elements, as Σ over normal bins of max(0, ω·Σ B A n). Exact where each bin's elements all
-/// face ω or all face away (always for a flat node); where they split, the parts cancel and the
-/// bin gives less. The bins keep a wall's sunlit outer face from shining through to its inner
-/// face, which a two-band model of the node (¼ Σ B A + ½ ω·Σ B A n) sends a quarter of its power.
-Rgb intensity(std::span<const RgbVec> bins, const Vec3& omega) {
-  Rgb out(0.0f);
-  for (const RgbVec& bin : bins) {
-    const Rgb along = bin.dot(omega);
-    for (int k = 0; k < 3; ++k) out[k] += std::max(0.0f, along[k]);
-  }
-  return out * (1.0f / kPi);
-}
-Rgb intensity(const Moments& moment, const Vec3& omega) { return intensity(std::span<const RgbVec>(moment.bins), omega); }
-
-/// What a node sends towards (or receives from) unit direction ω, by the cluster models above:
-/// `total` is Σ x_k A_k and `moment` Σ x_k A_k n_k for some per-element x (radiosity, or 1).
-float towards(const Node& node, float total, const Vec3& moment, const Vec3& omega) {
-  const float along = glm::dot(omega, moment);
-  switch (facing(node, omega)) {
-    case Facing::front:
-      return std::max(0.0f, along);
-    case Facing::back:
-      return 0.0f;
-    case Facing::mixed:
-      break;
-  }
-  return std::max(0.0f, 0.25f * total + 0.5f * along);
-}
-
-/// A point for a visibility ray on node `s`'s elements. The element is drawn by walking down
-/// the tree, each child taken in proportion to weight(child) (what it exchanges with the other
-/// end of the ray), so that the ray tests the part of a cluster that carries the light: a
-/// cluster holding a bright roof and a dark plate under it must not be seen through the plate.
-/// Children that both weigh nothing are taken by area. Uniform by area within the element.
-template <class Weight>
-rc::scene::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint32_t s, Weight weight,
-                              rc::util::Rng& rng) {
-  while (!tree.nodes[s].leaf()) {
-    const uint32_t a = s + 1, b = tree.nodes[s].right;
-    float wa = weight(a), wb = weight(b);
-    if (!(wa + wb > 0.0f)) wa = tree.nodes[a].area, wb = tree.nodes[b].area;
-    s = rng.uniform() * (wa + wb) < wa ? a : b;
-  }
-  const uint32_t e = tree.element(tree.nodes[s]);
-  const rc::Vec2 b = rc::util::sample_uniform_triangle(rng.uniform2());
-  const auto& el = mesh.elements[e];
-  const Vec3 q =
-      (1.0f - b.x - b.y) * mesh.positions[el[0]] + b.x * mesh.positions[el[1]] + b.y * mesh.positions[el[2]];
-  return mesh_surface_point(q, mesh.element_normal[e]);
-}
 
 /// A link: node `receiver` gathers from node `source`. Far links give the irradiance facing the
 /// source, I_S(−ω)·factor with factor = V κ / r² (κ the kernel's average over the two ends'
@@ -783,27 +461,6 @@ class Linker {
   rc::util::Progress* progress_ = nullptr;
 };
 
-/// Σ B A and Σ B A n of every node, from the element radiosities (leaves up).
-void pull(const Tree& tree, const RadiosityMesh& mesh, std::span<const Rgb> radiosity,
-          std::vector<Rgb>& power, std::vector<Moments>& moment) {
-  const size_t n = tree.nodes.size();
-  power.assign(n, Rgb(0.0f));
-  moment.assign(n, Moments{});
-  for (size_t i = n; i-- > 0;) {
-    const Node& node = tree.nodes[i];
-    if (node.leaf()) {
-      const uint32_t e = tree.element(node);
-      power[i] = radiosity[e] * mesh.element_area[e];
-      moment[i].add(power[i], mesh.element_normal[e]);
-    } else {
-      for (size_t c : {i + 1, size_t(node.right)}) {
-        power[i] += power[c];
-        moment[i].add(moment[c]);
-      }
-    }
-  }
-}
-
 /// What the links read of a source node in one gather, packed for them: its centre and area, its
 /// power, and its non-empty normal bins (bins[first .. next node's first) of a shared pool). A
 /// gather reads one of these per link, in the order of the links' sources, so it is the links'
@@ -834,7 +491,7 @@ struct PackedSources {
 
   /// intensity() of node s towards ω.
   Rgb intensity(uint32_t s, const Vec3& omega) const {
-    return gilt::radiosity::solver::intensity(std::span(bins).subspan(nodes[s].first, nodes[s + 1].first - nodes[s].first), omega);
+    return detail::intensity(std::span(bins).subspan(nodes[s].first, nodes[s + 1].first - nodes[s].first), omega);
   }
 };
 
@@ -1098,7 +755,7 @@ struct HierarchicalSolve {
 
   /// Reads the mesh and the albedo; writes the tree, its cut and result.nodes.
   void build_tree() {
-    tree = TreeBuilder(mesh, in.albedo).build();
+    tree = make_tree(mesh, in.albedo);
     result.nodes = tree.nodes.size();
     if (tree.nodes.size() >= Link::kExactBit) throw std::length_error("hierarchical radiosity: more than 2^31 tree nodes");
     // Under several processes the tree is cut into subtrees of at most 1/256 of its nodes (a
@@ -1826,7 +1483,7 @@ std::vector<Rgb> emitted_irradiance(const HierarchicalInput& in, std::span<const
     area += mesh.element_area[e];
   }
   if (!(total > 0.0) || first_vertex >= nv) return out;
-  const Tree tree = TreeBuilder(mesh, in.albedo).build();
+  const Tree tree = make_tree(mesh, in.albedo);
   std::vector<Rgb> power;
   std::vector<Moments> moment;
   pull(tree, mesh, emitted, power, moment);
