@@ -46,6 +46,7 @@
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/ladder_forecast.h"
 #include "radiosity/solver/probe_fraction.h"
+#include "radiosity/solver/process_cut.h"
 #include "raytrace_core/scene/scene.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
@@ -136,17 +137,6 @@ struct LinkLevel {
   std::vector<Link> exact, far;
   std::vector<OpenPair> open;
 };
-
-/// How many of `items` (links or pairs, each with a receiver node) one process would hold, when
-/// each process holds those receiving at its own nodes and all hold those above the cut (owner
-/// −1): the ones above the cut once, the rest summed over processes. Empty `owner`: one process.
-template <class Items>
-size_t count_as_one_process(const Items& items, std::span<const int> owner) {
-  if (owner.empty()) return items.size();
-  const size_t shared =
-      size_t(std::count_if(items.begin(), items.end(), [&](const auto& x) { return owner[x.receiver] < 0; }));
-  return shared + size_t(rc::util::processes().total(items.size() - shared));
-}
 
 class Linker {
  public:
@@ -623,42 +613,6 @@ struct TreeWalk {
     return sum;
   }
 };
-
-/// A node and the nodes of its subtree, [root, end).
-struct Subtree {
-  uint32_t root, end;
-};
-
-/// The tree cut for several processes: subtrees of at most 1/256 of the nodes each, in node
-/// order, and each node's owner: the rank of its subtree (subtree i is rank i mod count's), or
-/// −1 above the cut.
-struct SubtreeCut {
-  std::vector<Subtree> subtrees;
-  std::vector<int> owner;
-};
-
-SubtreeCut cut_tree(const Tree& tree, int count) {
-  const size_t n = tree.nodes.size(), most = std::max<size_t>(1, n / 256);
-  SubtreeCut cut;
-  cut.owner.assign(n, -1);
-  if (n == 0) return cut;
-  std::vector<uint32_t> end(n);
-  for (size_t i = n; i-- > 0;) end[i] = tree.nodes[i].leaf() ? uint32_t(i + 1) : end[tree.nodes[i].right];
-  std::vector<uint32_t> stack{0};
-  while (!stack.empty()) {
-    const uint32_t i = stack.back();
-    stack.pop_back();
-    if (tree.nodes[i].leaf() || end[i] - i <= most) {
-      const int rank = int(cut.subtrees.size() % size_t(count));
-      cut.subtrees.push_back({i, end[i]});
-      std::fill(cut.owner.begin() + i, cut.owner.begin() + end[i], rank);
-    } else {
-      stack.push_back(tree.nodes[i].right);
-      stack.push_back(i + 1);
-    }
-  }
-  return cut;
-}
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
