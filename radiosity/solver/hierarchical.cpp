@@ -19,9 +19,15 @@
 // of its mean normal) sends I(ω) = ω·Σ B_k A_k n_k / π, exact for a plane, and receives the
 // irradiance vector W = Σ J w (J the irradiance facing the source, w towards it), so that an
 // element below it with normal n gets n·W: exact when every source is in front of it. A
-// curved or scattered cluster sends by bins of its elements' normals (intensity, below) and
-// receives by bins of the links' directions (irradiance_at); the oracle's error factor is then 1,
-// so such links are accepted only where little light travels.
+// curved or scattered cluster sends by bins of its elements' normals (intensity, in
+// cluster_tree.h) and receives by bins of the links' directions (irradiance_at, in tree_walk.h);
+// the oracle's error factor is then 1, so such links are accepted only where little light travels.
+//
+// The parts of the method live beside this file, in namespace detail: the tree and the cluster
+// models (cluster_tree.h), the links and the Linker that makes them (linker.h), gathering from the
+// tree (tree_walk.h) and the cut of the tree among processes (process_cut.h). This file holds the
+// solve that drives them (HierarchicalSolve: the ladder of link tolerances, the iteration and the
+// final gather) and the entry points of hierarchical.h.
 
 #include "radiosity/solver/hierarchical.h"
 
@@ -31,29 +37,23 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
-#include <numeric>
 #include <optional>
 #include <span>
-#include <tuple>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include <oneapi/tbb/parallel_sort.h>
 
-#include "radiosity/mesh/element_scene.h"
-#include "radiosity/solver/cluster_kernel.h"
 #include "radiosity/solver/cluster_tree.h"
-#include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/ladder_forecast.h"
 #include "radiosity/solver/linker.h"
-#include "radiosity/solver/probe_fraction.h"
 #include "radiosity/solver/process_cut.h"
-#include "raytrace_core/scene/scene.h"
+#include "radiosity/solver/tree_walk.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
 #include "raytrace_core/util/progress.h"
 #include "raytrace_core/util/rng.h"
-#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::solver {
 
@@ -83,169 +83,6 @@ constexpr size_t kTrialStride = 50;
 constexpr uint32_t kGatherProbeStride = 61;
 /// `auto` skips the final gather when it would trace more than this many times the links' rays.
 constexpr double kGatherRayShare = 4.0;
-
-/// What the links read of a source node in one gather, packed for them: its centre and area, its
-/// power, and its non-empty normal bins (bins[first .. next node's first) of a shared pool). A
-/// gather reads one of these per link, in the order of the links' sources, so it is the links'
-/// memory traffic: 32 bytes and a bin or two (most nodes are flat) against the 132-byte node
-/// and six 36-byte bins. The bins kept are the non-zero ones in bin order, and a zero bin adds
-/// exactly nothing to intensity(), so the sums are the same to the bit.
-struct PackedSources {
-  struct Source {
-    Vec3 center;
-    uint32_t first;
-    Rgb power;
-    float area;
-  };
-  std::vector<Source> nodes;  ///< one per tree node, and one more closing the last node's bins
-  std::vector<RgbVec> bins;
-
-  void pack(const Tree& tree, std::span<const Rgb> power, std::span<const Moments> moment) {
-    const size_t n = tree.nodes.size();
-    nodes.resize(n + 1);
-    bins.clear();
-    for (size_t i = 0; i < n; ++i) {
-      nodes[i] = {tree.nodes[i].center, uint32_t(bins.size()), power[i], tree.nodes[i].area};
-      for (const RgbVec& b : moment[i].bins)
-        if (b.c[0] != Vec3(0.0f) || b.c[1] != Vec3(0.0f) || b.c[2] != Vec3(0.0f)) bins.push_back(b);
-    }
-    nodes[n] = {Vec3(0.0f), uint32_t(bins.size()), Rgb(0.0f), 0.0f};
-  }
-
-  /// intensity() of node s towards ω.
-  Rgb intensity(uint32_t s, const Vec3& omega) const {
-    return detail::intensity(std::span(bins).subspan(nodes[s].first, nodes[s + 1].first - nodes[s].first), omega);
-  }
-};
-
-/// What a node has gathered: the irradiance vector of flat receivers, and for curved ones, per
-/// bin of the links' directions w, the irradiance vector W_b = Σ J w and the sum S_b = Σ J over
-/// the links whose w falls in the bin.
-struct Gathered {
-  RgbVec flat;
-  RgbVec bins[kDirectionBins];
-  Rgb sums[kDirectionBins];
-};
-
-/// An element of normal n under a curved receiver takes S_b E[max(0, n·w)] from each bin b, the
-/// expectation over the bin's directions read from their mean x = n·W_b / S_b and their spread
-/// s = √(1 − κ²), κ = |W_b| / S_b: the ramp max(0, x) smoothed over [−s, s] by (x + s)² / 4s.
-/// Exact for one link (s = 0: max(0, J n·w)) and for directions spread evenly over the sphere
-/// (x = 0, s = 1: ¼ S_b); for an even hemisphere it gives 0.54, 0.22 and 0.04 for normals along,
-/// across and against it, where the answer is 0.5, 0.25 and 0. The two-band model it replaces,
-/// max(0, ¼ Σ J + ½ n·Σ J w), gave an element turned 90° from a lone source a quarter of its
-/// light, and one facing it three quarters: it moved light from the elements of a carved or curved
-/// cluster that face a bright source to those that do not (HierarchicalRadiosity.
-/// ABallsFacesTakeTheLightOfTheirOwnSide).
-Rgb irradiance_at(const Gathered& g, const Vec3& n) {
-  Rgb out = g.flat.dot(n);
-  for (int k = 0; k < 3; ++k) out[k] = std::max(0.0f, out[k]);
-  for (int i = 0; i < kDirectionBins; ++i) {
-    const Rgb b = g.bins[i].dot(n);
-    for (int k = 0; k < 3; ++k) {
-      const float sum = g.sums[i][k];
-      if (!(sum > 0.0f)) continue;
-      const float kappa = std::min(1.0f, glm::length(g.bins[i].c[k]) / sum);
-      const float x = b[k] / sum, spread = std::sqrt(std::max(0.0f, 1.0f - kappa * kappa));
-      const float phi = x >= spread ? x : (x <= -spread ? 0.0f : (x + spread) * (x + spread) / (4.0f * spread));
-      out[k] += sum * phi;
-    }
-  }
-  return out;
-}
-
-struct WalkCounts {
-  uint64_t rays = 0, nodes = 0, form_factors = 0;
-};
-
-/// Irradiance at a vertex from every element's radiosity, by a walk down the tree: a cluster is
-/// taken whole, as a point source seen through `rays` shadow rays, when the irradiance it may carry
-/// wrongly (F̂ B times the point-source error (r/d)², or all of it where its elements face both
-/// ways) is below `epsilon`; an element by Lambert's formula. With more than one ray, a probe of
-/// min(rays, 4) that finds the node partly hidden is extended to `rays` (read by extended_fraction).
-struct TreeWalk {
-  const HierarchicalInput& in;
-  const Tree& tree;
-  std::span<const Rgb> radiosity;  ///< per element
-  const std::vector<Rgb>& power;
-  const std::vector<Moments>& moment;
-
-  Rgb irradiance(size_t v, double epsilon, int rays, rc::util::Rng& rng, std::vector<uint32_t>& stack,
-                 WalkCounts& counts) const {
-    const RadiosityMesh& mesh = in.mesh;
-    const Vec3 p = in.vertex_point[v].p, n = mesh.normals[v];
-    Rgb sum(0.0f);
-    stack.assign(1, 0u);
-    while (!stack.empty()) {
-      const uint32_t s = stack.back();
-      stack.pop_back();
-      const Node& S = tree.nodes[s];
-      ++counts.nodes;
-      if (!(power[s].average() > 0.0f) || sends_nothing(S, p, n)) continue;
-      Rgb value(0.0f);
-      if (S.leaf()) {
-        ++counts.form_factors;
-        const uint32_t e = tree.element(S);
-        const float f = float(tree.triangles[e].form_factor(p, n));
-        if (!(f > 0.0f)) continue;
-        value = radiosity[e] * f;
-      } else {
-        const Vec3 d = S.center - p;
-        const float dist = glm::length(d), gap = dist - S.radius;
-        bool accept = false;
-        if (gap > 0.0f) {
-          const double bound = std::min(1.0, double(S.area) / (double(kPi) * gap * gap));
-          double error = bound * power[s].average() / S.area;
-          if (facing(S, -d / dist) == Facing::front)
-            error *= std::min(1.0, std::pow(double(S.radius) / gap, 2.0));
-          accept = error <= epsilon;
-        }
-        if (!accept) {
-          stack.push_back(S.right);
-          stack.push_back(s + 1);
-          continue;
-        }
-        const float cos_receiver = glm::dot(n, d) / dist;
-        if (!(cos_receiver > 0.0f)) continue;
-        // The kernel averaged over the source's extent (cluster_kernel_scale), the receiver a point.
-        const Vec3 n_s = facing(S, -d / dist) == Facing::front ? S.normal : -d / dist;
-        const float scale = cluster_kernel_scale(d, n, n_s, S.covariance);
-        value = intensity(moment[s], -d / dist) * (cos_receiver * scale / (dist * dist));
-      }
-      rc::Bounds3 reach = S.box;
-      reach.extend(p);
-      if (in.may_be_blocked(reach)) {
-        const Vec3 omega = glm::normalize(p - S.center);
-        auto sends = [&](uint32_t c) {
-          const RgbVec m = moment[c].total();
-          return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f),
-                         omega);
-        };
-        auto open = [&](int count) {
-          int hits = 0;
-          // The vertex's visibility origins in turn, from a random one.
-          const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
-          for (int i = 0; i < count; ++i) {
-            const rc::scene::SurfacePoint& at = in.visibility_origin[kVisibilityOrigins * v + (first + size_t(i)) % kVisibilityOrigins];
-            hits += !in.geometry.occluded(
-                rc::scene::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
-          }
-          counts.rays += uint64_t(count);
-          return hits;
-        };
-        const int probe = std::min(rays, 4);
-        const int probe_hits = open(probe);
-        if (probe_hits == 0) continue;
-        float visible = float(probe_hits) / float(probe);
-        if (probe_hits < probe && rays > probe)
-          visible = float(extended_fraction(probe_hits + open(rays - probe), rays, probe));
-        value = value * visible;
-      }
-      sum += value;
-    }
-    return sum;
-  }
-};
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
