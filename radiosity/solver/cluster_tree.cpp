@@ -87,7 +87,8 @@ class TreeBuilder {
     DVec3 a(0.0);
     a[m[0][0] >= m[1][1] && m[0][0] >= m[2][2] ? 0 : (m[1][1] >= m[2][2] ? 1 : 2)] = 1.0;
     for (int it = 0; it < 32; ++it) {
-      const DVec3 b(m[0][0] * a.x + m[0][1] * a.y + m[0][2] * a.z, m[1][0] * a.x + m[1][1] * a.y + m[1][2] * a.z,
+      const DVec3 b(m[0][0] * a.x + m[0][1] * a.y + m[0][2] * a.z,
+                    m[1][0] * a.x + m[1][1] * a.y + m[1][2] * a.z,
                     m[2][0] * a.x + m[2][1] * a.y + m[2][2] * a.z);
       const double len = glm::length(b);
       if (!(len > 0.0)) return half;
@@ -188,7 +189,9 @@ class TreeBuilder {
 
 }  // namespace
 
-Tree make_tree(const RadiosityMesh& mesh, std::span<const Rgb> albedo) { return TreeBuilder(mesh, albedo).build(); }
+Tree make_tree(const RadiosityMesh& mesh, std::span<const Rgb> albedo) {
+  return TreeBuilder(mesh, albedo).build();
+}
 
 void pull(const Tree& tree, const RadiosityMesh& mesh, std::span<const Rgb> radiosity,
           std::vector<Rgb>& power, std::vector<Moments>& moment) {

@@ -23,8 +23,8 @@
 
 namespace gilt::radiosity::solver::detail {
 
-using mesh::RadiosityMesh;
 using mesh::mesh_surface_point;
+using mesh::RadiosityMesh;
 using rc::Rgb;
 using rc::Vec3;
 
@@ -57,8 +57,8 @@ struct Node {
   float spread = 2.0f;            ///< max |n_k − normal| over the elements
   float low = 0.0f, high = 0.0f;  ///< least and greatest normal·(x − center) over the vertices
   float area = 0.0f;
-  Vec3 area_vector{0.0f};  ///< Σ A_k n_k
-  float albedo = 0.0f;     ///< area-weighted mean reflectance (channel mean)
+  Vec3 area_vector{0.0f};      ///< Σ A_k n_k
+  float albedo = 0.0f;         ///< area-weighted mean reflectance (channel mean)
   glm::mat3 covariance{0.0f};  ///< of its points about center, uniform by area
 
   bool leaf() const { return right == kNone; }
@@ -145,7 +145,9 @@ inline Rgb intensity(std::span<const RgbVec> bins, const Vec3& omega) {
   }
   return out * (1.0f / kPi);
 }
-inline Rgb intensity(const Moments& moment, const Vec3& omega) { return intensity(std::span<const RgbVec>(moment.bins), omega); }
+inline Rgb intensity(const Moments& moment, const Vec3& omega) {
+  return intensity(std::span<const RgbVec>(moment.bins), omega);
+}
 
 /// What a node sends towards (or receives from) unit direction ω, by the cluster models above:
 /// `total` is Σ x_k A_k and `moment` Σ x_k A_k n_k for some per-element x (radiosity, or 1).
@@ -169,7 +171,7 @@ inline float towards(const Node& node, float total, const Vec3& moment, const Ve
 /// Children that both weigh nothing are taken by area. Uniform by area within the element.
 template <class Weight>
 rc::scene::SurfacePoint sample_point(const Tree& tree, const RadiosityMesh& mesh, uint32_t s, Weight weight,
-                              rc::util::Rng& rng) {
+                                     rc::util::Rng& rng) {
   while (!tree.nodes[s].leaf()) {
     const uint32_t a = s + 1, b = tree.nodes[s].right;
     float wa = weight(a), wb = weight(b);

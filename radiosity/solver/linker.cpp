@@ -223,7 +223,7 @@ float Linker::visibility(uint32_t r, uint32_t s, uint64_t stream) {
 }
 
 void Linker::split_mixed(uint32_t r, uint32_t s, int r_depth, int s_depth, float visible,
-                 std::vector<Link>& links) const {
+                         std::vector<Link>& links) const {
   const Node& R = tree_.nodes[r];
   const Node& S = tree_.nodes[s];
   const Vec3 d = S.center - R.center;
@@ -240,7 +240,8 @@ void Linker::split_mixed(uint32_t r, uint32_t s, int r_depth, int s_depth, float
     split_mixed(r, S.right, r_depth, s_depth + 1, visible, links);
   } else {
     // The kernel averaged over the two ends' extent, not read at their centres alone.
-    const Vec3 n_r = receiving == Facing::front ? R.normal : w, n_s = sending == Facing::front ? S.normal : -w;
+    const Vec3 n_r = receiving == Facing::front ? R.normal : w,
+               n_s = sending == Facing::front ? S.normal : -w;
     const float scale = cluster_kernel_scale(d, n_r, n_s, R.covariance + S.covariance);
     links.emplace_back(r, s, visible * scale / dist2, false);
   }

@@ -29,15 +29,16 @@ inline constexpr uint64_t kPilotStream = 0x5100000000ull, kEstimateStream = 0x54
 /// mean factor to the source (SourceTriangle::form_factor_from), along the receiver's normal.
 /// Twelve bytes: the direction is found again from the nodes when gathering (a far link's, from
 /// its receiver's centre to its source's, as split_mixed made it; an exact link's, the receiving
-/// element's normal), since a 300k-triangle interior at tolerance 2e-6 holds 120 million links, and at 28 bytes
-/// with the sort's buffer those took 10 GB.
+/// element's normal), since a 300k-triangle interior at tolerance 2e-6 holds 120 million links,
+/// and at 28 bytes with the sort's buffer those took 10 GB.
 struct Link {
   static constexpr uint32_t kExactBit = 0x80000000u;
   uint32_t receiver;
   uint32_t tagged_source;  ///< the source node, kExactBit set for an exact link
   float factor;
 
-  Link(uint32_t r, uint32_t s, float f, bool exact) : receiver(r), tagged_source(s | (exact ? kExactBit : 0u)), factor(f) {}
+  Link(uint32_t r, uint32_t s, float f, bool exact)
+      : receiver(r), tagged_source(s | (exact ? kExactBit : 0u)), factor(f) {}
   uint32_t source() const { return tagged_source & ~kExactBit; }
   bool exact() const { return (tagged_source & kExactBit) != 0u; }
   /// Links ordered by receiver, then source: one receiver's links are adjacent, in an order that
@@ -71,7 +72,8 @@ struct LinkLevel {
 class Linker {
  public:
   bool out_of_time() const {
-    return (in_.out_of_time && in_.out_of_time()) || (keep_back_ > 0.0 && in_.seconds_left && in_.seconds_left() < keep_back_);
+    return (in_.out_of_time && in_.out_of_time()) ||
+           (keep_back_ > 0.0 && in_.seconds_left && in_.seconds_left() < keep_back_);
   }
 
   Linker(const HierarchicalInput& in, const Tree& tree, std::span<const float> power_estimate,
@@ -130,7 +132,8 @@ class Linker {
   /// Where the work on a pair receiving at `node` is counted: the counts are summed over
   /// processes, and the pairs above the cut, refined by every process, are counted by rank 0.
   Counters& count_for(uint32_t node) {
-    return owner_.empty() || owner_[node] == rank_ || (owner_[node] < 0 && rank_ == 0) ? counters_ : uncounted_;
+    return owner_.empty() || owner_[node] == rank_ || (owner_[node] < 0 && rank_ == 0) ? counters_
+                                                                                       : uncounted_;
   }
   /// Drops the links or pairs that receive at another process's nodes.
   template <class T>

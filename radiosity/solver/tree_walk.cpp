@@ -23,7 +23,7 @@ void PackedSources::pack(const Tree& tree, std::span<const Rgb> power, std::span
 }
 
 Rgb TreeWalk::irradiance(size_t v, double epsilon, int rays, rc::util::Rng& rng, std::vector<uint32_t>& stack,
-               WalkCounts& counts) const {
+                         WalkCounts& counts) const {
   const RadiosityMesh& mesh = in.mesh;
   const Vec3 p = in.vertex_point[v].p, n = mesh.normals[v];
   Rgb sum(0.0f);
@@ -70,17 +70,17 @@ Rgb TreeWalk::irradiance(size_t v, double epsilon, int rays, rc::util::Rng& rng,
       const Vec3 omega = glm::normalize(p - S.center);
       auto sends = [&](uint32_t c) {
         const RgbVec m = moment[c].total();
-        return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f),
-                       omega);
+        return towards(tree.nodes[c], power[c].average(), (m.c[0] + m.c[1] + m.c[2]) * (1.0f / 3.0f), omega);
       };
       auto open = [&](int count) {
         int hits = 0;
         // The vertex's visibility origins in turn, from a random one.
         const size_t first = size_t(rng.uniform() * float(kVisibilityOrigins));
         for (int i = 0; i < count; ++i) {
-          const rc::scene::SurfacePoint& at = in.visibility_origin[kVisibilityOrigins * v + (first + size_t(i)) % kVisibilityOrigins];
-          hits += !in.geometry.occluded(
-              rc::scene::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
+          const rc::scene::SurfacePoint& at =
+              in.visibility_origin[kVisibilityOrigins * v + (first + size_t(i)) % kVisibilityOrigins];
+          hits +=
+              !in.geometry.occluded(rc::scene::spawn_shadow_ray(at, sample_point(tree, mesh, s, sends, rng)));
         }
         counts.rays += uint64_t(count);
         return hits;

@@ -37,7 +37,8 @@ struct PackedSources {
 
   /// intensity() of node s towards ω.
   Rgb intensity(uint32_t s, const Vec3& omega) const {
-    return detail::intensity(std::span(bins).subspan(nodes[s].first, nodes[s + 1].first - nodes[s].first), omega);
+    return detail::intensity(std::span(bins).subspan(nodes[s].first, nodes[s + 1].first - nodes[s].first),
+                             omega);
   }
 };
 
@@ -70,7 +71,8 @@ inline Rgb irradiance_at(const Gathered& g, const Vec3& n) {
       if (!(sum > 0.0f)) continue;
       const float kappa = std::min(1.0f, glm::length(g.bins[i].c[k]) / sum);
       const float x = b[k] / sum, spread = std::sqrt(std::max(0.0f, 1.0f - kappa * kappa));
-      const float phi = x >= spread ? x : (x <= -spread ? 0.0f : (x + spread) * (x + spread) / (4.0f * spread));
+      const float phi =
+          x >= spread ? x : (x <= -spread ? 0.0f : (x + spread) * (x + spread) / (4.0f * spread));
       out[k] += sum * phi;
     }
   }
