@@ -1,6 +1,7 @@
 #pragma once
 // The geometric kernel between two clusters of surface, averaged over their extent, for the
-// far links of hierarchical radiosity (hierarchical.cpp), which read it at the clusters' centres.
+// far links of hierarchical radiosity (linker.cpp, tree_walk.cpp), which read it at the clusters'
+// centres.
 
 #include "raytrace_core/util/math.h"
 
