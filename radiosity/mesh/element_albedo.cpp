@@ -51,8 +51,9 @@ std::vector<rc::Rgb> element_reflectance(const rc::scene::Scene& scene, const Ra
         for (int j = 0; j < kSide; ++j) {
           const rc::Vec2 w = rc::util::sample_uniform_triangle({(i + 0.5f) / kSide, (j + 0.5f) / kSide});
           const Vec3 x = (1.0f - w.x - w.y) * p0 + w.x * p1 + w.y * p2;
-          const std::optional<rc::scene::Hit> h =
-              scene.nearest_triangle(s, x, reach, mesh.element_normal[e], 0.5f);
+          // An element turned over, or the back twin of one, faces against its input face.
+          std::optional<rc::scene::Hit> h = scene.nearest_triangle(s, x, reach, mesh.element_normal[e], 0.5f);
+          if (!h) h = scene.nearest_triangle(s, x, reach, -mesh.element_normal[e], 0.5f);
           if (!h) continue;
           // The footprint: this point's share of the element, as the found triangle maps it.
           const rc::Vec2 uv = uv_at(input, h->prim_id, x);

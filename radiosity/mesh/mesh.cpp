@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "radiosity/mesh/mesh_detail.h"
+#include "radiosity/mesh/sides.h"
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/progress.h"
@@ -730,14 +731,24 @@ RadiosityMesh build_mesh(const rc::scene::Scene& scene, const MeshSettings& sett
   st.end_stage("remesh");
   assemble_pass(st, out);
   st.end_stage("assemble");
+  if (settings.two_sided && scene.committed()) {
+    const SidesReport sides = orient_sides(scene, out);
+    rep.turned_elements = sides.turned_elements;
+    rep.two_sided_elements = sides.two_sided_elements;
+    rep.elements = out.element_count();
+    st.end_stage("sides");
+  }
   // The remesher keeps the input's borders, creases and contact lines where they are, so a model
   // of many small faces cannot be meshed coarser than they allow.
-  if (settings.elements > 0 && settings.max_edge == 0.0f && out.element_count() > 2 * size_t(settings.elements))
-    rep.warnings.push_back("asked for about " + std::to_string(settings.elements) + " elements, meshed " +
-                           std::to_string(out.element_count()) +
-                           ": the remesher keeps the input's borders, creases and contact lines, and makes no "
-                           "element coarser than they allow (the edge length asked for is " +
-                           std::to_string(st.edge_length) + ")");
+  // (Twins behind surfaces lit on both sides are not counted: they are the same surface.)
+  const size_t meshed = out.element_count() - rep.two_sided_elements;
+  if (settings.elements > 0 && settings.max_edge == 0.0f && meshed > 2 * size_t(settings.elements))
+    rep.warnings.push_back(
+        "asked for about " + std::to_string(settings.elements) + " elements, meshed " +
+        std::to_string(meshed) +
+        ": the remesher keeps the input's borders, creases and contact lines, and makes no "
+        "element coarser than they allow (the edge length asked for is " +
+        std::to_string(st.edge_length) + ")");
   return out;
 }
 

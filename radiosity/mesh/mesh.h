@@ -31,6 +31,10 @@ struct MeshSettings {
   int elements = 0;             ///< approximate total element count (0: use max_edge or the default)
   float sharp_angle_degrees = 30.0f;  ///< dihedral angle above which an edge is sharp (vertices split)
   int remesh_iterations = 3;    ///< isotropic remeshing passes
+  /// Give each smooth piece of surface an element on every side that light reaches (turning over
+  /// those lit on the back alone, doubling those lit on both: see sides.h); off, elements face
+  /// as the input's faces are wound.
+  bool two_sided = true;
   bool progress = false;        ///< report each stage that runs longer than a second or two on stderr
   /// When meshing must end (a solve under --time). Imprinting goes piece by piece, those with the
   /// most contact faces first; pieces not begun by then keep their input triangles, without
@@ -52,6 +56,12 @@ struct RadiosityMesh {
   std::vector<uint32_t> element_surface;         ///< which input mesh (or sphere) it came from
   std::vector<Vec3> element_normal;              ///< unit geometric normal (front)
   std::vector<float> element_area;               ///< scene units²
+  /// Per element, 1 for an element given a twin lying on it facing the other way, and for the
+  /// twin (a surface lit on both sides has an element, and a radiosity, per side: sides.h); empty
+  /// when no element has one.
+  std::vector<uint8_t> element_two_sided;
+
+  bool two_sided(size_t e) const { return !element_two_sided.empty() && element_two_sided[e] != 0; }
 
   size_t vertex_count() const { return positions.size(); }
   size_t element_count() const { return elements.size(); }
@@ -68,9 +78,11 @@ struct MeshReport {
   double buried_area = 0.0;    ///< area of both, scene units²
   double meshed_area = 0.0;    ///< area of the input surfaces that are meshed, scene units²
   size_t pieces_not_imprinted = 0;  ///< pieces that touch others but kept no contact lines: the deadline had passed
+  size_t turned_elements = 0;       ///< elements turned over: light reaches only their back (sides.h)
+  size_t two_sided_elements = 0;    ///< elements given a twin facing the other way: light reaches both sides
   size_t pieces_not_remeshed = 0;  ///< pieces that kept their imprinted triangles: the deadline had passed
   /// Seconds each stage took, in order: repair, contacts (which faces meet), imprint, buried
-  /// faces (the imprinted input's test), remesh (with the flat elements' test), assemble.
+  /// faces (the imprinted input's test), remesh (with the flat elements' test), assemble, sides.
   std::vector<std::pair<std::string, double>> stage_seconds;
   std::vector<std::string> warnings;
 };

@@ -102,6 +102,7 @@ size_t split_longest_edges(RadiosityMesh& mesh, const std::vector<uint32_t>& ele
       const float half = 0.5f * mesh.element_area[f];
       mesh.element_area[f] = half;
       mesh.element_area.push_back(half);
+      if (!mesh.element_two_sided.empty()) mesh.element_two_sided.push_back(mesh.element_two_sided[f]);
       replace(key_of(g, 1), f, g);  // edge b–c moved to g
       on_edge[key_of(f, 0)].push_back(f);
       on_edge[key_of(f, 1)].push_back(f);
