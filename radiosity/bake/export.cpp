@@ -518,10 +518,14 @@ RadiosityMesh snapped_to_input(const rc::scene::Scene& scene, const RadiosityMes
   rc::util::parallel_for(mesh.vertex_count(), [&](size_t v) {
     if (progress) progress->advance(1);
     std::optional<rc::scene::Hit> best;
-    for (uint8_t k = 0; k < count[v]; ++k) {
-      const std::optional<rc::scene::Hit> h =
-          scene.nearest_triangle(surfaces[v][k], mesh.positions[v], best ? best->t : reach, mesh.normals[v], 0.5f);
-      if (h && (!best || h->t < best->t)) best = h;
+    // A vertex of an element turned over, or of the back twin of one, faces against its input.
+    for (const float side : {1.0f, -1.0f}) {
+      for (uint8_t k = 0; k < count[v]; ++k) {
+        const std::optional<rc::scene::Hit> h = scene.nearest_triangle(
+            surfaces[v][k], mesh.positions[v], best ? best->t : reach, side * mesh.normals[v], 0.5f);
+        if (h && (!best || h->t < best->t)) best = h;
+      }
+      if (best) break;
     }
     if (!best) return;
     const rc::scene::TriangleMesh& m = scene.meshes[best->geom_id];

@@ -287,11 +287,19 @@ Rgb RadiosityView::mesh_radiance(const rc::scene::Ray& camera_ray, rc::render::S
       return beta * rc::scene::escaped_radiance(scene_.punctual_lights, glm::normalize(ray.direction));
     const rc::scene::SurfaceInteraction si = display_.surface(ray, *hit);
     if (hit->geom_id == 0) {
-      // Radiosity is solved for the element fronts; their backs are not part of the answer.
-      if (!si.front_face) return Rgb(0.0f);
-      const auto& e = elements_[hit->prim_id];
-      const Rgb l = vertex_radiance_[e[0]] * (1.0f - hit->u - hit->v) + vertex_radiance_[e[1]] * hit->u +
-                    vertex_radiance_[e[2]] * hit->v;
+      // Radiosity is solved for the element fronts; a back is part of the answer only where an
+      // element facing the other way lies on it (a twin, where light reaches both sides, or the
+      // other sheet of a surface modelled as two back to back), which the ray may have met in
+      // its place.
+      Location at{hit->prim_id, hit->u, hit->v, 0.0f};
+      if (!si.front_face) {
+        const std::optional<Location> behind = locate_on(si, -si.ng);
+        if (!behind) return Rgb(0.0f);
+        at = *behind;
+      }
+      const auto& e = elements_[at.element];
+      const Rgb l = vertex_radiance_[e[0]] * (1.0f - at.u - at.v) + vertex_radiance_[e[1]] * at.u +
+                    vertex_radiance_[e[2]] * at.v;
       return beta * l;
     }
     const rc::scene::Material& m = display_.materials[si.material];

@@ -71,8 +71,9 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> element_fans(const Radio
 /// long) from a candidate receiver hit the back of a surface: a receiver that sees a back so
 /// close lies behind part of the mesh around it.
 /// Probing stops once `enough` backs are seen (the callers only compare the count with the
-/// fewest so far, or with zero).
-int backs_seen(const rc::scene::Scene& scene, const Vec3& p, const Vec3& n, float reach, int enough) {
+/// fewest so far, or with zero). The back of a two-sided element is its twin's front.
+int backs_seen(const rc::scene::Scene& scene, const RadiosityMesh& mesh, const Vec3& p, const Vec3& n,
+               float reach, int enough) {
   const rc::scene::SurfacePoint at = surface_point(p, n);
   const rc::Frame frame = rc::Frame::from_normal(n);
   static const std::array<Vec3, 5> dirs = {Vec3(0.0f, 0.0f, 1.0f), Vec3(0.8660254f, 0.0f, 0.5f),
@@ -84,7 +85,8 @@ int backs_seen(const rc::scene::Scene& scene, const Vec3& p, const Vec3& n, floa
     rc::scene::Ray ray = rc::scene::spawn_ray(at, frame.to_world(d));
     ray.tmax = reach;
     const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
-    backs += hit && !scene.surface(ray, *hit).front_face;
+    backs +=
+        hit && !scene.surface(ray, *hit).front_face && !(hit->geom_id == 0 && mesh.two_sided(hit->prim_id));
   }
   return backs;
 }
@@ -114,7 +116,7 @@ std::vector<Vec3> receiver_points(const rc::scene::Scene& geometry, const Radios
       const Vec3 p = mesh.positions[v], n = mesh.normals[v];
       int fewest = std::numeric_limits<int>::max();
       const auto consider = [&](const Vec3& candidate, float reach) {
-        const int backs = backs_seen(geometry, candidate, n, reach, fewest);
+        const int backs = backs_seen(geometry, mesh, candidate, n, reach, fewest);
         if (backs < fewest) fewest = backs, origin[v] = candidate;
       };
       for (uint32_t i = offsets[v]; i < offsets[v + 1] && fewest > 0; ++i) {
@@ -166,7 +168,7 @@ std::vector<rc::scene::SurfacePoint> visibility_origins(const rc::scene::Scene& 
         if (!(size > 0.0f)) continue;
         const Vec3 n = mesh.element_normal[e];
         const Vec3 q = p + towards * (radius / size) + (1e-3f * size) * n;
-        if (backs_seen(geometry, q, n, 2.0f * size, 1) == 0)
+        if (backs_seen(geometry, mesh, q, n, 2.0f * size, 1) == 0)
           out[kVisibilityOrigins * v + taken++] = surface_point(q, n);
       }
       if (taken == 0) out[kVisibilityOrigins * v + taken++] = surface_point(receivers[v], mesh.normals[v]);

@@ -30,7 +30,8 @@ rc::scene::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 /// Gives `scene` (its meshes added, all of material 0) a white diffuse material (0.8) and a sun
 /// of unit irradiance travelling along `sun_direction`, commits it, and solves it with elements
 /// of at most `max_edge`.
-rad::solver::Solution solve_sunlit(rc::scene::Scene& scene, Vec3 sun_direction, float max_edge) {
+rad::solver::Solution solve_sunlit(rc::scene::Scene& scene, Vec3 sun_direction, float max_edge,
+                                   bool two_sided = true) {
   scene.materials.push_back(rc::scene::Material::make_diffuse("white", Rgb(0.8f)));
   rc::scene::Light sun;
   sun.kind = rc::scene::LightKind::directional;
@@ -40,6 +41,7 @@ rad::solver::Solution solve_sunlit(rc::scene::Scene& scene, Vec3 sun_direction, 
   scene.commit();
   rad::solver::SolverSettings settings;
   settings.mesh.max_edge = max_edge;
+  settings.mesh.two_sided = two_sided;
   settings.progress = false;
   return rad::solver::solve(scene, settings);
 }
@@ -251,15 +253,19 @@ TEST(RadiosityView, NoLightLeaksAcrossAContactLine) {
 // not. (In Šibenik's carved stone, rays that entered a moulding from behind read the lit face
 // outside this way.)
 TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
+  const auto build = [](rc::scene::Scene& scene) {
+    scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));  // floor, up
+    scene.meshes.push_back(quad({-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f},
+                                {-0.5f, 0.5f, 0.5f}));  // canopy, down
+    rc::scene::TriangleMesh chip;                       // a small plate, up, its edge 0.1
+    chip.positions = {{-0.05f, 0.53f, -0.05f}, {-0.05f, 0.53f, 0.05f}, {0.05f, 0.53f, 0.0f}};
+    chip.indices = {0, 1, 2};
+    scene.meshes.push_back(chip);
+  };
   rc::scene::Scene scene;
-  scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));                  // floor, up
-  scene.meshes.push_back(quad({-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f},
-                              {-0.5f, 0.5f, 0.5f}));                                              // canopy, down
-  rc::scene::TriangleMesh chip;  // a small plate, up, its edge 0.1
-  chip.positions = {{-0.05f, 0.53f, -0.05f}, {-0.05f, 0.53f, 0.05f}, {0.05f, 0.53f, 0.0f}};
-  chip.indices = {0, 1, 2};
-  scene.meshes.push_back(chip);
-  const rad::solver::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);
+  build(scene);
+  // One-sided: the canopy's sunlit top would otherwise be given elements of its own (below).
+  const rad::solver::Solution sol = solve_sunlit(scene, Vec3(-0.3f, -1.0f, 0.2f), 1.0f, /*two_sided=*/false);
   const rad::bake::RadiosityView view(scene, sol, rad::bake::ViewMode::two_pass, false);
 
   const Vec3 up(0.0f, 1.0f, 0.0f), down(0.0f, -1.0f, 0.0f);
@@ -273,6 +279,18 @@ TEST(RadiosityView, TheBackOfAFaceReadsOnlyAnElementLyingOnIt) {
   // The canopy's top, lit side up but face normal down, is its back: nothing to read there.
   EXPECT_FALSE(
       view.indirect_irradiance(rc::scene::SurfacePoint{on_canopy, Vec3(1e-6f), down}, up).has_value());
+
+  // Two-sided (the default), the canopy's top sees the sun and the floor its bottom: the canopy is
+  // given a twin facing up, and its top reads that twin, lying on it.
+  rc::scene::Scene again;
+  build(again);
+  const rad::solver::Solution both = solve_sunlit(again, Vec3(-0.3f, -1.0f, 0.2f), 1.0f);
+  const rad::bake::RadiosityView two_sided(again, both, rad::bake::ViewMode::two_pass, false);
+  const auto twin = two_sided.locate(on_canopy, up);
+  ASSERT_TRUE(twin.has_value());
+  EXPECT_NEAR(twin->distance, 0.0f, 1e-5f);
+  EXPECT_TRUE(
+      two_sided.indirect_irradiance(rc::scene::SurfacePoint{on_canopy, Vec3(1e-6f), down}, up).has_value());
 }
 
 // An element lies over a point of a curved surface it is a chord of; one beside it, however
