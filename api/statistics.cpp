@@ -74,6 +74,8 @@ nlohmann::json solution_statistics(const radiosity::solver::Solution& sol, const
           {"contact_edges", sol.mesh_report.contact_edges},
           {"pieces_not_imprinted", sol.mesh_report.pieces_not_imprinted},
           {"pieces_not_remeshed", sol.mesh_report.pieces_not_remeshed},
+          {"turned_elements", sol.mesh_report.turned_elements},
+          {"two_sided_elements", sol.mesh_report.two_sided_elements},
           {"buried_faces", sol.mesh_report.buried_faces},
           {"buried_elements", sol.mesh_report.buried_elements},
           {"buried_area", sol.mesh_report.buried_area},

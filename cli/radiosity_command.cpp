@@ -337,6 +337,11 @@ void print_solve_report(const radiosity::solver::Solution& sol, const RadiosityO
               "direct light\n",
               sol.mesh.element_count(), sol.mesh_report.elements, sol.mesh.vertex_count(), sol.mesh_report.max_edge,
               sol.refined_elements);
+  if (sol.mesh_report.turned_elements > 0 || sol.mesh_report.two_sided_elements > 0)
+    std::printf(
+        "  sides:   %zu elements turned over (light reaches only their back), %zu given a twin facing the "
+        "other way (light reaches both sides)\n",
+        sol.mesh_report.turned_elements, sol.mesh_report.two_sided_elements);
   if (sol.mesh_report.contact_edges > 0 || sol.mesh_report.buried_area > 0.0)
     std::printf("  contact: %zu edges imprinted where surfaces touch; %.3g %% of the area buried under or inside "
                 "other surfaces, removed (%zu input faces, %zu elements)\n",
@@ -510,6 +515,10 @@ void add_solver_options(CLI::App& cmd, radiosity::solver::SolverSettings& s) {
                                                     std::to_string(radiosity::mesh::kDefaultElements) + ")")
       ->check(CLI::Range(1, 50000000))
       ->excludes(edge);
+  cmd.add_flag_callback(
+      "--one-sided", [&s] { s.mesh.two_sided = false; },
+      "Radiosity: elements receive and send light on the side the input's faces are wound to face only "
+      "(default: on every side light reaches, as the path tracer sees a diffuse surface)");
   cmd.add_option("--tolerance", s.tolerance, "Radiosity: stop when unshot power < T x emitted power (default 1e-3)")
       ->check(CLI::Range(1e-12, 1.0))
       ->check(finite_number());
