@@ -248,6 +248,8 @@ void add_bake_json(nlohmann::json& j, const radiosity::solver::Solution& sol, co
                 {"gather_rays", o.bake_gather},
                 {"gathered_samples", run.onto->gather.gathered},
                 {"samples_read_after_deadline", run.onto->gather.late},
+                {"samples_from_the_back", run.onto->sides.back},
+                {"samples_whose_sides_differ", run.onto->sides.differ},
                 {"seconds", run.onto->seconds}};
   if (run.vertex_gather)
     j["vertex_gather"] = {{"gather_rays", o.bake_gather},
@@ -268,6 +270,8 @@ void add_bake_json(nlohmann::json& j, const radiosity::solver::Solution& sol, co
                      {"gather_rays", o.bake_gather},
                      {"gathered_points", atlas->stats.gather.gathered},
                      {"points_read_after_deadline", atlas->stats.gather.late},
+                     {"points_from_the_back", atlas->stats.sides.back},
+                     {"points_whose_sides_differ", atlas->stats.sides.differ},
                      {"layout_seconds", atlas->stats.layout_seconds},
                      {"bake_seconds", atlas->stats.bake_seconds}};
 }
@@ -440,6 +444,18 @@ void print_bake_gather(const radiosity::bake::BakeGatherCount& g, int bake_gathe
   std::printf("\n");
 }
 
+/// Warns, on stderr, when many of a bake's points lie on surfaces whose two sides take
+/// different light: one colour per point can carry one side only.
+void warn_sides(const radiosity::bake::BakeSides& s, const char* bake) {
+  if (s.points == 0 || double(s.differ) < 0.01 * double(s.points)) return;
+  std::fprintf(
+      stderr,
+      "gilt: warning: %s: %.3g %% of the baked points lie on surfaces lit on both sides, by irradiances "
+      "more than %g times apart; a point carries the light of its face's front (the side its winding "
+      "faces), so their backs show it too (--onto elements exports both sides)\n",
+      bake, 100.0 * double(s.differ) / double(s.points), double(radiosity::bake::kSidesDiffer));
+}
+
 /// Reads the solution, the options and run's bakes and input-face check; prints the vertex
 /// gather, onto, lightmap and check lines, and what was written.
 void print_bake_report(const radiosity::solver::Solution& sol, const RadiosityOptions& o, const RadiosityRun& run) {
@@ -464,10 +480,12 @@ void print_bake_report(const radiosity::solver::Solution& sol, const RadiosityOp
                 100.0 * double(atlas->stats.texels) / (double(atlas->size) * atlas->size),
                 atlas->stats.layout_seconds, atlas->stats.bake_seconds, atlas->stats.uv_source.c_str());
   if (onto) print_bake_gather(onto->gather, o.bake_gather);
+  if (onto) warn_sides(onto->sides, "--onto input");
   if (atlas && atlas->stats.uv_set < 0)
     std::printf(", %zu charts at %.4g texels per unit", atlas->stats.charts, atlas->stats.texels_per_metre);
   if (atlas) std::printf("\n            wrote %s\n", radiosity::bake::lightmap_image_path(o.output).c_str());
   if (atlas) print_bake_gather(atlas->stats.gather, o.bake_gather);
+  if (atlas) warn_sides(atlas->stats.sides, "--lightmap");
   if (surface_check && surface_check->points == 0 && surface_check->unlit == 0)
     std::printf(kNothingChecked, "sampled point");
   else if (surface_check)

@@ -701,6 +701,7 @@ Lightmap bake_lightmap(const rc::scene::Scene& scene, const Solution& solution, 
   for (char f : filled) out.stats.texels += size_t(f);
   pad_border(filled, out);
   out.stats.gather = at_input.gather_count();
+  out.stats.sides = at_input.sides_count();
   out.stats.bake_seconds = seconds_since(start);
   return out;
 }

@@ -50,6 +50,7 @@ struct LightmapStats {
   std::string uv_source;        ///< which UVs, and why the input's were not used
   double layout_seconds = 0, bake_seconds = 0;
   BakeGatherCount gather;       ///< with a final gather: how the texels' points were evaluated
+  BakeSides sides;              ///< which side of the surface the texels' points read
 };
 
 struct Lightmap {

@@ -55,9 +55,30 @@ SolutionAtInput::SolutionAtInput(const rc::scene::Scene& scene, const Solution& 
 }
 
 std::optional<Rgb> SolutionAtInput::operator()(const rc::scene::Material& m, const Vec3& p,
-                                               const Vec3& n) const {
-  const std::optional<RadiosityView::Location> at = view_.locate(p, n);
+                                               const Vec3& face_normal) const {
+  // The side to read: the face's front (as it is wound), unless an element lies nearer on its
+  // back, facing the other way (the mesher turned the surface over: light reaches only its back).
+  // Where both sides have an element lying on them (light reaches both), the front's is read, as
+  // a viewer shows a vertex colour on both sides.
+  const std::optional<RadiosityView::Location> front = view_.locate(p, face_normal);
+  const std::optional<RadiosityView::Location> back = view_.locate(p, -face_normal);
+  const float on = 1e-4f * view_.reach();
+  const bool use_back = back && (!front || back->distance + on < front->distance);
+  const std::optional<RadiosityView::Location> at = use_back ? back : front;
   if (!at) return std::nullopt;
+  const Vec3 n = use_back ? -face_normal : face_normal;
+  ++points_;
+  if (use_back) {
+    ++back_;
+  } else if (back && back->distance <= front->distance + on) {
+    const auto irradiance = [&](const RadiosityView::Location& l) {
+      const auto& c = solution_.mesh.elements[l.element];
+      const std::vector<Rgb>& e = solution_.vertex_irradiance;
+      return (e[c[0]] * (1.0f - l.u - l.v) + e[c[1]] * l.u + e[c[2]] * l.v).average();
+    };
+    const float a = irradiance(*front), b = irradiance(*back);
+    if (std::max(a, b) > kSidesDiffer * std::min(a, b)) ++differ_;
+  }
   const Rgb e = gather_.rays > 0 && std::chrono::steady_clock::now() < gather_.deadline ? gathered(p, n) : read(*at, p, n);
   const Rgb radiosity = m.emission * rc::kPi + rc::scene::diffuse_reflectance(m) * e;
   return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
@@ -172,6 +193,7 @@ InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& so
     out.per_file_vertex = fit_vertex_colours(positions, indices, field, fit, spacing, &out.stats, &progress);
   }
   out.gather = at_input.gather_count();
+  out.sides = at_input.sides_count();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -192,7 +214,10 @@ std::optional<InputPoint> input_surface_under(const rc::scene::Scene& scene, con
   const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
   if (!hit || &scene.primitive_material(hit->geom_id, hit->prim_id) != &scene.materials[mesh.vertex_material[v]])
     return std::nullopt;
-  const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
+  rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
+  // A vertex of a surface the mesher turned over, or of a twin behind one, faces the input's
+  // back: the point is on that side.
+  if (!si.front_face) si.ng = -si.ng, si.ns = -si.ns;
   if (glm::dot(si.ng, n) < kSameSideOfCrease) return std::nullopt;
   return InputPoint{ray, si};
 }

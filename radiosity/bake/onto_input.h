@@ -51,6 +51,19 @@ struct BakeGatherCount {
   uint64_t late = 0;      ///< read from the solution because the deadline had passed
 };
 
+/// Points a bake evaluated, by the side of the surface they read (see SolutionAtInput).
+struct BakeSides {
+  uint64_t points = 0;  ///< points an element stands for
+  uint64_t back =
+      0;  ///< read from an element facing against the face's winding (light reaches only its back)
+  /// Lit on both sides, by irradiances that differ by more than kSidesDiffer times: the bake
+  /// carries the front's, and the face's back shows the wrong light.
+  uint64_t differ = 0;
+};
+
+/// Irradiances whose ratio exceeds this are "different" sides (BakeSides::differ).
+inline constexpr float kSidesDiffer = 2.0f;
+
 /// Colours for the vertices of the meshes read from one model file.
 struct InputColours {
   int32_t file = -1;                        ///< index into Scene::model_files
@@ -61,6 +74,7 @@ struct InputColours {
   std::vector<Rgb> per_file_vertex;
   FitStats stats;
   BakeGatherCount gather;   ///< with a final gather: how its points were evaluated
+  BakeSides sides;          ///< which side of the surface its points read
   size_t buried_faces = 0;  ///< input faces left out of the fit: inside closed solids or under objects
   double seconds = 0.0;
 };
@@ -85,6 +99,7 @@ class SolutionAtInput {
   SolutionAtInput(const rc::scene::Scene& scene, const solver::Solution& solution, Quantity quantity, BakeGather gather = {});
   std::optional<Rgb> operator()(const rc::scene::Material& m, const Vec3& p, const Vec3& n) const;
   BakeGatherCount gather_count() const { return {gathered_.load(), late_.load()}; }
+  BakeSides sides_count() const { return {points_.load(), back_.load(), differ_.load()}; }
 
  private:
   Rgb gathered(const Vec3& p, const Vec3& n) const;
@@ -96,6 +111,7 @@ class SolutionAtInput {
   Quantity quantity_;
   BakeGather gather_;
   mutable std::atomic<uint64_t> gathered_{0}, late_{0};
+  mutable std::atomic<uint64_t> points_{0}, back_{0}, differ_{0};
   std::vector<const rc::scene::Light*> delta_lights_;
   bool exact_direct_ = false;
 };
@@ -125,7 +141,9 @@ std::vector<float> vertex_disk_radius(const mesh::RadiosityMesh& mesh);
 
 /// The point of the input surface under vertex v, displaced by `offset` in its tangent plane: the
 /// first input face a ray straight down the vertex normal meets, from `radius` above to `radius`
-/// below, when it has the vertex's material and faces its side of any crease. With the ray.
+/// below, when it has the vertex's material and faces its side of any crease (the face's front or
+/// back, whichever the ray meets: the side of the returned point, whose normals face the ray's
+/// origin). With the ray.
 struct InputPoint {
   rc::scene::Ray ray;
   rc::scene::SurfaceInteraction si;

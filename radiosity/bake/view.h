@@ -66,6 +66,8 @@ class RadiosityView {
     float distance;  ///< from p to the element
   };
   std::optional<Location> locate(const Vec3& p, const Vec3& n) const;
+  /// How far from an element locate() looks: twice the solution's target edge.
+  float reach() const { return reach_; }
 
   /// Irradiance (W·m⁻²) at a point p of the input whose lit side faces along its unit geometric
   /// normal p.ng, estimated from `rays` samples, each one shadow ray's direct light
