@@ -188,66 +188,116 @@ std::vector<CheckFace> checked_faces(const rc::scene::Scene& scene,
   return faces;
 }
 
-/// Draws point i on `face` with `rng`, path-traces its irradiance (settings.samples samples, along
-/// rays `step` above it) and asks `baked_at` for the bake's value there.
-CheckedPoint check_point(const rc::scene::Scene& scene, const CheckFace& face, rc::util::Rng& rng, size_t i,
-                         float step, const rc::render::PathSettings& path, const BakedAt& baked_at,
-                         const CheckSettings& settings) {
-  CheckedPoint out;
+/// Which side of a drawn point is compared.
+enum class Sides : uint8_t {
+  /// The front, or the back where no light reaches the front: the side a bake carries (one
+  /// colour per point; it reads the back where the mesher turned the surface over).
+  lit,
+  /// Either, drawn at random: an element export has an element on each side light reaches.
+  either,
+};
+
+/// A point's path-traced irradiance below this fraction of the mean over the drawn points is no
+/// light: a sample can bring an emitter's light at a grazing angle of a rounding error (1e-14 of
+/// it on the outside of a closed furnace, whose faces emit inwards).
+constexpr double kUnlitFraction = 1e-6;
+
+/// A point on its way through the check: drawn, then traced on one side, then perhaps the other.
+struct PointInCheck {
+  DrawnPoint point;
+  bool face_buried = false;  ///< on a face inside a solid or under an object (input_triangle_buried)
+  bool buried = false;       ///< that, or the point buried on the side traced (input_point_buried)
+  bool blocked = false;      ///< something lies on the point, or coincides with its face
+  Rgb mean{0.0f}, variance{0.0f};
+};
+
+/// Draws point i on `face` with `rng`, on its front, or with Sides::either on a side drawn at random.
+PointInCheck draw_point(const rc::scene::Scene& scene, const CheckFace& face, rc::util::Rng& rng,
+                        Sides sides) {
   const rc::scene::TriangleMesh& mesh = scene.meshes[face.mesh];
-  const rc::scene::Material& m = scene.materials[mesh.material];
   const uint32_t* corner = &mesh.indices[3 * size_t(face.triangle)];
   const rc::Vec2 uv = rc::util::sample_uniform_triangle(rng.uniform2());
-  DrawnPoint point{face.mesh, face.triangle, {1.0f - uv.x - uv.y, uv.x, uv.y}, Vec3(0.0f), Vec3(0.0f)};
+  PointInCheck out;
+  DrawnPoint& point = out.point;
+  point = DrawnPoint{face.mesh, face.triangle, {1.0f - uv.x - uv.y, uv.x, uv.y}, Vec3(0.0f), Vec3(0.0f)};
   for (int k = 0; k < 3; ++k) point.position += point.weight[k] * mesh.positions[corner[k]];
   point.normal = glm::normalize(glm::cross(mesh.positions[corner[1]] - mesh.positions[corner[0]],
                                            mesh.positions[corner[2]] - mesh.positions[corner[0]]));
-  const Vec3 &p = point.position, &n = point.normal;
-  if (input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]], mesh.positions[corner[2]]) ||
-      input_point_buried(scene, p, n)) {
-    // Inside a solid or under an object: no one sees it (the fit leaves buried faces out too).
-    out.outcome = Outcome::unlit;
-    return out;
-  }
+  if (sides == Sides::either && rng.uniform() < 0.5f) point.normal = -point.normal;
+  // Inside a solid or under an object: no one sees it (the fit leaves buried faces out too).
+  out.face_buried = input_triangle_buried(scene, mesh.positions[corner[0]], mesh.positions[corner[1]],
+                                          mesh.positions[corner[2]]);
+  return out;
+}
+
+/// Path-traces the irradiance of point i on the side its normal faces: settings.samples samples,
+/// along rays `step` above it, each looking straight down at it.
+void trace_point(const rc::scene::Scene& scene, PointInCheck& at, size_t i, float step,
+                 const rc::render::PathSettings& path, const CheckSettings& settings) {
+  const Vec3 &p = at.point.position, &n = at.point.normal;
+  at.buried = at.face_buried || input_point_buried(scene, p, n);
+  at.mean = at.variance = Rgb(0.0f);
+  if (at.buried) return;
   Rgb sum(0.0f), sum_squares(0.0f);
-  int taken = 0;
   for (int s = 0; s < settings.samples; ++s) {
     rc::render::SampleContext ctx{
         rc::render::Sampler(rc::util::Rng::for_item(settings.seed, i, 0xc0ffee0000ull + uint64_t(s))), 0};
     const rc::scene::Ray ray{p + step * n, -n, 2.0f * step};
     const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
     // Something lies on the point, or coincides with its face (a duplicate, facing either way).
-    if (!hit || hit->geom_id != face.mesh || hit->prim_id != face.triangle) return out;
+    if (!hit || hit->geom_id != at.point.mesh || hit->prim_id != at.point.triangle) {
+      at.blocked = true;
+      return;
+    }
     const Rgb e = rc::render::path_radiance(scene, ray, ctx, path) * rc::kPi;
     sum += e;
     sum_squares += e * e;
-    ++taken;
   }
-  if (sum.is_black()) {  // no light at all: inside a closed solid, where no one looks
+  const float ns = float(settings.samples);
+  at.mean = sum / ns;
+  for (int c = 0; c < 3; ++c)
+    at.variance[c] = std::max(0.0f, (sum_squares[c] - sum[c] * sum[c] / ns) / (ns - 1.0f)) / ns;
+}
+
+/// The mean path-traced irradiance over the points traced (neither buried nor blocked).
+double mean_traced(const std::vector<PointInCheck>& points) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (const PointInCheck& at : points)
+    if (!at.buried && !at.blocked) sum += at.mean.average(), ++n;
+  return n > 0 ? sum / double(n) : 0.0;
+}
+
+/// The outcome of a traced point: unlit below `unlit` (or buried), else compared with `baked_at`.
+CheckedPoint outcome_of(const rc::scene::Scene& scene, const PointInCheck& at, double unlit,
+                        const BakedAt& baked_at) {
+  CheckedPoint out;
+  if (at.blocked) return out;
+  if (at.buried || !(at.mean.average() > unlit)) {
     out.outcome = Outcome::unlit;
     return out;
   }
   // Whether the bake has a value here is asked last, of points that would be compared: a
   // buried or unlit point is no hole in it.
-  const std::optional<Rgb> value = baked_at(point);
+  const std::optional<Rgb> value = baked_at(at.point);
   if (!value) {
     out.outcome = Outcome::uncovered;
     return out;
   }
-  const float ns = float(taken);
-  out.mean = sum / ns;
-  for (int c = 0; c < 3; ++c)
-    out.variance[c] = std::max(0.0f, (sum_squares[c] - sum[c] * sum[c] / ns) / (ns - 1.0f)) / ns;
+  const rc::scene::TriangleMesh& mesh = scene.meshes[at.point.mesh];
+  const uint32_t* corner = &mesh.indices[3 * size_t(at.point.triangle)];
+  out.mean = at.mean;
+  out.variance = at.variance;
   out.baked = *value;
-  SurfaceCheckPoint& at = out.where;
-  at.mesh = face.mesh;
-  at.triangle = face.triangle;
+  SurfaceCheckPoint& where = out.where;
+  where.mesh = at.point.mesh;
+  where.triangle = at.point.triangle;
   for (int k = 0; k < 3; ++k) {
-    at.file_vertex[k] = mesh.origin.vertex.empty() ? corner[k] : mesh.origin.vertex[corner[k]];
-    at.weight[k] = point.weight[k];
+    where.file_vertex[k] = mesh.origin.vertex.empty() ? corner[k] : mesh.origin.vertex[corner[k]];
+    where.weight[k] = at.point.weight[k];
   }
-  at.position = p;
-  at.albedo = m.albedo;
+  where.position = at.point.position;
+  where.albedo = scene.materials[mesh.material].albedo;
   out.outcome = Outcome::compared;
   return out;
 }
@@ -285,7 +335,7 @@ void score_points(std::vector<CheckedPoint>& points, size_t used, double referen
 /// settings.points points by area over the faces of the scene meshes `drawn_from(m)` accepts
 /// (mirrors and glass never), path-traces the irradiance at each and compares it with `baked_at`.
 SurfaceCheckResult check_baked(const rc::scene::Scene& scene, const std::function<bool(size_t)>& drawn_from,
-                               const BakedAt& baked_at, const CheckSettings& settings) {
+                               const BakedAt& baked_at, const CheckSettings& settings, Sides sides) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
   std::vector<float> area;
@@ -295,13 +345,28 @@ SurfaceCheckResult check_baked(const rc::scene::Scene& scene, const std::functio
   if (pick.size() == 0) return result;
   const float step = 1e-4f * glm::length(scene.bounds().diagonal());
   const size_t count = size_t(settings.points);
-  std::vector<CheckedPoint> points(count);
+  std::vector<PointInCheck> drawn(count);
   const rc::render::PathSettings path = irradiance_probe();
   rc::util::parallel_for(count, [&](size_t i) {
     rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
     const CheckFace& face = faces[pick.sample(rng.uniform())];
-    points[i] = check_point(scene, face, rng, i, step, path, baked_at, settings);
+    drawn[i] = draw_point(scene, face, rng, sides);
+    trace_point(scene, drawn[i], i, step, path, settings);
   });
+  // What counts as no light is known once the points are traced; with Sides::lit, the points
+  // whose front has none are traced again on their back.
+  double unlit = kUnlitFraction * mean_traced(drawn);
+  if (sides == Sides::lit) {
+    rc::util::parallel_for(count, [&](size_t i) {
+      PointInCheck& at = drawn[i];
+      if (at.blocked || at.face_buried || at.mean.average() > unlit) return;
+      at.point.normal = -at.point.normal;
+      trace_point(scene, at, i, step, path, settings);
+    });
+    unlit = kUnlitFraction * mean_traced(drawn);
+  }
+  std::vector<CheckedPoint> points(count);
+  rc::util::parallel_for(count, [&](size_t i) { points[i] = outcome_of(scene, drawn[i], unlit, baked_at); });
   double reference_mean = 0.0;
   size_t used = 0;
   for (const CheckedPoint& point : points) {
@@ -379,7 +444,7 @@ SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const Inpu
   };
   return check_baked(
       scene, [&](size_t m) { return scene.meshes[m].origin.file == irradiance.file && baked_on(m); },
-      baked_at, settings);
+      baked_at, settings, Sides::lit);
 }
 
 SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings) {
@@ -391,7 +456,7 @@ SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap&
       [&](const DrawnPoint& at) -> std::optional<Rgb> {
         return irradiance.at(at.mesh, at.triangle, at.weight[1], at.weight[2]);
       },
-      settings);
+      settings, Sides::lit);
 }
 
 SurfaceCheckResult check_element_colours(const rc::scene::Scene& scene, const RadiosityMesh& exported,
@@ -416,7 +481,8 @@ SurfaceCheckResult check_element_colours(const rc::scene::Scene& scene, const Ra
            near->u * vertex_irradiance[corner[1]] + near->v * vertex_irradiance[corner[2]];
   };
   // Every input mesh of every file (check_baked leaves out mirrors and glass, which are not meshed).
-  SurfaceCheckResult result = check_baked(scene, [](size_t) { return true; }, baked_at, settings);
+  SurfaceCheckResult result = check_baked(
+      scene, [](size_t) { return true; }, baked_at, settings, Sides::either);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -110,7 +110,9 @@ void write_check_points(const std::string& path, const CheckResult& result);
 /// and a point with something lying on it (the path tracer's ray hits another surface) is left out,
 /// and so is a buried point (input_triangle_buried for its face, which the fit leaves out, or
 /// input_point_buried for the point: inside a closed solid or under an object) or one no
-/// path-traced sample brings any light to: no one sees their colour.
+/// path-traced sample brings any light to: no one sees their colour. A point is compared on its
+/// face's front, or on its back where no light reaches the front (a surface wound against the
+/// side it is seen from, which the bake reads from the back: SolutionAtInput).
 SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings);
 
@@ -126,11 +128,14 @@ SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap&
 /// snapped_to_input, then without_coincident) and `vertex_irradiance` its irradiance per vertex
 /// (Solution::vertex_irradiance: without_coincident keeps the vertex numbering). A point's value
 /// is read from the nearest exported element within 10⁻⁴ of the scene's bounding-box diagonal
-/// that faces the way its input face does (geometric normals within 2.5°), interpolated
+/// that faces the way the point's side does (geometric normals within 2.5°; each point is
+/// compared on one side of its face, front or back at random, as the export has an element on
+/// every side light reaches), interpolated
 /// barycentrically at the point of the element nearest to it, found by a point query of a BVH
 /// over the elements (O(log n) a point). A point with no such element is counted in `uncovered`
-/// and left out of the figures: on a flat input, a share below 1 is a hole or a flipped element
-/// in the export. Throws std::logic_error when vertex_irradiance does not match the mesh.
+/// and left out of the figures: on a flat input, a share below 1 is a hole in the export, or a
+/// side light reaches that has no element. Throws std::logic_error when vertex_irradiance does not match the
+/// mesh.
 SurfaceCheckResult check_element_colours(const rc::scene::Scene& scene, const mesh::RadiosityMesh& exported,
                                          const std::vector<Rgb>& vertex_irradiance,
                                          const CheckSettings& settings);
