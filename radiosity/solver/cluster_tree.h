@@ -96,10 +96,14 @@ inline bool behind(const Node& from, const Node& to) {
   const Vec3 d = to.center - from.center;
   const float dist = glm::length(d), far = dist + from.radius + to.radius;
   const float near = std::max(0.0f, dist - from.radius - to.radius);
-  // The greatest n̄_from·(x − c_to) over `to`: its radius, or less when the two face alike.
-  const float to_high = std::min(to.radius, to.high + glm::length(from.normal - to.normal) * to.radius);
+  // The greatest n̄_from·(x − c_to) over `to`: its radius, or less when the two face alike, or
+  // when they face opposite ways (n̄_from·y = −n̄_to·y + (n̄_from + n̄_to)·y): a cluster of twins
+  // lying on the elements they were made from is behind them, and they behind it.
+  const float to_high = std::min({to.radius, to.high + glm::length(from.normal - to.normal) * to.radius,
+                                  -to.low + glm::length(from.normal + to.normal) * to.radius});
   const float reach = glm::dot(from.normal, d) + to_high - from.low + from.spread * far;
-  return reach <= kPlaneSlack * near;
+  // (Plus rounding: two clusters in one plane lie on it to within float precision of their size.)
+  return reach <= kPlaneSlack * near + 1e-6f * far;
 }
 
 /// The same with a point receiver (p, n) as `to`: the node sends nothing to it.
