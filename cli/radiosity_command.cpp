@@ -209,18 +209,25 @@ void check_radiosity(const rc::scene::Scene& scene, const radiosity::solver::Sol
   const rc::util::ThreadLimit limit(o.solver.threads);
   // The check's own irradiance bake gathers every point, past any deadline.
   run.gather.deadline = std::chrono::steady_clock::time_point::max();
+  // Each point is compared on the side of its face the bake read there.
+  std::optional<radiosity::bake::SolutionAtInput> reader;
+  radiosity::bake::BakedSide side;
+  if (run.lightmap || run.onto_input) {
+    reader.emplace(scene, sol, radiosity::bake::Quantity::irradiance);
+    side = [&reader](const rc::Vec3& p, const rc::Vec3& n) { return reader->side(p, n); };
+  }
   if (run.lightmap) {
     const radiosity::bake::Lightmap e = ex.quantity == radiosity::bake::Quantity::irradiance
                                       ? *run.atlas
                                       : radiosity::bake::bake_lightmap(scene, sol, radiosity::bake::Quantity::irradiance, o.lightmap, run.gather);
-    run.surface_check = radiosity::bake::check_lightmap(scene, e, o.check);
+    run.surface_check = radiosity::bake::check_lightmap(scene, e, o.check, side);
   } else if (run.onto_input) {
     // The colours as irradiance, at random points inside the input's faces.
     const radiosity::bake::InputColours e =
         ex.quantity == radiosity::bake::Quantity::irradiance
             ? *run.onto
             : radiosity::bake::fit_input_colours(scene, sol, run.fit, radiosity::bake::Quantity::irradiance, run.gather);
-    run.surface_check = radiosity::bake::check_input_colours(scene, e, o.check);
+    run.surface_check = radiosity::bake::check_input_colours(scene, e, o.check, side);
   } else {
     run.check = radiosity::bake::check_against_path_tracer(scene, run.exported(sol), o.check);
     // And at random points inside the input's faces, read from the elements as written: the

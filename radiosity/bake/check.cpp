@@ -335,7 +335,8 @@ void score_points(std::vector<CheckedPoint>& points, size_t used, double referen
 /// settings.points points by area over the faces of the scene meshes `drawn_from(m)` accepts
 /// (mirrors and glass never), path-traces the irradiance at each and compares it with `baked_at`.
 SurfaceCheckResult check_baked(const rc::scene::Scene& scene, const std::function<bool(size_t)>& drawn_from,
-                               const BakedAt& baked_at, const CheckSettings& settings, Sides sides) {
+                               const BakedAt& baked_at, const CheckSettings& settings, Sides sides,
+                               const BakedSide& side = {}) {
   settings.validate();
   const auto start = std::chrono::steady_clock::now();
   std::vector<float> area;
@@ -351,12 +352,13 @@ SurfaceCheckResult check_baked(const rc::scene::Scene& scene, const std::functio
     rc::util::Rng rng = rc::util::Rng::for_item(settings.seed, i, 0x5eed0f00ull);
     const CheckFace& face = faces[pick.sample(rng.uniform())];
     drawn[i] = draw_point(scene, face, rng, sides);
+    if (side) drawn[i].point.normal = side(drawn[i].point.position, drawn[i].point.normal);
     trace_point(scene, drawn[i], i, step, path, settings);
   });
   // What counts as no light is known once the points are traced; with Sides::lit, the points
   // whose front has none are traced again on their back.
   double unlit = kUnlitFraction * mean_traced(drawn);
-  if (sides == Sides::lit) {
+  if (sides == Sides::lit && !side) {
     rc::util::parallel_for(count, [&](size_t i) {
       PointInCheck& at = drawn[i];
       if (at.blocked || at.face_buried || at.mean.average() > unlit) return;
@@ -426,7 +428,7 @@ void write_check_points(const std::string& path, const CheckResult& result) {
 }
 
 SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const InputColours& irradiance,
-                                       const CheckSettings& settings) {
+                                       const CheckSettings& settings, const BakedSide& side) {
   const auto baked_on = [&](size_t m) {
     return irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty() : !irradiance.per_mesh[m].empty();
   };
@@ -444,10 +446,11 @@ SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const Inpu
   };
   return check_baked(
       scene, [&](size_t m) { return scene.meshes[m].origin.file == irradiance.file && baked_on(m); },
-      baked_at, settings, Sides::lit);
+      baked_at, settings, Sides::lit, side);
 }
 
-SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings) {
+SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance,
+                                  const CheckSettings& settings, const BakedSide& side) {
   return check_baked(
       scene,
       [&](size_t m) {
@@ -456,7 +459,7 @@ SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap&
       [&](const DrawnPoint& at) -> std::optional<Rgb> {
         return irradiance.at(at.mesh, at.triangle, at.weight[1], at.weight[2]);
       },
-      settings, Sides::lit);
+      settings, Sides::lit, side);
 }
 
 SurfaceCheckResult check_element_colours(const rc::scene::Scene& scene, const RadiosityMesh& exported,

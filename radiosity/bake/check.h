@@ -4,6 +4,7 @@
 // reader knows which differences the check can resolve.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -110,17 +111,22 @@ void write_check_points(const std::string& path, const CheckResult& result);
 /// and a point with something lying on it (the path tracer's ray hits another surface) is left out,
 /// and so is a buried point (input_triangle_buried for its face, which the fit leaves out, or
 /// input_point_buried for the point: inside a closed solid or under an object) or one no
-/// path-traced sample brings any light to: no one sees their colour. A point is compared on its
-/// face's front, or on its back where no light reaches the front (a surface wound against the
-/// side it is seen from, which the bake reads from the back: SolutionAtInput).
+/// path-traced sample brings any light to: no one sees their colour. A point is compared on the
+/// side `side` names, or without it on its face's front, or its back where no light reaches the
+/// front.
+/// `side`, when given, names the side the bake read at each point (SolutionAtInput::side: its
+/// arguments the point and its face's unit normal as wound, its result that normal or its
+/// negation), and the point is compared there.
+using BakedSide = std::function<Vec3(const Vec3& p, const Vec3& face_normal)>;
 SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const InputColours& irradiance,
-                                       const CheckSettings& settings);
+                                       const CheckSettings& settings, const BakedSide& side = {});
 
 struct Lightmap;  // radiosity/bake/lightmap.h
 
 /// The same check for a lightmap of irradiance (`--lightmap`): the baked value at each point is
 /// the atlas read bilinearly at the point's UV, as a viewer reads it.
-SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance, const CheckSettings& settings);
+SurfaceCheckResult check_lightmap(const rc::scene::Scene& scene, const Lightmap& irradiance,
+                                  const CheckSettings& settings, const BakedSide& side = {});
 
 /// The same check for gilt's element mesh as exported (`--onto elements`), at the same random
 /// points inside the input's faces, drawn over every input mesh the mesher meshes (mirrors and

@@ -54,32 +54,50 @@ SolutionAtInput::SolutionAtInput(const rc::scene::Scene& scene, const Solution& 
   exact_direct_ = !delta_lights_.empty() && solution.vertex_punctual.size() == solution.mesh.vertex_count();
 }
 
-std::optional<Rgb> SolutionAtInput::operator()(const rc::scene::Material& m, const Vec3& p,
-                                               const Vec3& face_normal) const {
-  // The side to read: the face's front (as it is wound), unless an element lies nearer on its
-  // back, facing the other way (the mesher turned the surface over: light reaches only its back).
-  // Where both sides have an element lying on them (light reaches both), the front's is read, as
-  // a viewer shows a vertex colour on both sides.
+SolutionAtInput::Side SolutionAtInput::choose(const Vec3& p, const Vec3& face_normal) const {
+  // The side to read: the one whose element lies on the point, the nearer where only one does
+  // (the mesher turned the surface over where light reaches only its back). Where light reaches
+  // both sides, an element lies on each: the one the mesher made from the surface (not its twin)
+  // is read, so that every face of a piece reads the same side however each face is wound (a
+  // model wound face by face at random would otherwise blend its two sides at every shared
+  // vertex), and the face's front where neither is a twin (two sheets back to back).
+  Side out;
   const std::optional<RadiosityView::Location> front = view_.locate(p, face_normal);
   const std::optional<RadiosityView::Location> back = view_.locate(p, -face_normal);
   const float on = 1e-4f * view_.reach();
-  const bool use_back = back && (!front || back->distance + on < front->distance);
-  const std::optional<RadiosityView::Location> at = use_back ? back : front;
-  if (!at) return std::nullopt;
-  const Vec3 n = use_back ? -face_normal : face_normal;
+  bool use_back = back && (!front || back->distance + on < front->distance);
+  out.both = front && back && std::abs(back->distance - front->distance) <= on;
+  if (out.both) use_back = solution_.mesh.twin(front->element) && !solution_.mesh.twin(back->element);
+  out.at = use_back ? back : front;
+  out.normal = use_back ? -face_normal : face_normal;
+  out.back = use_back;
+  out.other = use_back ? front : back;
+  return out;
+}
+
+Vec3 SolutionAtInput::side(const Vec3& p, const Vec3& face_normal) const {
+  return choose(p, face_normal).normal;
+}
+
+std::optional<Rgb> SolutionAtInput::operator()(const rc::scene::Material& m, const Vec3& p,
+                                               const Vec3& face_normal) const {
+  const Side side = choose(p, face_normal);
+  if (!side.at) return std::nullopt;
+  const Vec3& n = side.normal;
   ++points_;
-  if (use_back) {
-    ++back_;
-  } else if (back && back->distance <= front->distance + on) {
+  back_ += side.back;
+  if (side.both) {
     const auto irradiance = [&](const RadiosityView::Location& l) {
       const auto& c = solution_.mesh.elements[l.element];
       const std::vector<Rgb>& e = solution_.vertex_irradiance;
       return (e[c[0]] * (1.0f - l.u - l.v) + e[c[1]] * l.u + e[c[2]] * l.v).average();
     };
-    const float a = irradiance(*front), b = irradiance(*back);
+    const float a = irradiance(*side.at), b = irradiance(*side.other);
     if (std::max(a, b) > kSidesDiffer * std::min(a, b)) ++differ_;
   }
-  const Rgb e = gather_.rays > 0 && std::chrono::steady_clock::now() < gather_.deadline ? gathered(p, n) : read(*at, p, n);
+  const Rgb e = gather_.rays > 0 && std::chrono::steady_clock::now() < gather_.deadline
+                    ? gathered(p, n)
+                    : read(*side.at, p, n);
   const Rgb radiosity = m.emission * rc::kPi + rc::scene::diffuse_reflectance(m) * e;
   return quantity_ == Quantity::irradiance ? e : quantity_ == Quantity::radiosity ? radiosity : radiosity / rc::kPi;
 }

@@ -100,7 +100,21 @@ class SolutionAtInput {
   std::optional<Rgb> operator()(const rc::scene::Material& m, const Vec3& p, const Vec3& n) const;
   BakeGatherCount gather_count() const { return {gathered_.load(), late_.load()}; }
   BakeSides sides_count() const { return {points_.load(), back_.load(), differ_.load()}; }
+  /// The side of the input face at p, with unit normal `face_normal` as wound, that a bake
+  /// reads there: `face_normal` or its negation (see choose() in onto_input.cpp).
+  Vec3 side(const Vec3& p, const Vec3& face_normal) const;
 
+ private:
+  /// Which element a point reads, on which side (see choose()).
+  struct Side {
+    std::optional<RadiosityView::Location> at, other;  ///< the element read; the one on the other side
+    Vec3 normal{0.0f};                                 ///< the side read
+    bool back = false;                                 ///< against the face's winding
+    bool both = false;                                 ///< an element lies on the point on each side
+  };
+  Side choose(const Vec3& p, const Vec3& face_normal) const;
+
+ public:
  private:
   Rgb gathered(const Vec3& p, const Vec3& n) const;
   Rgb read(const RadiosityView::Location& at, const Vec3& p, const Vec3& n) const;

@@ -56,12 +56,14 @@ struct RadiosityMesh {
   std::vector<uint32_t> element_surface;         ///< which input mesh (or sphere) it came from
   std::vector<Vec3> element_normal;              ///< unit geometric normal (front)
   std::vector<float> element_area;               ///< scene units²
-  /// Per element, 1 for an element given a twin lying on it facing the other way, and for the
+  /// Per element, 1 for an element given a twin lying on it facing the other way, and 2 for the
   /// twin (a surface lit on both sides has an element, and a radiosity, per side: sides.h); empty
   /// when no element has one.
   std::vector<uint8_t> element_two_sided;
 
   bool two_sided(size_t e) const { return !element_two_sided.empty() && element_two_sided[e] != 0; }
+  /// Whether element e is a twin (made behind another by orient_sides: element_two_sided 2).
+  bool twin(size_t e) const { return !element_two_sided.empty() && element_two_sided[e] == 2; }
 
   size_t vertex_count() const { return positions.size(); }
   size_t element_count() const { return elements.size(); }

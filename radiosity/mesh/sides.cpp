@@ -243,7 +243,7 @@ void add_backs(RadiosityMesh& mesh, const std::vector<uint32_t>& vertex_piece, c
     mesh.element_normal.push_back(-mesh.element_normal[e]);
     mesh.element_area.push_back(mesh.element_area[e]);
     mesh.element_two_sided[e] = 1;
-    mesh.element_two_sided.push_back(1);
+    mesh.element_two_sided.push_back(2);
     ++*doubled;
   }
 }
