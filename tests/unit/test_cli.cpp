@@ -240,15 +240,18 @@ TEST_F(Cli, CtrlCStopsARenderWithCode130AndNoOutput) {
   // A render of minutes, sent SIGINT once gilt has installed its handler (the SigCgt mask of
   // /proc/PID/status has SIGINT's bit, the last hex digit's 2: a fixed sleep was not enough under
   // AddressSanitizer on a loaded machine, and before its handler the shell's background job
-  // ignores SIGINT). It must stop at its next tile, exit with 130 and leave the existing file as
+  // ignores SIGINT). The process must be gilt by then (its comm): the shell's child, before it
+  // runs gilt, can show the shell's own SIGINT handler, and a SIGINT sent then was ignored once
+  // gilt started under AddressSanitizer (the render ran on until the watchdog killed it). It must stop at its next tile, exit with 130 and leave the existing file as
   // it was. A watchdog kills it after 60 s should it not stop: the test fails, not hangs.
   const fs::path out = write("keep.exr", "previous contents");
   const Result r = gilt::test::run_command(
       std::string("{ '") + GILT_BINARY_PATH + "' render cornell --spp 1000000 --width 64 --height 64 --threads 1 -q -o " +
           out.string() +
           " & g=$!; ( sleep 60; kill -KILL $g 2>/dev/null ) & w=$!; i=0; while [ $i -lt 1200 ]; do "
-          "m=$(awk '/^SigCgt/ {print $2}' /proc/$g/status 2>/dev/null); case \"${m#${m%?}}\" in 2|3|6|7|a|b|e|f) "
-          "break;; esac; i=$((i + 1)); sleep 0.05; done; sleep 0.2; t0=$(date +%s%N); kill -INT $g; wait $g; "
+          "c=$(cat /proc/$g/comm 2>/dev/null); m=$(awk '/^SigCgt/ {print $2}' /proc/$g/status 2>/dev/null); "
+          "if [ \"$c\" = gilt ]; then case \"${m#${m%?}}\" in 2|3|6|7|a|b|e|f) break;; esac; fi; "
+          "i=$((i + 1)); sleep 0.05; done; sleep 0.2; t0=$(date +%s%N); kill -INT $g; wait $g; "
           "code=$?; t1=$(date +%s%N); kill $w 2>/dev/null; echo \"exit $code\"; echo \"stopped_ms "
           "$(( (t1 - t0) / 1000000 ))\"; }",
       dir_);
