@@ -1,6 +1,7 @@
 #include "radiosity/mesh/element_albedo.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/util/parallel.h"
@@ -24,6 +25,22 @@ rc::Vec2 uv_at(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x
   return (1.0f - b1 - b2) * mesh.uvs[c[0]] + b1 * mesh.uvs[c[1]] + b2 * mesh.uvs[c[2]];
 }
 
+/// Whether x lies on triangle `prim` of `mesh`: its projection inside the triangle (with a
+/// margin of 1e-4 of the edges) and x within `slack` of its plane.
+bool lies_on(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x, float slack) {
+  const uint32_t* c = &mesh.indices[3 * size_t(prim)];
+  const Vec3 p0 = mesh.positions[c[0]], e1 = mesh.positions[c[1]] - p0, e2 = mesh.positions[c[2]] - p0;
+  const Vec3 d = x - p0, n = glm::cross(e1, e2);
+  const float n_len = glm::length(n);
+  if (!(n_len > 0.0f) || std::abs(glm::dot(d, n)) > slack * n_len) return false;
+  const float a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2);
+  const float det = a11 * a22 - a12 * a12;
+  const float b1 = (a22 * glm::dot(d, e1) - a12 * glm::dot(d, e2)) / det;
+  const float b2 = (a11 * glm::dot(d, e2) - a12 * glm::dot(d, e1)) / det;
+  constexpr float kMargin = 1e-4f;
+  return b1 >= -kMargin && b2 >= -kMargin && b1 + b2 <= 1.0f + kMargin;
+}
+
 }  // namespace
 
 std::vector<rc::Rgb> element_reflectance(const rc::scene::Scene& scene, const RadiosityMesh& mesh) {
@@ -45,19 +62,34 @@ std::vector<rc::Rgb> element_reflectance(const rc::scene::Scene& scene, const Ra
       const float reach = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
       constexpr int kSide = 4;
       const Vec3 step1 = (p1 - p0) * (1.0f / kSide), step2 = (p2 - p0) * (1.0f / kSide);
+      // Most samples lie on the input triangle the one before found (an element is seldom cut
+      // by an input edge): it is kept while they lie on it, to within 1e-5 of the element's size
+      // off its plane (plus the rounding of coordinates this far from the origin), and the search
+      // runs only when one does not.
+      const float on_plane =
+          1e-5f * reach + 1e-6f * std::max({std::abs(p0.x), std::abs(p0.y), std::abs(p0.z)});
+      uint32_t last = ~0u;
       rc::Rgb sum(0.0f);
       int found = 0;
       for (int i = 0; i < kSide; ++i)
         for (int j = 0; j < kSide; ++j) {
           const rc::Vec2 w = rc::util::sample_uniform_triangle({(i + 0.5f) / kSide, (j + 0.5f) / kSide});
           const Vec3 x = (1.0f - w.x - w.y) * p0 + w.x * p1 + w.y * p2;
-          // An element turned over, or the back twin of one, faces against its input face.
-          std::optional<rc::scene::Hit> h = scene.nearest_triangle(s, x, reach, mesh.element_normal[e], 0.5f);
-          if (!h) h = scene.nearest_triangle(s, x, reach, -mesh.element_normal[e], 0.5f);
-          if (!h) continue;
+          if (last == ~0u || !lies_on(input, last, x, on_plane)) {
+            // An element turned over, or the twin of one, faces against its input face: the
+            // nearer of the faces facing either way, not the nearest facing the element's way
+            // (on a turned sheet that was another surface a tenth of the element away).
+            std::optional<rc::scene::Hit> h =
+                scene.nearest_triangle(s, x, reach, mesh.element_normal[e], 0.5f);
+            const std::optional<rc::scene::Hit> back =
+                scene.nearest_triangle(s, x, reach, -mesh.element_normal[e], 0.5f);
+            if (back && (!h || back->t < h->t)) h = back;
+            if (!h) continue;
+            last = h->prim_id;
+          }
           // The footprint: this point's share of the element, as the found triangle maps it.
-          const rc::Vec2 uv = uv_at(input, h->prim_id, x);
-          const rc::Vec2 dx = uv_at(input, h->prim_id, x + step1) - uv, dy = uv_at(input, h->prim_id, x + step2) - uv;
+          const rc::Vec2 uv = uv_at(input, last, x);
+          const rc::Vec2 dx = uv_at(input, last, x + step1) - uv, dy = uv_at(input, last, x + step2) - uv;
           sum += textures->lookup(t.image, t.st(uv), t.st_delta(dx), t.st_delta(dy)).rgb;
           ++found;
         }
