@@ -1,5 +1,5 @@
 #pragma once
-// Small scenes and helpers shared by the ray-core tests.
+// Small scenes and helpers shared by the tests.
 
 #include <cmath>
 #include <cstdint>
@@ -44,6 +44,23 @@ inline rc::scene::TriangleMesh icosphere(int levels, uint32_t material = 0) {
   mesh.indices = std::move(f);
   mesh.material = material;
   return mesh;
+}
+
+/// A quad (a, b, c, d) as two triangles, counter-clockwise seen from its front.
+inline rc::scene::TriangleMesh quad(rc::Vec3 a, rc::Vec3 b, rc::Vec3 c, rc::Vec3 d) {
+  rc::scene::TriangleMesh m;
+  m.name = "quad";
+  m.positions = {a, b, c, d};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+/// A uniform sky of `radiance`.
+inline rc::scene::Light uniform_sky(float radiance) {
+  rc::scene::Light l;
+  l.kind = rc::scene::LightKind::environment;
+  l.radiance = rc::Rgb(radiance);
+  return l;
 }
 
 /// Mean of all pixels of a film, per channel averaged.

@@ -11,8 +11,10 @@
 #include "photonmap/photon_map.h"
 #include "raytrace_core/scene/light.h"
 #include "raytrace_core/util/rng.h"
+#include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;
+using gilt::test::quad;
 namespace pm = gilt::photonmap;
 
 namespace {
@@ -31,14 +33,6 @@ double brute_force(const rc::Vec3& a, const rc::Vec3& b, const rc::Vec3& c, cons
         sum += std::max(0.0, 1.0 - glm::dot(y - glm::dvec3(p), y - glm::dvec3(p)) / r2);
       }
   return sum * piece;
-}
-
-rc::scene::TriangleMesh quad(rc::Vec3 a, rc::Vec3 b, rc::Vec3 c, rc::Vec3 d) {
-  rc::scene::TriangleMesh m;
-  m.name = "quad";
-  m.positions = {a, b, c, d};
-  m.indices = {0, 1, 2, 0, 2, 3};
-  return m;
 }
 
 /// A 2 × 2 floor at y = 0 facing up, and a wall at x = 1 facing −x, both diffuse.

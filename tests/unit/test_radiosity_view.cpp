@@ -7,25 +7,19 @@
 #include <tuple>
 #include <utility>
 
-#include "radiosity/solver/solver.h"
 #include "radiosity/bake/view.h"
 #include "radiosity/mesh/element_scene.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/render/path_tracer.h"
+#include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;
+using gilt::test::quad;
 namespace rad = gilt::radiosity;
 using rc::Rgb;
 using rc::Vec3;
 
 namespace {
-
-/// A quad (a, b, c, d), counter-clockwise seen from its front.
-rc::scene::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-  rc::scene::TriangleMesh m;
-  m.positions = {a, b, c, d};
-  m.indices = {0, 1, 2, 0, 2, 3};
-  return m;
-}
 
 /// Gives `scene` (its meshes added, all of material 0) a white diffuse material (0.8) and a sun
 /// of unit irradiance travelling along `sun_direction`, commits it, and solves it with elements

@@ -13,21 +13,15 @@
 #include "radiosity/mesh/mesh.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/scene/scene.h"
+#include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;
+using gilt::test::quad;
 namespace rad = gilt::radiosity;
 using rc::Rgb;
 using rc::Vec3;
 
 namespace {
-
-/// A quad (a, b, c, d), counter-clockwise seen from its front.
-rc::scene::TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-  rc::scene::TriangleMesh m;
-  m.positions = {a, b, c, d};
-  m.indices = {0, 1, 2, 0, 2, 3};
-  return m;
-}
 
 /// The cube [-1, 1]³ as one closed mesh, its faces wound to face out (or in).
 rc::scene::TriangleMesh cube(bool outward) {
@@ -43,13 +37,6 @@ rc::scene::TriangleMesh cube(bool outward) {
       m.indices.insert(m.indices.end(), {f[0], f[2], f[1], f[0], f[3], f[2]});
   }
   return m;
-}
-
-rc::scene::Light sky(float radiance) {
-  rc::scene::Light l;
-  l.kind = rc::scene::LightKind::environment;
-  l.radiance = Rgb(radiance);
-  return l;
 }
 
 rc::scene::Light point_light(Vec3 at, float intensity) {
@@ -108,7 +95,7 @@ TEST(Sides, ARoomWoundOutwardIsTurnedOver) {
 TEST(Sides, ASolidBlockUnderTheSkyIsLeftAsItIs) {
   rc::scene::Scene scene;
   scene.meshes.push_back(cube(/*outward=*/true));
-  scene.punctual_lights.push_back(sky(1.0f));
+  scene.punctual_lights.push_back(gilt::test::uniform_sky(1.0f));
   const rad::mesh::MeshReport report = mesh_of(scene);
   EXPECT_EQ(report.turned_elements, 0u);
   EXPECT_EQ(report.two_sided_elements, 0u);
@@ -118,7 +105,7 @@ TEST(Sides, ASolidBlockUnderTheSkyIsLeftAsItIs) {
 TEST(Sides, ASheetUnderTheSkyIsLitOnBothSides) {
   rc::scene::Scene scene;
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));
-  scene.punctual_lights.push_back(sky(1.0f));
+  scene.punctual_lights.push_back(gilt::test::uniform_sky(1.0f));
   rad::mesh::RadiosityMesh mesh;
   const rad::mesh::MeshReport report = mesh_of(scene, &mesh);
   EXPECT_EQ(report.turned_elements, 0u);
@@ -139,7 +126,7 @@ TEST(Sides, SheetsBackToBackGetNoTwins) {
   rc::scene::Scene scene;
   scene.meshes.push_back(quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}));  // up
   scene.meshes.push_back(quad({-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}));  // down
-  scene.punctual_lights.push_back(sky(1.0f));
+  scene.punctual_lights.push_back(gilt::test::uniform_sky(1.0f));
   rad::mesh::RadiosityMesh mesh;
   const rad::mesh::MeshReport report = mesh_of(scene, &mesh);
   EXPECT_EQ(report.turned_elements, 0u);
