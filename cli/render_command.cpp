@@ -146,9 +146,14 @@ void run_render(const RenderOptions& o) {
                 double(stats.rays) / secs * 1e-6);
     std::printf("  samples: %llu, %.3f Msamples/s\n", static_cast<unsigned long long>(stats.samples),
                 double(stats.samples) / secs * 1e-6);
-    if (solution)
+    if (solution) {
       std::printf("  solve:   %zu elements, %llu shots, residual %.3g, %.3f s\n", solution->mesh.element_count(),
                   static_cast<unsigned long long>(solution->shots), solution->residual, solution->seconds);
+      if (!solution->vertex_ambient.empty())
+        std::printf(
+            "  ambient: the unshot light gathered where it lands (%.0f %% of its rays left the scene)\n",
+            100.0 * solution->ambient_escaped);
+    }
     if (photon)
       std::printf("  photons: %zu global, %zu caustic stored from %llu paths in %.3f s; %zu irradiance points in %.3f s\n",
                   photon->global_photons, photon->caustic_photons, static_cast<unsigned long long>(photon->paths),

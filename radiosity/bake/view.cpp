@@ -88,10 +88,13 @@ RadiosityView::RadiosityView(const rc::scene::Scene& scene, const Solution& solu
   for (size_t v = 0; v < nv; ++v) {
     const Rgb rho = v < solution.vertex_albedo.size() ? solution.vertex_albedo[v] : rc::scene::diffuse_reflectance(scene.materials[mesh.vertex_material[v]]);
     vertex_radiance_[v] = solution.vertex_radiance(v);
-    if (ambient) vertex_radiance_[v] += rho * solution.ambient * (1.0f / rc::kPi);
+    const Rgb ambient_irradiance =
+        !ambient ? Rgb(0.0f)
+                 : (v < solution.vertex_ambient.size() ? solution.vertex_ambient[v] : solution.ambient);
+    vertex_radiance_[v] += rho * ambient_irradiance * (1.0f / rc::kPi);
     Rgb indirect = solution.vertex_irradiance[v] - solution.vertex_direct[v];
     for (int k = 0; k < 3; ++k) indirect[k] = std::max(0.0f, indirect[k]);
-    vertex_indirect_[v] = indirect + (ambient ? solution.ambient : Rgb(0.0f));
+    vertex_indirect_[v] = indirect + ambient_irradiance;
     // Overshooting leaves some unshot light negative, and the ambient term with it: where little
     // light arrives, a vertex would read below zero (the outward-wound atrium's mesh view had 4 %
     // of its pixel values negative). Light is never negative.

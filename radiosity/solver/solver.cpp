@@ -22,6 +22,7 @@
 
 #include "radiosity/mesh/element_albedo.h"
 #include "radiosity/mesh/element_scene.h"
+#include "radiosity/solver/ambient_gather.h"
 #include "radiosity/solver/element_direct.h"
 #include "radiosity/solver/form_factor.h"
 #include "radiosity/solver/probe_fraction.h"
@@ -979,8 +980,9 @@ struct SolveState {
       const double done = std::clamp(std::log(sol.residual) / std::log(settings.tolerance), 0.0, 1.0);
       if (uint64_t(done * 1000) > shown) progress.advance(uint64_t(done * 1000) - shown), shown = uint64_t(done * 1000);
       if (sol.residual < settings.tolerance) break;
-      // A shot takes about as long as the last one: stop before one would end past the budget.
-      if (over_solve_limit(elapsed() + shot.last_shot)) break;
+      // A shot takes about as long as the last one: stop before one would end past the budget,
+      // and the ambient gather after it.
+      if (over_solve_limit(elapsed() + shot.last_shot + ambient_gather_seconds(shot))) break;
       const double shot_start = elapsed();
       aim(shot, src, best_signed);
       shoot(shot, src);
@@ -991,7 +993,33 @@ struct SolveState {
     // they disagree a dim vertex can be left below zero, which no irradiance is: held at zero.
     for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
     keep_ambient(shot);
+    const int gather_rays = ambient_gather_rays(shot);
+    if (sol.residual > settings.tolerance && gather_rays > 0) {
+      AmbientGather gathered =
+          gather_ambient(receivers.geometry, mesh, shot.patches.offsets, shot.patches.elements, shot.unshot,
+                         sol.element_albedo, gather_rays, settings.seed);
+      rays += gathered.rays;
+      sol.vertex_ambient = std::move(gathered.vertex_ambient);
+      sol.ambient_escaped = gathered.escaped;
+    }
     sol.shoot_seconds = elapsed() - shoot_start;
+  }
+
+  /// Foretold seconds of gather_ambient with kAmbientRaysPerPatch rays at the vertices' direct
+  /// light's rate (a closest hit costs about twice a shadow ray); 0 untimed. The shots keep it back.
+  double ambient_gather_seconds(const Shooting& shot) const {
+    if (!(settings.time_limit > 0.0) || !(direct_rays_per_second > 0.0)) return 0.0;
+    return 2.0 * double(shot.patches.count()) * kAmbientRaysPerPatch / direct_rays_per_second;
+  }
+
+  /// Gather rays per patch for the time left: kAmbientRaysPerPatch, fewer where the last shot
+  /// took more than foretold, and none below kAmbientLeastRays (Cohen's term is used then).
+  int ambient_gather_rays(const Shooting& shot) const {
+    const double seconds = ambient_gather_seconds(shot);
+    if (!(seconds > 0.0)) return kAmbientRaysPerPatch;
+    const double left = group.broadcast_value(solve_limit() - elapsed());
+    const int rays = int(std::min(1.0, std::max(0.0, left) / seconds) * kAmbientRaysPerPatch);
+    return rays >= kAmbientLeastRays ? rays : 0;
   }
 
   /// Copies the hierarchical solve's result into the solution, its interreflection added to

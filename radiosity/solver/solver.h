@@ -112,6 +112,11 @@ struct Solution {
   /// solution only (Cohen, Chen, Wallace & Greenberg 1988): the area-weighted mean unshot
   /// radiosity times the interreflection factor 1 / (1 − ρ̄). Never part of exported values.
   Rgb ambient{0.0f};
+  /// Progressive, stopped before its tolerance: the ambient term gathered where the unshot light
+  /// lands (ambient_gather.h), irradiance (W·m⁻²) per vertex, which displays use in place of
+  /// `ambient`; empty otherwise. Never part of exported values.
+  std::vector<Rgb> vertex_ambient;
+  double ambient_escaped = 0.0;  ///< the share of the ambient gather's rays that met no surface
   double seconds = 0.0;
   double seconds_kept_back = 0.0;  ///< of the time limit, for what follows the solve (see SolverSettings::after_seconds)
   /// Where the time went: meshing, the direct light with adaptive subdivision, and the
