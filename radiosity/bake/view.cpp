@@ -25,6 +25,7 @@ using solver::Solution;
 using solver::SolverSettings;
 
 SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
+  settings.gather_ambient = true;  // both views show a partial solution's ambient term
   if (mode == ViewMode::two_pass) {
     settings.subdivision_levels = 0;
     settings.hierarchical.final_gather = FinalGather::never;

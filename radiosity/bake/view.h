@@ -34,7 +34,8 @@ inline constexpr double kTwoPassLinkTolerance = 2e-5;
 /// The solver settings a view of the solution needs: the two-pass view takes the direct light
 /// and the last bounce per pixel, so its solve skips adaptive subdivision at shadow boundaries
 /// and the hierarchical solver's vertex final gather, and links at kTwoPassLinkTolerance unless
-/// a tolerance is set; the mesh view shows the vertices as they are and needs them all.
+/// a tolerance is set; the mesh view shows the vertices as they are and needs them all. Both
+/// gather a partial solution's unshot light for its ambient term (SolverSettings::gather_ambient).
 solver::SolverSettings solver_settings_for(ViewMode mode, solver::SolverSettings settings);
 
 /// Display of a solution; radiance() is a RadianceFunction for raytrace_core::render::render_image.

@@ -994,7 +994,7 @@ struct SolveState {
     for (Rgb& e : sol.vertex_irradiance) e = Rgb(std::max(e.r, 0.0f), std::max(e.g, 0.0f), std::max(e.b, 0.0f));
     keep_ambient(shot);
     const int gather_rays = ambient_gather_rays(shot);
-    if (sol.residual > settings.tolerance && gather_rays > 0) {
+    if (settings.gather_ambient && sol.residual > settings.tolerance && gather_rays > 0) {
       AmbientGather gathered =
           gather_ambient(receivers.geometry, mesh, shot.patches.offsets, shot.patches.elements, shot.unshot,
                          sol.element_albedo, gather_rays, settings.seed);
@@ -1008,7 +1008,8 @@ struct SolveState {
   /// Foretold seconds of gather_ambient with kAmbientRaysPerPatch rays at the vertices' direct
   /// light's rate (a closest hit costs about twice a shadow ray); 0 untimed. The shots keep it back.
   double ambient_gather_seconds(const Shooting& shot) const {
-    if (!(settings.time_limit > 0.0) || !(direct_rays_per_second > 0.0)) return 0.0;
+    if (!settings.gather_ambient || !(settings.time_limit > 0.0) || !(direct_rays_per_second > 0.0))
+      return 0.0;
     return 2.0 * double(shot.patches.count()) * kAmbientRaysPerPatch / direct_rays_per_second;
   }
 

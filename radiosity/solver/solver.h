@@ -61,6 +61,10 @@ struct SolverSettings {
   int subdivision_levels = 2;          ///< adaptive subdivision may halve the mesh's edge this many times
   double subdivision_threshold = 0.6;  ///< bisect an element whose vertices' direct irradiance spreads by more
                                        ///< than this fraction of the brightest
+  /// Progressive refinement stopped before its tolerance gathers its unshot light for a display's
+  /// ambient term (Solution::vertex_ambient; solver_settings_for in radiosity/bake/view.h sets it).
+  /// Exports never show the ambient term, so they leave the time to the shots.
+  bool gather_ambient = false;
   uint64_t seed = 0;
   int threads = 0;           ///< 0 = all
   bool progress = true;
