@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -19,9 +21,12 @@
 
 #include "radiosity/mesh/mesh_detail.h"
 #include "radiosity/mesh/sides.h"
+#include "raytrace_core/scene/light.h"
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/progress.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace gilt::radiosity::mesh {
 namespace detail {
@@ -338,11 +343,58 @@ std::vector<DVec3> burial_directions() {
 /// scene whose surfaces face the wrong way, and then nothing is removed.
 constexpr double kMaxBuriedShare = 0.25;
 
+/// Walks from the back of an open sheet that light could still reach: kLightWalks walks of up to
+/// kLightWalkBounces diffuse bounces each.
+constexpr int kLightWalks = 8, kLightWalkBounces = 4;
+
+/// Whether light reaches the point `at` (on the side its normal faces) within a few diffuse
+/// bounces, as orient_sides asks of the meshed pieces: a shadow ray to a light drawn at random
+/// arrives, a ray escapes to a lit sky, or one meets a surface emitting towards it; glass lets
+/// light through. Every surface met is taken as reflecting on the side met. Seeded by the point.
+bool light_reaches(const rc::scene::Scene& scene, const rc::scene::SurfacePoint& at) {
+  const std::vector<rc::scene::Light>& lights = scene.lights();
+  uint64_t key = 0;
+  std::memcpy(&key, &at.p, sizeof(float) * 2);
+  key ^= uint64_t(std::bit_cast<uint32_t>(at.p.z)) * 0x9e3779b97f4a7c15ull;
+  for (int walk = 0; walk < kLightWalks; ++walk) {
+    rc::util::Rng rng = rc::util::Rng::for_item(0xb0e1ull, key, uint64_t(walk));
+    rc::scene::SurfacePoint sp = at;
+    for (int bounce = 0; bounce < kLightWalkBounces; ++bounce) {
+      const Vec3 n = sp.ng;
+      if (!lights.empty()) {
+        const rc::scene::Light& light = lights[rng.next_u32() % lights.size()];
+        const rc::scene::LightSample ls = rc::scene::sample_light(scene, light, sp, rng.uniform2(), n);
+        if (!ls.radiance.is_black() && glm::dot(ls.wi, n) > 0.0f && !scene.occluded(ls.shadow_ray)) return true;
+      }
+      const Vec3 w = rc::Frame::from_normal(n).to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
+      const rc::scene::Ray ray = rc::scene::spawn_ray(sp, w);
+      const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
+      if (!hit) {
+        if (!rc::scene::escaped_radiance(scene.punctual_lights, w).is_black()) return true;
+        break;
+      }
+      const rc::scene::SurfaceInteraction si = scene.surface(ray, *hit);
+      const rc::scene::Material& m = scene.materials[si.material];
+      if (m.kind == rc::scene::MaterialKind::dielectric) return true;
+      if (m.is_emissive() && !rc::scene::emitted_radiance(m, si.ng, -w).is_black()) return true;
+      sp = si;
+      if (glm::dot(sp.ng, w) > 0.0f) sp.ng = -sp.ng;  // the side the walk met
+    }
+  }
+  return false;
+}
+
 /// Whether every test ray from `at` over its front hemisphere (see burial_directions) first
-/// hits the back of an opaque surface, and the camera cannot see the point.
+/// hits the back of an opaque surface, no light reaches the point, and the camera cannot see it.
+/// Inside a closed surface nothing more is asked. Behind an open sheet it is: a floor slab
+/// modelled as one quad facing up may have a room under it, lit through its windows, or the
+/// space over a furnace's floor, lit by every surface round it (the furnace family's dome lost
+/// the middle of its enclosure's floor, 2 % of its light, that way), while the floor under a
+/// block that has no bottom face is as dark as the floor under a closed one.
 bool enclosed(const rc::scene::Scene& scene, const rc::scene::SurfacePoint& at) {
   static const std::vector<DVec3> dirs = burial_directions();
   const rc::Frame frame = rc::Frame::from_normal(at.ng);
+  bool behind_a_sheet = false;
   for (const DVec3& dir : dirs) {
     const rc::scene::Ray ray = rc::scene::spawn_ray(at, frame.to_world(Vec3(dir)));
     const std::optional<rc::scene::Hit> hit = scene.intersect(ray);
@@ -351,7 +403,9 @@ bool enclosed(const rc::scene::Scene& scene, const rc::scene::SurfacePoint& at) 
     // Open, or enclosed by glass that lets light in.
     if (si.front_face || scene.materials[si.material].kind == rc::scene::MaterialKind::dielectric)
       return false;
+    behind_a_sheet = behind_a_sheet || !scene.on_closed_surface(hit->geom_id, hit->prim_id);
   }
+  if (behind_a_sheet && light_reaches(scene, at)) return false;
   // A room modelled inside out (its walls facing outwards) encloses what is in it just as a
   // block encloses the floor under it; the camera inside tells the two apart where it looks.
   const Vec3 camera = scene.effective_camera().look_from;

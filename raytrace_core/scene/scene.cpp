@@ -7,18 +7,18 @@
 
 #include "raytrace_core/scene/scene.h"
 
-#include "raytrace_core/scene/normal_map.h"
-
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <algorithm>
+#include <mutex>
 #include <string>
 
+#include "raytrace_core/scene/closed_surface.h"
+#include "raytrace_core/scene/normal_map.h"
 #include "raytrace_core/util/closest_point.h"
 #include "raytrace_core/util/error.h"
-#include "raytrace_core/scene/normal_map.h"
 
 namespace gilt::raytrace_core::scene {
 namespace {
@@ -439,6 +439,8 @@ struct AlphaTest;
 
 struct Scene::Impl {
   RTCScene scene = nullptr;
+  std::once_flag closed_once;  // on_closed_surface's table, made on first use
+  std::vector<std::vector<char>> closed;
   std::vector<std::unique_ptr<AlphaTest>> alpha_tests;  // Embree's user data for cut-out meshes
   std::vector<Sphere> spheres;  // Embree's user data: a stable copy that survives moves of Scene
   ~Impl() {
@@ -589,6 +591,18 @@ bool near_triangle_callback(RTCPointQueryFunctionArguments* args) {
 }
 
 }  // namespace
+
+bool Scene::on_closed_surface(uint32_t geom_id, uint32_t prim_id) const {
+  if (geom_id >= meshes.size()) return true;  // a sphere
+  // On one thread: callers ask from inside parallel loops, and a parallel loop here could hand
+  // this thread one of their tasks, which would ask again inside the call_once.
+  std::call_once(impl_->closed_once, [&] {
+    impl_->closed.resize(meshes.size());
+    for (size_t m = 0; m < meshes.size(); ++m) impl_->closed[m] = triangles_on_closed_surfaces(meshes[m]);
+  });
+  const std::vector<char>& closed = impl_->closed[geom_id];
+  return prim_id < closed.size() && closed[prim_id] != 0;
+}
 
 void Scene::for_each_triangle_near(const Vec3& p, float radius,
                                    const std::function<void(uint32_t geom_id, uint32_t prim_id)>& f) const {

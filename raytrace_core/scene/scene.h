@@ -139,6 +139,9 @@ class Scene {
   /// the Hit's t and (u, v) its barycentrics. Ties go to the lower triangle index.
   std::optional<Hit> nearest_triangle(uint32_t geom_id, const Vec3& p, float radius, const Vec3& n,
                                       float min_cosine) const;
+  /// Whether triangle prim_id of mesh geom_id lies on a closed surface, one that bounds a solid
+  /// (closed_surface.h); spheres always do. Worked out per mesh on first use, then kept.
+  bool on_closed_surface(uint32_t geom_id, uint32_t prim_id) const;
   /// Calls f(geom_id, prim_id) for every triangle whose bounding box reaches within `radius`
   /// of p (a superset of the triangles that do: the caller tests the triangle itself), in no set
   /// order.

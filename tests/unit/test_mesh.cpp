@@ -699,6 +699,34 @@ TEST(Mesh, PointsUnderABoxAreBuriedOnAFaceThatIsNot) {
   EXPECT_FALSE(input_point_buried(scene, Vec3(-0.9f, -0.8f, 0.8f), up)) << "the standing box's top";
 }
 
+// Behind an open sheet a point is buried only where no light reaches it. A floor under a slab
+// modelled as one quad facing up (its back over the floor, nothing closed about it) is lit by
+// the sky round the slab's edges and is kept, though every burial ray from its middle meets the
+// slab's back; the floor under a box with no bottom face, which no light can enter, is removed
+// as under a closed box. The camera looks down on the slab, seeing neither.
+TEST(Mesh, PointsBehindAnOpenSheetAreBuriedOnlyWhereNoLightReaches) {
+  Scene scene;
+  scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
+  TriangleMesh floor;
+  floor.positions = {Vec3(-8, -8, 0), Vec3(8, -8, 0), Vec3(8, 8, 0), Vec3(-8, 8, 0)};
+  floor.indices = {0, 1, 2, 0, 2, 3};
+  scene.meshes.push_back(floor);
+  TriangleMesh slab = floor;  // facing up, half a unit over the floor's left part
+  slab.positions = {Vec3(-7, -3, 0.5f), Vec3(-1, -3, 0.5f), Vec3(-1, 3, 0.5f), Vec3(-7, 3, 0.5f)};
+  scene.meshes.push_back(slab);
+  TriangleMesh bottomless = closed_box("bottomless", 4.0, 0.0, 0.5, 0.5, 0.0, 0.0f, 1.0f);
+  bottomless.indices.erase(bottomless.indices.begin(), bottomless.indices.begin() + 6);
+  scene.meshes.push_back(bottomless);
+  scene.punctual_lights.push_back(gilt::test::uniform_sky(1.0f));
+  scene.camera = rc::scene::Camera{.look_from = Vec3(0, 0, 30), .look_at = Vec3(0, 0, 0)};
+  scene.commit();
+  ASSERT_FALSE(scene.on_closed_surface(1, 0));
+  ASSERT_FALSE(scene.on_closed_surface(2, 0));
+  const Vec3 up(0, 0, 1);
+  EXPECT_FALSE(input_point_buried(scene, Vec3(-4.0f, 0.0f, 0.0f), up)) << "under the slab: lit round its edges";
+  EXPECT_TRUE(input_point_buried(scene, Vec3(4.0f, 0.0f, 0.0f), up)) << "under the box without a bottom";
+}
+
 // A model of many small separate tiles cannot be meshed coarser than its tiles: each keeps its
 // border. Asked for fewer elements than that, the mesher says so rather than silently giving
 // many more (on Šibenik, --elements 20000 gave 170,608); without --elements it says nothing.
