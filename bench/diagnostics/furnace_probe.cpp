@@ -17,11 +17,11 @@
 
 #include "radiosity/bake/view.h"
 #include "radiosity/mesh/element_scene.h"
-#include "raytrace_core/util/rng.h"
-#include "raytrace_core/util/sampling.h"
 #include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/scene/bsdf.h"
+#include "raytrace_core/util/rng.h"
+#include "raytrace_core/util/sampling.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -36,21 +36,25 @@ int main(int argc, char** argv) {
   rad::solver::SolverSettings ss;
   ss.progress = false;
   ss.solver = argc > 2 && std::strcmp(argv[2], "progressive") == 0 ? rad::solver::SolverKind::progressive
-                                                                    : rad::solver::SolverKind::hierarchical;
-  const auto mode = argc > 3 && std::strcmp(argv[3], "mesh") == 0 ? rad::bake::ViewMode::mesh : rad::bake::ViewMode::two_pass;
+                                                                   : rad::solver::SolverKind::hierarchical;
+  const auto mode = argc > 3 && std::strcmp(argv[3], "mesh") == 0 ? rad::bake::ViewMode::mesh
+                                                                  : rad::bake::ViewMode::two_pass;
   ss = rad::bake::solver_settings_for(mode, ss);
   if (argc > 4) ss.hierarchical.link_tolerance = std::atof(argv[4]);
   const rad::solver::Solution sol = rad::solver::solve(scene, ss);
   const auto& mesh = sol.mesh;
-  std::printf("le %g rho %g: %zu elements, %zu vertices, %zu links at %g, %d iterations, residual %g, final gather %d\n",
-              le, rho, mesh.element_count(), mesh.vertex_count(), sol.links, sol.link_tolerance, sol.iterations,
-              sol.residual, int(sol.final_gather));
+  std::printf(
+      "le %g rho %g: %zu elements, %zu vertices, %zu links at %g, %d iterations, residual %g, final gather "
+      "%d\n",
+      le, rho, mesh.element_count(), mesh.vertex_count(), sol.links, sol.link_tolerance, sol.iterations,
+      sol.residual, int(sol.final_gather));
   double area = 0, d_el = 0, t_el = 0, ed_el = 0;
   for (size_t e = 0; e < mesh.element_count(); ++e) {
     const auto& el = mesh.elements[e];
     const double a = mesh.element_area[e];
     double d = 0, t = 0;
-    for (uint32_t v : el) d += sol.vertex_direct[v].average() / 3.0, t += sol.vertex_irradiance[v].average() / 3.0;
+    for (uint32_t v : el)
+      d += sol.vertex_direct[v].average() / 3.0, t += sol.vertex_irradiance[v].average() / 3.0;
     area += a, d_el += a * d, t_el += a * t;
     if (!sol.element_direct.empty()) ed_el += a * sol.element_direct[e].average();
   }
@@ -76,8 +80,8 @@ int main(int argc, char** argv) {
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
       const auto p = mesh.positions[v], n = mesh.normals[v];
       std::fprintf(f, "%zu,%g,%g,%g,%g,%g,%g,%g,%g,%d,%g,%d\n", v, p.x, p.y, p.z, n.x, n.y, n.z,
-                   sol.vertex_direct[v].average() / direct, sol.vertex_irradiance[v].average() / total, count[v],
-                   least[v], side[v]);
+                   sol.vertex_direct[v].average() / direct, sol.vertex_irradiance[v].average() / total,
+                   count[v], least[v], side[v]);
     }
     std::fclose(f);
   }
@@ -92,27 +96,35 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 256; ++i) {
       const rc::Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
       const auto h = geo.intersect(rc::scene::spawn_ray(rad::mesh::mesh_surface_point(p, n), w));
-      if (!h) { ++counts[0]; continue; }
-      if (h->geom_id != 0) { ++counts[1]; continue; }
+      if (!h) {
+        ++counts[0];
+        continue;
+      }
+      if (h->geom_id != 0) {
+        ++counts[1];
+        continue;
+      }
       const bool front = glm::dot(w, mesh.element_normal[h->prim_id]) < 0.0f;
       ++counts[front ? 2 : 3];
       if (i < 12) {
         const auto& el = mesh.elements[h->prim_id];
         const rc::Vec3 c = (mesh.positions[el[0]] + mesh.positions[el[1]] + mesh.positions[el[2]]) / 3.0f;
-        std::printf("  ray %d: t %.3f element %u at (%.2f %.2f %.2f) normal (%.2f %.2f %.2f) %s side %d\n", i, h->t,
-                    h->prim_id, c.x, c.y, c.z, mesh.element_normal[h->prim_id].x, mesh.element_normal[h->prim_id].y,
-                    mesh.element_normal[h->prim_id].z, front ? "front" : "back",
+        std::printf("  ray %d: t %.3f element %u at (%.2f %.2f %.2f) normal (%.2f %.2f %.2f) %s side %d\n", i,
+                    h->t, h->prim_id, c.x, c.y, c.z, mesh.element_normal[h->prim_id].x,
+                    mesh.element_normal[h->prim_id].y, mesh.element_normal[h->prim_id].z,
+                    front ? "front" : "back",
                     mesh.element_two_sided.empty() ? 0 : int(mesh.element_two_sided[h->prim_id]));
       }
     }
-    std::printf("vertex %zu at (%.3f %.3f %.3f) n (%.2f %.2f %.2f): escaped %d, other %d, fronts %d, backs %d\n", v,
-                mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z, n.x, n.y, n.z, counts[0], counts[1],
-                counts[2], counts[3]);
+    std::printf(
+        "vertex %zu at (%.3f %.3f %.3f) n (%.2f %.2f %.2f): escaped %d, other %d, fronts %d, backs %d\n", v,
+        mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z, n.x, n.y, n.z, counts[0], counts[1],
+        counts[2], counts[3]);
   }
   const double nv = double(mesh.vertex_count());
   std::printf("elements (by area): direct %.4f, total %.4f, element_direct %.4f\n", d_el / area / direct,
               t_el / area / total, ed_el / area / direct);
-  std::printf("vertices (plain):   direct %.4f, total %.4f, %.1f %% off by more than 5 %%\n", d_v / nv / direct,
-              t_v / nv / total, 100.0 * double(off) / nv);
+  std::printf("vertices (plain):   direct %.4f, total %.4f, %.1f %% off by more than 5 %%\n",
+              d_v / nv / direct, t_v / nv / total, 100.0 * double(off) / nv);
   return 0;
 }

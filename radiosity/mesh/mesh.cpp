@@ -364,7 +364,8 @@ bool light_reaches(const rc::scene::Scene& scene, const rc::scene::SurfacePoint&
       if (!lights.empty()) {
         const rc::scene::Light& light = lights[rng.next_u32() % lights.size()];
         const rc::scene::LightSample ls = rc::scene::sample_light(scene, light, sp, rng.uniform2(), n);
-        if (!ls.radiance.is_black() && glm::dot(ls.wi, n) > 0.0f && !scene.occluded(ls.shadow_ray)) return true;
+        if (!ls.radiance.is_black() && glm::dot(ls.wi, n) > 0.0f && !scene.occluded(ls.shadow_ray))
+          return true;
       }
       const Vec3 w = rc::Frame::from_normal(n).to_world(rc::util::sample_cosine_hemisphere(rng.uniform2()));
       const rc::scene::Ray ray = rc::scene::spawn_ray(sp, w);

@@ -59,7 +59,8 @@ std::vector<char> triangles_on_closed_surfaces(const TriangleMesh& mesh) {
   std::iota(parent.begin(), parent.end(), 0u);
   for (uint32_t t = 0; t < triangles; ++t)
     for (int k = 0; k < 3; ++k) {
-      const uint32_t a = vertex[mesh.indices[3 * size_t(t) + k]], b = vertex[mesh.indices[3 * size_t(t) + (k + 1) % 3]];
+      const uint32_t a = vertex[mesh.indices[3 * size_t(t) + k]],
+                     b = vertex[mesh.indices[3 * size_t(t) + (k + 1) % 3]];
       if (a == b) continue;
       const uint64_t key = uint64_t(std::min(a, b)) << 32 | std::max(a, b);
       auto [it, fresh] = edges.try_emplace(key, EdgeUse{t, 0});

@@ -18,8 +18,8 @@ namespace {
 rc::scene::TriangleMesh cube(Vec3 at, bool bottom, bool shared) {
   std::vector<Vec3> corners;
   for (int v = 0; v < 8; ++v) corners.push_back(at + Vec3(v & 1 ? 1 : 0, v & 2 ? 1 : 0, v & 4 ? 1 : 0));
-  std::vector<uint32_t> faces = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 1, 5, 0, 5, 4,
-                                 2, 6, 7, 2, 7, 3,  0, 4, 6, 0, 6, 2,  1, 3, 7, 1, 7, 5};
+  std::vector<uint32_t> faces = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
   if (!bottom) faces.erase(faces.begin(), faces.begin() + 6);
   rc::scene::TriangleMesh m;
   if (shared) {
@@ -54,7 +54,8 @@ TEST(ClosedSurface, ACubeIsClosedAndACubeWithoutItsBottomIsNot) {
 }
 
 TEST(ClosedSurface, EachPieceIsJudgedOnItsOwn) {
-  const rc::scene::TriangleMesh both = join(cube(Vec3(0.0f), true, true), cube(Vec3(3.0f, 0.0f, 0.0f), false, false));
+  const rc::scene::TriangleMesh both =
+      join(cube(Vec3(0.0f), true, true), cube(Vec3(3.0f, 0.0f, 0.0f), false, false));
   const std::vector<char> closed = rc::scene::triangles_on_closed_surfaces(both);
   ASSERT_EQ(closed.size(), 22u);
   for (size_t t = 0; t < 12; ++t) EXPECT_EQ(closed[t], 1) << t;
@@ -63,7 +64,8 @@ TEST(ClosedSurface, EachPieceIsJudgedOnItsOwn) {
 
 // Two cubes sharing an edge make an edge with four triangles: not the boundary of one solid.
 TEST(ClosedSurface, AnEdgeOfFourTrianglesIsNotClosed) {
-  const rc::scene::TriangleMesh touching = join(cube(Vec3(0.0f), true, true), cube(Vec3(1.0f, 1.0f, 0.0f), true, true));
+  const rc::scene::TriangleMesh touching =
+      join(cube(Vec3(0.0f), true, true), cube(Vec3(1.0f, 1.0f, 0.0f), true, true));
   const std::vector<char> closed = rc::scene::triangles_on_closed_surfaces(touching);
   for (char c : closed) EXPECT_EQ(c, 0);
 }

@@ -723,7 +723,8 @@ TEST(Mesh, PointsBehindAnOpenSheetAreBuriedOnlyWhereNoLightReaches) {
   ASSERT_FALSE(scene.on_closed_surface(1, 0));
   ASSERT_FALSE(scene.on_closed_surface(2, 0));
   const Vec3 up(0, 0, 1);
-  EXPECT_FALSE(input_point_buried(scene, Vec3(-4.0f, 0.0f, 0.0f), up)) << "under the slab: lit round its edges";
+  EXPECT_FALSE(input_point_buried(scene, Vec3(-4.0f, 0.0f, 0.0f), up))
+      << "under the slab: lit round its edges";
   EXPECT_TRUE(input_point_buried(scene, Vec3(4.0f, 0.0f, 0.0f), up)) << "under the box without a bottom";
 }
 
