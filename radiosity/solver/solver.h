@@ -82,8 +82,7 @@ struct Solution {
   std::vector<Rgb> element_albedo;     ///< reflectance, textured materials' mean over the element
   std::vector<Rgb> vertex_albedo;      ///< area-weighted mean of the vertex's elements' reflectance
   /// Per element: the mean over it of E straight from the lights (stratified points) and the
-  /// emitting surfaces (its vertices' mean); what it reflects into the scene. Hierarchical
-  /// solver only (empty otherwise).
+  /// emitting surfaces (its vertices' mean); what it reflects into the scene. Both solvers.
   std::vector<Rgb> element_direct;
 
   // What the solve did.
