@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/util/parallel.h"
@@ -11,34 +12,40 @@ namespace gilt::radiosity::mesh {
 
 namespace {
 
-/// Texture coordinates at the point of triangle `prim` of `mesh` whose barycentrics are those
-/// of x projected into the triangle's plane (x may lie outside the triangle: the map is affine).
-rc::Vec2 uv_at(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x) {
+/// Barycentrics (of the second and third corner) of x projected into the plane of triangle
+/// `prim` of `mesh` (x may lie outside the triangle: the map is affine); none for a triangle of
+/// no area.
+std::optional<rc::Vec2> barycentrics(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x) {
   const uint32_t* c = &mesh.indices[3 * size_t(prim)];
   const Vec3 p0 = mesh.positions[c[0]], e1 = mesh.positions[c[1]] - p0, e2 = mesh.positions[c[2]] - p0;
   const Vec3 d = x - p0;
   const float a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2);
   const float det = a11 * a22 - a12 * a12;
-  if (!(det > 0.0f) || mesh.uvs.empty()) return mesh.uvs.empty() ? rc::Vec2(0.0f) : mesh.uvs[c[0]];
-  const float b1 = (a22 * glm::dot(d, e1) - a12 * glm::dot(d, e2)) / det;
-  const float b2 = (a11 * glm::dot(d, e2) - a12 * glm::dot(d, e1)) / det;
-  return (1.0f - b1 - b2) * mesh.uvs[c[0]] + b1 * mesh.uvs[c[1]] + b2 * mesh.uvs[c[2]];
+  if (!(det > 0.0f)) return std::nullopt;
+  return rc::Vec2((a22 * glm::dot(d, e1) - a12 * glm::dot(d, e2)) / det,
+                  (a11 * glm::dot(d, e2) - a12 * glm::dot(d, e1)) / det);
+}
+
+/// Texture coordinates at the point of triangle `prim` of `mesh` with x's barycentrics.
+rc::Vec2 uv_at(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x) {
+  if (mesh.uvs.empty()) return rc::Vec2(0.0f);
+  const uint32_t* c = &mesh.indices[3 * size_t(prim)];
+  const std::optional<rc::Vec2> b = barycentrics(mesh, prim, x);
+  if (!b) return mesh.uvs[c[0]];
+  return (1.0f - b->x - b->y) * mesh.uvs[c[0]] + b->x * mesh.uvs[c[1]] + b->y * mesh.uvs[c[2]];
 }
 
 /// Whether x lies on triangle `prim` of `mesh`: its projection inside the triangle (with a
 /// margin of 1e-4 of the edges) and x within `slack` of its plane.
 bool lies_on(const rc::scene::TriangleMesh& mesh, uint32_t prim, const Vec3& x, float slack) {
   const uint32_t* c = &mesh.indices[3 * size_t(prim)];
-  const Vec3 p0 = mesh.positions[c[0]], e1 = mesh.positions[c[1]] - p0, e2 = mesh.positions[c[2]] - p0;
-  const Vec3 d = x - p0, n = glm::cross(e1, e2);
+  const Vec3 p0 = mesh.positions[c[0]];
+  const Vec3 n = glm::cross(mesh.positions[c[1]] - p0, mesh.positions[c[2]] - p0);
   const float n_len = glm::length(n);
-  if (!(n_len > 0.0f) || std::abs(glm::dot(d, n)) > slack * n_len) return false;
-  const float a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2);
-  const float det = a11 * a22 - a12 * a12;
-  const float b1 = (a22 * glm::dot(d, e1) - a12 * glm::dot(d, e2)) / det;
-  const float b2 = (a11 * glm::dot(d, e2) - a12 * glm::dot(d, e1)) / det;
+  if (!(n_len > 0.0f) || std::abs(glm::dot(x - p0, n)) > slack * n_len) return false;
+  const std::optional<rc::Vec2> b = barycentrics(mesh, prim, x);
   constexpr float kMargin = 1e-4f;
-  return b1 >= -kMargin && b2 >= -kMargin && b1 + b2 <= 1.0f + kMargin;
+  return b && b->x >= -kMargin && b->y >= -kMargin && b->x + b->y <= 1.0f + kMargin;
 }
 
 }  // namespace

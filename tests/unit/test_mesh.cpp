@@ -707,13 +707,10 @@ TEST(Mesh, PointsUnderABoxAreBuriedOnAFaceThatIsNot) {
 TEST(Mesh, PointsBehindAnOpenSheetAreBuriedOnlyWhereNoLightReaches) {
   Scene scene;
   scene.materials.push_back(Material::make_diffuse("grey", Rgb(0.5f)));
-  TriangleMesh floor;
-  floor.positions = {Vec3(-8, -8, 0), Vec3(8, -8, 0), Vec3(8, 8, 0), Vec3(-8, 8, 0)};
-  floor.indices = {0, 1, 2, 0, 2, 3};
-  scene.meshes.push_back(floor);
-  TriangleMesh slab = floor;  // facing up, half a unit over the floor's left part
-  slab.positions = {Vec3(-7, -3, 0.5f), Vec3(-1, -3, 0.5f), Vec3(-1, 3, 0.5f), Vec3(-7, 3, 0.5f)};
-  scene.meshes.push_back(slab);
+  scene.meshes.push_back(gilt::test::quad(Vec3(-8, -8, 0), Vec3(8, -8, 0), Vec3(8, 8, 0), Vec3(-8, 8, 0)));
+  // The slab, facing up, half a unit over the floor's left part.
+  scene.meshes.push_back(
+      gilt::test::quad(Vec3(-7, -3, 0.5f), Vec3(-1, -3, 0.5f), Vec3(-1, 3, 0.5f), Vec3(-7, 3, 0.5f)));
   TriangleMesh bottomless = closed_box("bottomless", 4.0, 0.0, 0.5, 0.5, 0.0, 0.0f, 1.0f);
   bottomless.indices.erase(bottomless.indices.begin(), bottomless.indices.begin() + 6);
   scene.meshes.push_back(bottomless);
