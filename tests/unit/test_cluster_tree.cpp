@@ -102,3 +102,35 @@ TEST(ClusterTree, BehindCullsTwinsAndNothingThatSeesLight) {
   EXPECT_GT(culled, 0u);
   EXPECT_TRUE(twins_apart) << "a cluster of the sheet and one of its twins cull each other";
 }
+
+// Three sheets facing up, one above another with space between (a floor over a crawl space's,
+// the floors of storeys): each sheet is a subtree of its own. A cluster that held pieces of two
+// would share one visible fraction between an upper piece and the lower one it hides; split by
+// position (the sheets are wider than they are apart) every node above the leaves held both.
+TEST(ClusterTree, ParallelLayersAreSplitApart) {
+  rad::mesh::RadiosityMesh mesh;
+  add_sheet(mesh, 8, 0.0f, true);
+  add_sheet(mesh, 8, 0.3f, true);
+  add_sheet(mesh, 8, 0.6f, true);
+  const uint32_t per_sheet = 128;
+  ASSERT_EQ(mesh.element_count(), 3u * per_sheet);
+  const std::vector<Rgb> albedo(mesh.element_count(), Rgb(0.5f));
+  const rad::solver::detail::Tree tree = rad::solver::detail::make_tree(mesh, albedo);
+  for (uint32_t sheet = 0; sheet < 3; ++sheet) {
+    bool found = false;
+    for (uint32_t k = 0; k < tree.nodes.size() && !found; ++k) {
+      const std::vector<uint32_t> es = elements_of(tree, k);
+      found = es.size() == per_sheet &&
+              std::all_of(es.begin(), es.end(), [&](uint32_t e) { return e / per_sheet == sheet; });
+    }
+    EXPECT_TRUE(found) << "no node holds exactly sheet " << sheet;
+  }
+  // Nodes below the top two levels hold one sheet each.
+  for (uint32_t k = 0; k < tree.nodes.size(); ++k) {
+    const std::vector<uint32_t> es = elements_of(tree, k);
+    if (es.size() > per_sheet) continue;
+    const uint32_t sheet = es.front() / per_sheet;
+    EXPECT_TRUE(std::all_of(es.begin(), es.end(), [&](uint32_t e) { return e / per_sheet == sheet; }))
+        << "node " << k << " of " << es.size() << " elements mixes sheets";
+  }
+}
