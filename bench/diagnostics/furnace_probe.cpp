@@ -3,11 +3,11 @@
 // and π Le / (1 − ρ) in all. Prints the area-weighted means over the elements, and the plain
 // means over the vertices, of the solution's direct and total irradiance as fractions of those,
 // and the share of vertices more than 5 % off. Usage: furnace_probe SCENE [progressive|hierarchical]
-// [mesh|two-pass] [LINK_TOLERANCE]; the scene's single material gives Le and ρ. VERTCSV names a
-// CSV of every vertex (position, normal, direct and total as fractions, its elements, their
-// least area, twin or not); PROBE_VERTEX=v prints what 256 cosine rays from vertex v meet in the
-// element scene. (On the furnace family's dome it showed the middle of the enclosure's floor
-// removed as buried under the building's one-sided floor: rays from under it escaped.)
+// [mesh|two-pass] [LINK_TOLERANCE [RECEIVER_SHARE]]; the scene's single material gives Le and ρ. VERTCSV
+// names a CSV of every vertex (position, normal, direct and total as fractions, its elements, their least
+// area, twin or not); PROBE_VERTEX=v prints what 256 cosine rays from vertex v meet in the element scene. (On
+// the furnace family's dome it showed the middle of the enclosure's floor removed as buried under the
+// building's one-sided floor: rays from under it escaped.)
 
 #include <cmath>
 #include <cstdio>
@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
                                                                   : rad::bake::ViewMode::two_pass;
   ss = rad::bake::solver_settings_for(mode, ss);
   if (argc > 4) ss.hierarchical.link_tolerance = std::atof(argv[4]);
+  if (argc > 5) ss.hierarchical.receiver_share = std::atof(argv[5]);
   const rad::solver::Solution sol = rad::solver::solve(scene, ss);
   const auto& mesh = sol.mesh;
   std::printf(

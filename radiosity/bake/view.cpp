@@ -30,6 +30,8 @@ SolverSettings solver_settings_for(ViewMode mode, SolverSettings settings) {
     settings.subdivision_levels = 0;
     settings.hierarchical.final_gather = FinalGather::never;
     if (!(settings.hierarchical.link_tolerance > 0.0)) settings.hierarchical.link_tolerance = kTwoPassLinkTolerance;
+    if (!(settings.hierarchical.receiver_share > 0.0))
+      settings.hierarchical.receiver_share = kTwoPassReceiverShare;
   }
   return settings;
 }

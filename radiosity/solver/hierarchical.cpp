@@ -10,7 +10,9 @@
 // root. Linking starts from the root paired with itself and splits the larger end of a pair
 // until the oracle accepts it: the power the link may carry wrongly, ρ_R A_R F̂ B_S times the
 // point-source error ((r_R + r_S)/d)², where F̂ = A_S / (π d²) bounds the form factor from R to S
-// at a gap d, must stay below link_tolerance × the scene's reflected power. A pair of elements
+// at a gap d, must stay below link_tolerance × the scene's reflected power (and, where
+// HierarchicalSettings::receiver_share is set, below link_tolerance × R's own reflected power
+// / receiver_share). A pair of elements
 // that the oracle never accepts gets an exact link: Lambert's point-to-triangle factor at the
 // receiver's centroid. Pairs that provably exchange nothing (each end behind the other's
 // surfaces, coplanar pieces of one wall) are dropped before any test.

@@ -38,6 +38,15 @@ struct HierarchicalSettings {
   /// 0 takes the default of the use: kDefaultLinkTolerance, or a two-pass view's own
   /// (solver_settings_for in radiosity/bake/view.h).
   double link_tolerance = 0.0;
+  /// The scene-wide bound is loose where little light arrives: a link into a dim or small
+  /// receiver may carry much of its light wrongly and still pass. With a share s > 0 a link is
+  /// also held below link_tolerance times its receiver's own reflected power over s: the
+  /// scene-wide bound holds for receivers with at least s of the scene's power, and one with
+  /// less is bounded relative to its own. 0 (the default) drops the receiver's bound, for solves
+  /// whose vertex final gather bounds each vertex by its own light (gather_tolerance); the
+  /// two-pass view, which reads the links' light without one, takes kTwoPassReceiverShare
+  /// (radiosity/bake/view.h).
+  double receiver_share = 0.0;
   /// A cluster stands in for its elements in the vertex final gather when the irradiance it may
   /// carry wrongly is below this fraction of the local indirect irradiance.
   double gather_tolerance = 0.02;

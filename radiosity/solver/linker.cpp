@@ -28,7 +28,8 @@ constexpr double kPartialVisibility = 10.0;
 size_t Linker::splits(std::span<const OpenPair> open) const {
   size_t n = 0;
   for (const OpenPair& p : open)
-    n += !(p.error <= epsilon_ && (p.error * kPartialVisibility <= epsilon_ || p.visible == 1.0f));
+    n +=
+        !(acceptable(p.error, p.receiver) && (p.error * kPartialVisibility <= epsilon_ || p.visible == 1.0f));
   return n;
 }
 
@@ -152,7 +153,7 @@ void Linker::refine(const OpenPair& pair, LinkLevel& out, std::vector<OpenPair>&
     // Both ends wholly facing each other: the models are exact up to the point-source error.
     if (receiving == Facing::front && sending == Facing::front)
       error *= std::min(1.0, std::pow(double(R.radius + S.radius) / gap, 2.0));
-    if (error <= epsilon_) {
+    if (acceptable(error, r)) {
       // A cluster link shares one visible fraction among all the receiver's elements that face
       // the source. Where the source is partly hidden, the hidden and the open elements get the
       // same share: light meant for a wall's inner face lands on its outer face and leaves the

@@ -127,6 +127,15 @@ class Linker {
   std::optional<LinkLevel> link(std::span<const OpenPair> start);
 
  private:
+  /// Whether a link into `receiver` whose error bound is `error` passes the oracle: below the
+  /// tolerance's share of the scene's reflected power and of the receiver's own over
+  /// settings.receiver_share (power_[0], the root's, is the scene's).
+  bool acceptable(double error, uint32_t receiver) const {
+    return error <= epsilon_ &&
+           (!(settings_.receiver_share > 0.0) ||
+            error * settings_.receiver_share * double(power_[0]) <= epsilon_ * double(power_[receiver]));
+  }
+
   /// Whether this process refines pairs, and keeps links, that receive at `node`.
   bool mine(uint32_t node) const { return owner_.empty() || owner_[node] < 0 || owner_[node] == rank_; }
   /// Where the work on a pair receiving at `node` is counted: the counts are summed over
