@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "radiosity/mesh/element_scene.h"
 #include "radiosity/mesh/mesh.h"
 #include "radiosity/solver/ambient_gather.h"
+#include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
 #include "tests/support/test_scenes.h"
 
@@ -131,4 +133,37 @@ TEST(AmbientGather, SeesATwoSidedSheetFromBelow) {
   RecordProperty("floor_gathered", std::to_string(floor_sum / floor_area));
   RecordProperty("view_factor", std::to_string(f));
   EXPECT_NEAR(floor_sum / floor_area, f, 4.0 * standard_error) << "view factor " << f;
+}
+
+// A hierarchical solve that has no time for the reflected light (a limit of a microsecond: no
+// links, no shots) says so, with a residual of 1, and gathers what it left unshot for a display.
+// Each run of elements averages the unshot radiosity ρ E_direct of what its rays meet, times the
+// series 1 / (1 − ρ) of a closed furnace (no ray escapes), so every vertex's term lies between
+// ρ/(1 − ρ) times the least and the greatest direct irradiance of any vertex, up to float rounding.
+TEST(AmbientGather, ASolveWithNoTimeGathersWhatItLeftUnshot) {
+  constexpr float rho = 0.6f;
+  rc::scene::Scene scene = rc::io::furnace_scene(1.0f, rho);
+  scene.commit();
+  rad::solver::SolverSettings s;
+  s.solver = rad::solver::SolverKind::hierarchical;
+  s.mesh.elements = 2000;
+  s.progress = false;
+  s.gather_ambient = true;
+  s.time_limit = 1e-6;
+  const rad::solver::Solution sol = rad::solver::solve(scene, s);
+  EXPECT_EQ(sol.links, 0u);
+  EXPECT_EQ(sol.shots, 0u);
+  EXPECT_EQ(sol.residual, 1.0);
+  EXPECT_EQ(sol.ambient_escaped, 0.0);
+  ASSERT_EQ(sol.vertex_ambient.size(), sol.mesh.vertex_count());
+  float least = 1e30f, most = 0.0f;
+  for (const Rgb& d : sol.vertex_direct)
+    least = std::min(least, d.average()), most = std::max(most, d.average());
+  ASSERT_GT(least, 0.0f);
+  const float series = 1.0f / (1.0f - rho);
+  for (const Rgb& a : sol.vertex_ambient) {
+    ASSERT_TRUE(std::isfinite(a.average()));
+    EXPECT_GE(a.average(), rho * least * series * (1.0f - 1e-5f));
+    EXPECT_LE(a.average(), rho * most * series * (1.0f + 1e-5f));
+  }
 }
