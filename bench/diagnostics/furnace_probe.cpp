@@ -9,6 +9,7 @@
 // the furnace family's dome it showed the middle of the enclosure's floor removed as buried under the
 // building's one-sided floor: rays from under it escaped.)
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   ss = rad::bake::solver_settings_for(mode, ss);
   if (argc > 4) ss.hierarchical.link_tolerance = std::atof(argv[4]);
   if (argc > 5) ss.hierarchical.receiver_share = std::atof(argv[5]);
+  ss.hierarchical.keep_closure = true;
   const rad::solver::Solution sol = rad::solver::solve(scene, ss);
   const auto& mesh = sol.mesh;
   std::printf(
@@ -121,6 +123,29 @@ int main(int argc, char** argv) {
         "vertex %zu at (%.3f %.3f %.3f) n (%.2f %.2f %.2f): escaped %d, other %d, fronts %d, backs %d\n", v,
         mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z, n.x, n.y, n.z, counts[0], counts[1],
         counts[2], counts[3]);
+  }
+  if (!sol.element_closure.empty()) {
+    // The links' closure: the sum of each element's link factors, 1 in any closed scene.
+    std::vector<std::pair<float, float>> by_closure;  // (closure, area)
+    double closure_area = 0.0, closure_sum = 0.0, under = 0.0, over = 0.0;
+    for (size_t e = 0; e < mesh.element_count(); ++e) {
+      const float c = sol.element_closure[e], a = mesh.element_area[e];
+      by_closure.emplace_back(c, a);
+      closure_area += a, closure_sum += double(c) * a;
+      under += c < 0.9f ? a : 0.0f, over += c > 1.1f ? a : 0.0f;
+    }
+    std::sort(by_closure.begin(), by_closure.end());
+    auto quantile = [&](double q) {
+      double acc = 0.0;
+      for (const auto& [c, a] : by_closure)
+        if ((acc += a) >= q * closure_area) return c;
+      return by_closure.back().first;
+    };
+    std::printf(
+        "closure (by area): mean %.4f, 5 %% %.3f, median %.3f, 95 %% %.3f; %.1f %% of the area below 0.9, "
+        "%.1f %% above 1.1\n",
+        closure_sum / closure_area, quantile(0.05), quantile(0.5), quantile(0.95),
+        100.0 * under / closure_area, 100.0 * over / closure_area);
   }
   const double nv = double(mesh.vertex_count());
   std::printf("elements (by area): direct %.4f, total %.4f, element_direct %.4f\n", d_el / area / direct,

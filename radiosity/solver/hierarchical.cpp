@@ -370,6 +370,10 @@ struct HierarchicalSolve {
       const float reflects = in.albedo[e].max_component() * capacity[e].max_component();
       if (reflects > kMaxReflectedGain) gain[e] = kMaxReflectedGain / reflects, ++result.clamped_elements;
     }
+    if (settings.keep_closure) {
+      result.element_closure.resize(ne);
+      for (size_t e = 0; e < ne; ++e) result.element_closure[e] = capacity[e].average();
+    }
   }
 
   /// One step of the iteration (see iterate): gathers from `radiosity` into `indirect`, reflects

@@ -58,6 +58,8 @@ struct HierarchicalSettings {
   FinalGather final_gather = FinalGather::automatic;
   uint64_t seed = 0;
   bool progress = false;  ///< report linking, iterating and the final gather on stderr (rc::util::Progress)
+  bool keep_closure =
+      false;  ///< keep each element's closure (HierarchicalResult::element_closure; diagnostics)
 };
 
 /// How many points each vertex's visibility rays start from (see visibility_origins in solver.h).
@@ -108,6 +110,10 @@ struct HierarchicalResult {
   bool tail_added = false;  ///< whether the iteration's geometric tail was added (see solve_hierarchical)
   double chebyshev_beta = 0.0;  ///< the bound on the iteration's spectrum Chebyshev's steps used (0: none)
   size_t clamped_elements = 0;  ///< elements whose links promised more light than they can reflect (scaled down)
+  /// Per element, with HierarchicalSettings::keep_closure: the channel mean of the irradiance its
+  /// links gather from a unit radiosity everywhere, Σ F over what it sees. In a closed scene it is
+  /// 1 for every element; below 1 the links lose light there, above 1 they promise too much.
+  std::vector<float> element_closure;
   uint64_t shadow_rays = 0, form_factors = 0;
   uint64_t gather_nodes = 0;  ///< clusters and elements the vertex final gather evaluated
   bool final_gather = true;   ///< false when it did not run to the end (vertices then take their elements' mean)

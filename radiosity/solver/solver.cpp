@@ -1100,6 +1100,7 @@ struct SolveState {
     sol.tail_added = h.tail_added;
     sol.chebyshev_beta = h.chebyshev_beta;
     sol.ladder = h.ladder;
+    sol.element_closure = h.element_closure;
     sol.gather_nodes = h.gather_nodes;
     sol.final_gather = h.final_gather;
     sol.final_gather_note = h.final_gather_note;

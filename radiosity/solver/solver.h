@@ -111,6 +111,8 @@ struct Solution {
   bool tail_added = false;       ///< hierarchical: the iteration's geometric tail was added
   double chebyshev_beta = 0.0;   ///< hierarchical: the spectral bound of Chebyshev's iteration (0: plain Jacobi)
   std::vector<LadderLevel> ladder;  ///< hierarchical: the link tolerances a timed solve went through
+  std::vector<float>
+      element_closure;  ///< hierarchical, with hierarchical.keep_closure: HierarchicalResult::element_closure
   /// Ambient radiosity (W·m⁻²) standing in for the light not yet shot, for displaying a partial
   /// solution only (Cohen, Chen, Wallace & Greenberg 1988): the area-weighted mean unshot
   /// radiosity times the interreflection factor 1 / (1 − ρ̄). Never part of exported values.
