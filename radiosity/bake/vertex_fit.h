@@ -15,6 +15,7 @@
 #include <span>
 #include <vector>
 
+#include "radiosity/bake/vertex_split.h"
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/util/progress.h"
 #include "raytrace_core/util/rgb.h"
@@ -68,5 +69,34 @@ struct FitStats {
 std::vector<Rgb> fit_vertex_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
                                     const SurfaceField& field, VertexFit fit, float spacing,
                                     FitStats* stats = nullptr, rc::util::Progress* progress = nullptr);
+
+/// Where a split fit (fit_split_colours) gives the faces around a vertex colours of their own.
+struct SplitRules {
+  /// Faces whose normals are further apart than this cosine (30°, the mesher's crease) do not
+  /// share: a floor meeting a wall sees different light.
+  float crease_cos = 0.8660254f;
+  /// Faces of different keys do not share (their materials: radiance and radiosity jump with the
+  /// albedo). Empty: one key.
+  std::span<const uint32_t> face_key;
+  /// Nor do two faces whose own fits (each face's best linear colour, alone) jump across their
+  /// edge by at least kLightEdgeRatio at both its ends, the same way: a shadow line along an
+  /// edge. Least squares only; a point fit has no face fits to compare.
+  bool light_edges = true;
+};
+
+/// The jump in colour (the sum of its channels) across an edge that splits it as a shadow line:
+/// twice as bright on one side as on the other, at both ends. Past that a shared colour is a
+/// visible compromise on both faces; below it, the faces' own fits are too noisy to tell (with a
+/// final gather) and splitting shows the noise as seams. Colours within 1 % of the mesh's mean
+/// colour of zero count as that 1 % (a dark corner is not a shadow line).
+inline constexpr float kLightEdgeRatio = 2.0f;
+
+/// As fit_vertex_colours, with the vertices split into `wedges` (vertex_split.h) by `rules`: one
+/// colour per wedge, fitted over the wedge's faces, with no smoothness term across a split. For
+/// an output whose vertices can be split (glTF); the least-squares quadrature is the same.
+std::vector<Rgb> fit_split_colours(std::span<const Vec3> positions, std::span<const uint32_t> indices,
+                                   const SurfaceField& field, VertexFit fit, float spacing,
+                                   const SplitRules& rules, Wedges& wedges, FitStats* stats = nullptr,
+                                   rc::util::Progress* progress = nullptr);
 
 }  // namespace gilt::radiosity::bake
