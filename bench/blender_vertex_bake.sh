@@ -23,10 +23,16 @@ cd "$work"
 echo "== reference: 2000 points, $reference path-traced samples each"
 "$gilt" radiosity open.json --onto input --fit point --link-tolerance 1e-1 --final-gather off --quantity irradiance \
   --check 2000 --check-samples "$reference" --check-points ref.csv -o ref.obj -q --threads 2 | grep check:
-echo "== gilt radiosity --onto input --time $seconds"
-/usr/bin/time -f "gilt wall %e s" "$gilt" radiosity open.json --onto input --time "$seconds" --quantity irradiance \
-  --check 2000 --check-samples 256 --check-points gilt.csv -o gilt.obj -q --threads 2 | grep -E "solve:|time:"
+# The OBJ keeps one colour per `v` line; the GLB splits vertices where the light jumps across an edge.
+for ext in obj glb; do
+  echo "== gilt radiosity --onto input --time $seconds -o gilt.$ext"
+  /usr/bin/time -f "gilt wall %e s" "$gilt" radiosity open.json --onto input --time "$seconds" --quantity irradiance \
+    --check 2000 --check-samples 256 --check-points "gilt-$ext.csv" -o "gilt.$ext" -q --threads 2 | grep -E "solve:|time:|positions"
+done
 echo "== Blender Cycles vertex bake, $samples samples"
 SUN="0.35,-1,0.45,8" ENV=1.0 blender -b --factory-startup -P "$shared/tools/cycles_bake.py" -- open.obj "$samples" \
   blender.npy 2 2>&1 | grep BAKE_SECONDS
-$py "$here/scripts/score_vertex_bake.py" gilt.csv open.obj blender.npy --reference ref.csv --label "blender $samples"
+for ext in obj glb; do
+  echo "== scored: gilt.$ext against Blender"
+  $py "$here/scripts/score_vertex_bake.py" "gilt-$ext.csv" open.obj blender.npy --reference ref.csv --label "blender $samples"
+done

@@ -37,6 +37,7 @@ struct RadiosityOptions {
   int lightmap = 0;      ///< 0: no lightmap
   int bake_gather = 0;   ///< final-gather samples per baked point; 0: read the solution
   bool onto_given = false, fit_given = false;
+  bool keep_vertices = false;  ///< --keep-vertices
   bool srgb8 = false, linear_float = false, json = false, quiet = false;
   float exposure = 0.0f;
 };
@@ -101,6 +102,10 @@ void validate_radiosity_options(RadiosityOptions& o, RadiosityRun& run) {
     throw rc::InputError("--linear-float applies to .ply and .obj output of --onto elements only");
   if (o.linear_float && o.srgb8) throw rc::InputError("--linear-float and --srgb8 ask for opposite colours");
   if (o.fit != "least-squares" && !onto_input) throw rc::InputError("--fit applies to --onto input only");
+  if (o.keep_vertices && (!onto_input || lightmap || (ext != ".gltf" && ext != ".glb")))
+    throw rc::InputError(
+        "--keep-vertices applies to --onto input written as glTF (.gltf or .glb) only: OBJ and PLY "
+        "keep the input's vertices anyway");
   if (!o.check_points_file.empty()) {
     if (o.check_points == 0) throw rc::InputError("--check-points writes the points of --check N: give --check too");
     const std::filesystem::path parent = std::filesystem::absolute(o.check_points_file).parent_path();
@@ -180,7 +185,9 @@ void export_radiosity(const rc::scene::Scene& scene, const radiosity::solver::So
     run.atlas = radiosity::bake::bake_lightmap(scene, sol, ex.quantity, o.lightmap, run.gather);
     radiosity::bake::write_lightmap(o.output, scene, *run.atlas, ex);
   } else if (run.onto_input) {
-    run.onto = radiosity::bake::fit_input_colours(scene, sol, run.fit, ex.quantity, run.gather);
+    run.onto =
+        radiosity::bake::fit_input_colours(scene, sol, run.fit, ex.quantity, run.gather,
+                                           radiosity::bake::input_vertices(o.output, scene, o.keep_vertices));
     radiosity::bake::write_onto_input(o.output, scene, *run.onto, ex);
   } else {
     if (o.bake_gather > 0) {
@@ -226,7 +233,9 @@ void check_radiosity(const rc::scene::Scene& scene, const radiosity::solver::Sol
     const radiosity::bake::InputColours e =
         ex.quantity == radiosity::bake::Quantity::irradiance
             ? *run.onto
-            : radiosity::bake::fit_input_colours(scene, sol, run.fit, radiosity::bake::Quantity::irradiance, run.gather);
+            : radiosity::bake::fit_input_colours(
+                  scene, sol, run.fit, radiosity::bake::Quantity::irradiance, run.gather,
+                  radiosity::bake::input_vertices(o.output, scene, o.keep_vertices));
     run.surface_check = radiosity::bake::check_input_colours(scene, e, o.check, side);
   } else {
     run.check = radiosity::bake::check_against_path_tracer(scene, run.exported(sol), o.check);
@@ -247,17 +256,19 @@ void check_radiosity(const rc::scene::Scene& scene, const radiosity::solver::Sol
 void add_bake_json(nlohmann::json& j, const radiosity::solver::Solution& sol, const RadiosityOptions& o,
                    const RadiosityRun& run) {
   if (run.onto)
-    j["fit"] = {{"method", o.fit},
-                {"samples", run.onto->stats.samples},
-                {"samples_without_solution", run.onto->stats.missing},
-                {"buried_faces_left_out", run.onto->buried_faces},
-                {"iterations", run.onto->stats.iterations},
-                {"gather_rays", o.bake_gather},
-                {"gathered_samples", run.onto->gather.gathered},
-                {"samples_read_after_deadline", run.onto->gather.late},
-                {"samples_from_the_back", run.onto->sides.back},
-                {"samples_whose_sides_differ", run.onto->sides.differ},
-                {"seconds", run.onto->seconds}};
+    j["fit"] = {
+        {"method", o.fit},
+        {"samples", run.onto->stats.samples},
+        {"samples_without_solution", run.onto->stats.missing},
+        {"buried_faces_left_out", run.onto->buried_faces},
+        {"iterations", run.onto->stats.iterations},
+        {"gather_rays", o.bake_gather},
+        {"gathered_samples", run.onto->gather.gathered},
+        {"samples_read_after_deadline", run.onto->gather.late},
+        {"samples_from_the_back", run.onto->sides.back},
+        {"samples_whose_sides_differ", run.onto->sides.differ},
+        {"vertices", {{"fitted", run.onto->welded_vertices}, {"written", run.onto->written_vertices()}}},
+        {"seconds", run.onto->seconds}};
   if (run.vertex_gather)
     j["vertex_gather"] = {{"gather_rays", o.bake_gather},
                           {"gathered_vertices", run.vertex_gather_count.gathered},
@@ -480,6 +491,10 @@ void print_bake_report(const radiosity::solver::Solution& sol, const RadiosityOp
                 "faces left out), %.3g s\n",
                 o.fit.c_str(), static_cast<unsigned long long>(onto->stats.samples),
                 static_cast<unsigned long long>(onto->stats.missing), onto->buried_faces, onto->seconds);
+  if (onto && !onto->wedges.empty())
+    std::printf("           %zu %s, written as %zu vertices%s\n", onto->welded_vertices,
+                o.keep_vertices ? "vertices in the file" : "positions welded", onto->written_vertices(),
+                o.keep_vertices ? "" : ", split at creases, materials and shadow lines along edges");
   if (atlas)
     std::printf("  lightmap: %d x %d over %zu faces (%zu buried left out), %zu texels (%.3g %%); layout %.3g s, "
                 "bake %.3g s\n            UVs: %s",
@@ -611,6 +626,11 @@ std::function<void()> add_radiosity_command(CLI::App& app) {
                   "With --onto input: least-squares (default) fits the colours to the solution over each face; "
                   "point takes the solution at each vertex")
       ->check(CLI::IsMember({"least-squares", "point"}));
+  cmd->add_flag(
+      "--keep-vertices", o->keep_vertices,
+      "With --onto input written as glTF: one colour per vertex of the input (per position of an OBJ "
+      "or PLY input), instead of splitting vertices where the light jumps across an edge (creases, "
+      "materials, shadow lines along edges)");
   cmd->add_option("--bake-gather", o->bake_gather,
                   "A final gather. Each baked point (with --onto input or --lightmap) or exported vertex (--onto "
                   "elements, at the input surface under it) takes its light from N shadow rays and N gather rays "

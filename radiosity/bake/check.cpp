@@ -429,23 +429,14 @@ void write_check_points(const std::string& path, const CheckResult& result) {
 
 SurfaceCheckResult check_input_colours(const rc::scene::Scene& scene, const InputColours& irradiance,
                                        const CheckSettings& settings, const BakedSide& side) {
-  const auto baked_on = [&](size_t m) {
-    return irradiance.per_mesh.empty() ? !irradiance.per_file_vertex.empty() : !irradiance.per_mesh[m].empty();
-  };
   const auto baked_at = [&](const DrawnPoint& at) -> std::optional<Rgb> {
-    const rc::scene::TriangleMesh& mesh = scene.meshes[at.mesh];
     Rgb value(0.0f);
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = mesh.indices[3 * size_t(at.triangle) + size_t(k)];
-      value += at.weight[k] *
-               (irradiance.per_mesh.empty()
-                    ? irradiance.per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]]
-                    : irradiance.per_mesh[at.mesh][v]);
-    }
+    for (size_t k = 0; k < 3; ++k)
+      value += at.weight[k] * irradiance.at_corner(scene, at.mesh, 3 * size_t(at.triangle) + k);
     return value;
   };
   return check_baked(
-      scene, [&](size_t m) { return scene.meshes[m].origin.file == irradiance.file && baked_on(m); },
+      scene, [&](size_t m) { return scene.meshes[m].origin.file == irradiance.file && irradiance.covers(m); },
       baked_at, settings, Sides::lit, side);
 }
 

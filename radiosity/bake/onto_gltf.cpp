@@ -6,15 +6,16 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <cstdint>
-#include <cmath>
 #include <cfloat>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 #include <unordered_map>
 
@@ -390,41 +391,6 @@ void finish_output(GltfOutput& o, const std::string& output) {
 
 }  // namespace
 
-void write_onto_gltf(const std::string& input, const std::string& output, const rc::scene::Scene& scene,
-                     const InputColours& colours, const ExportSettings& settings) {
-  GltfOutput o = begin_output(input, output);
-  Json& j = o.json();
-  std::map<int32_t, int32_t> mesh_of_node;
-  const auto scene_meshes_of_node = split_instances(
-      j, scene, colours.file, [&](size_t m) { return !colours.per_mesh[m].empty(); }, mesh_of_node);
-  Json& meshes = array(j, "meshes");
-  Json& accessors = array(j, "accessors");
-  const float scale = std::exp2(settings.exposure);
-  const auto add_colours = [&](const std::vector<Rgb>& values, bool clamp) {
-    std::vector<float> floats;
-    floats.reserve(3 * values.size());
-    for (const Rgb& c : values)
-      for (int k = 0; k < 3; ++k) floats.push_back(clamp ? std::clamp(c[k] * scale, 0.0f, 1.0f) : c[k]);
-    return o.add_accessor(floats.data(), floats.size() * 4,
-                          {{"componentType", kFloat}, {"count", values.size()}, {"type", "VEC3"}}, true);
-  };
-  for (const auto& [node, list] : scene_meshes_of_node) {
-    Json& primitives = meshes[size_t(mesh_of_node.at(node))]["primitives"];
-    for (size_t m : list) {
-      const std::vector<Rgb>& values = colours.per_mesh[m];
-      Json& attributes = primitives[size_t(scene.meshes[m].origin.primitive)]["attributes"];
-      const Json& position = accessors[size_t(attributes["POSITION"].get<int64_t>())];
-      if (position.value("count", size_t(0)) != values.size())
-        throw std::logic_error("write_onto_gltf: vertex count of a primitive changed while loading");
-      attributes["COLOR_0"] = add_colours(values, true);
-      attributes[gltf_attribute(settings.quantity)] = add_colours(values, false);
-    }
-  }
-  if (o.data.empty())
-    throw InputError(input + ": no surface of the model holds a solution (mirrors and glass are not baked)");
-  finish_output(o, output);
-}
-
 namespace {
 
 /// A primitive's faces with their vertices split where the atlas's UVs differ: new vertex k is
@@ -457,15 +423,15 @@ UvSplit split_by_uv(const std::vector<uint32_t>& indices, const std::vector<rc::
 }
 
 /// The accessor's elements gathered at `xref`, packed (no stride).
-std::string gather(const tinygltf::Model& model, int index, const std::vector<uint32_t>& xref, const std::string& what) {
+std::string gather(const tinygltf::Model& model, int index, const std::vector<uint32_t>& xref, const std::string& what,
+                   const char* option) {
   if (index < 0 || size_t(index) >= model.accessors.size()) throw InputError(what + ": no such accessor");
   const tinygltf::Accessor& a = model.accessors[size_t(index)];
   const int component = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
   const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
   if (component <= 0 || components <= 0) throw InputError(what + ": unknown component type or type");
   if (a.sparse.isSparse)
-    throw InputError(what + ": a sparse accessor; --lightmap splits this primitive's vertices and does not rewrite "
-                     "sparse accessors");
+    throw InputError(what + ": a sparse accessor, which " + option + " does not rewrite");
   const size_t element = size_t(component) * size_t(components);
   std::string out(xref.size() * element, '\0');
   if (a.bufferView < 0) return out;  // all zeros, as the specification says
@@ -494,6 +460,102 @@ Json position_fields(const std::string& bytes, size_t count) {
   return {{"componentType", kFloat}, {"count", count}, {"type", "VEC3"}, {"min", lo}, {"max", hi}};
 }
 
+/// Rewrites a primitive's attributes (and its morph targets') as new accessors holding the
+/// input's vertices xref[k], k = 0, 1, …, in that order; the caller adds the index list. A
+/// Draco-compressed primitive is then written decoded (its attributes were regathered from
+/// tinygltf's decoded accessors): its compressed data no longer applies.
+void regather_primitive(GltfOutput& o, const tinygltf::Model& model, Json& primitive,
+                        const std::vector<uint32_t>& xref, const std::string& what, const char* option) {
+  const auto regather = [&](Json& attributes, bool target) {
+    for (auto& [name, index] : attributes.items()) {
+      if (!index.is_number_integer()) continue;
+      const std::string bytes = gather(model, int(index.get<int64_t>()), xref, what + " " + name, option);
+      const tinygltf::Accessor& a = model.accessors[size_t(index.get<int64_t>())];
+      const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+      Json fields = {{"componentType", a.componentType},
+                     {"count", xref.size()},
+                     {"type", components == 1   ? "SCALAR"
+                              : components == 2 ? "VEC2"
+                              : components == 3 ? "VEC3"
+                              : components == 4 ? "VEC4"
+                                                : "MAT4"}};
+      if (a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3)
+        throw InputError(what + " " + name + ": matrix vertex attributes are not supported by " + option);
+      if (a.normalized) fields["normalized"] = true;
+      if (name == "POSITION" && a.componentType == kFloat && a.type == TINYGLTF_TYPE_VEC3)
+        fields = position_fields(bytes, xref.size());
+      else if (name == "POSITION" && !target)
+        throw InputError(what + ": quantized positions (KHR_mesh_quantization) are not supported by " +
+                         option);
+      index = o.add_accessor(bytes.data(), bytes.size(), std::move(fields), true);
+    }
+  };
+  regather(primitive["attributes"], false);
+  if (primitive.contains("targets") && primitive["targets"].is_array())
+    for (Json& target : primitive["targets"])
+      if (target.is_object()) regather(target, true);
+  if (primitive.contains("extensions") && primitive["extensions"].is_object()) {
+    primitive["extensions"].erase("KHR_draco_mesh_compression");
+    if (primitive["extensions"].empty()) primitive.erase("extensions");
+  }
+}
+
+/// Once no primitive is compressed any more, the file no longer needs a Draco decoder.
+void drop_draco_if_unused(Json& j) {
+  bool draco_left = false;
+  if (j.contains("meshes") && j["meshes"].is_array())
+    for (const Json& mesh : j["meshes"])
+      if (mesh.is_object() && mesh.contains("primitives") && mesh["primitives"].is_array())
+        for (const Json& primitive : mesh["primitives"])
+          draco_left = draco_left || (primitive.is_object() && primitive.contains("extensions") &&
+                                      primitive["extensions"].is_object() &&
+                                      primitive["extensions"].contains("KHR_draco_mesh_compression"));
+  if (!draco_left)
+    for (const char* list : {"extensionsUsed", "extensionsRequired"})
+      if (j.contains(list) && j[list].is_array()) {
+        Json kept = Json::array();
+        for (const Json& name : j[list])
+          if (name != "KHR_draco_mesh_compression") kept.push_back(name);
+        if (kept.empty())
+          j.erase(list);
+        else
+          j[list] = std::move(kept);
+      }
+}
+
+/// A primitive's index list as a new accessor (triangles: strips and fans were unrolled by the loader).
+void add_indices(GltfOutput& o, Json& primitive, const std::vector<uint32_t>& indices) {
+  primitive["indices"] =
+      o.add_accessor(indices.data(), indices.size() * 4,
+                     {{"componentType", kUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}}, false);
+  primitive["mode"] = 4;
+}
+
+/// Whether `w` is no split at all: wedge k is vertex k of a mesh of `vertices` vertices, and the
+/// corners are the index list.
+bool is_identity(const Wedges& w, const std::vector<uint32_t>& indices, size_t vertices) {
+  if (w.vertex.size() != vertices) return false;
+  for (size_t k = 0; k < w.vertex.size(); ++k)
+    if (w.vertex[k] != k) return false;
+  return w.of_corner == indices;
+}
+
+/// A vertex bake's two colour attributes: COLOR_0 display-referred, the quantity itself beside it.
+void add_colour_attributes(GltfOutput& o, Json& attributes, const std::vector<Rgb>& values,
+                           const ExportSettings& settings) {
+  const float scale = std::exp2(settings.exposure);
+  const auto add_colours = [&](bool clamp) {
+    std::vector<float> floats;
+    floats.reserve(3 * values.size());
+    for (const Rgb& c : values)
+      for (int k = 0; k < 3; ++k) floats.push_back(clamp ? std::clamp(c[k] * scale, 0.0f, 1.0f) : c[k]);
+    return o.add_accessor(floats.data(), floats.size() * 4,
+                          {{"componentType", kFloat}, {"count", values.size()}, {"type", "VEC3"}}, true);
+  };
+  attributes["COLOR_0"] = add_colours(true);
+  attributes[gltf_attribute(settings.quantity)] = add_colours(false);
+}
+
 Json lightmap_extras(const std::string& uri, int tex_coord, const ExportSettings& settings) {
   return {{"uri", percent_encode(uri)},
           {"texCoord", tex_coord},
@@ -510,10 +572,7 @@ int add_lightmap_uvs(GltfOutput& o, Json& primitive, const UvSplit& split) {
   attributes["TEXCOORD_" + std::to_string(tex_coord)] =
       o.add_accessor(split.uv.data(), split.uv.size() * sizeof(rc::Vec2),
                      {{"componentType", kFloat}, {"count", split.uv.size()}, {"type", "VEC2"}}, true);
-  primitive["indices"] = o.add_accessor(split.indices.data(), split.indices.size() * 4,
-                                        {{"componentType", kUnsignedInt}, {"count", split.indices.size()}, {"type", "SCALAR"}},
-                                        false);
-  primitive["mode"] = 4;  // triangles: strips and fans were unrolled by the loader
+  add_indices(o, primitive, split.indices);
   return tex_coord;
 }
 
@@ -553,39 +612,8 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
         continue;
       }
       const UvSplit split = split_by_uv(mesh.indices, lightmap.corner_uv[m]);
-      const auto regather = [&](Json& attributes, bool target) {
-        for (auto& [name, index] : attributes.items()) {
-          if (!index.is_number_integer()) continue;
-          const std::string bytes = gather(model, int(index.get<int64_t>()), split.xref, what + " " + name);
-          const tinygltf::Accessor& a = model.accessors[size_t(index.get<int64_t>())];
-          Json fields = {{"componentType", a.componentType},
-                         {"count", split.xref.size()},
-                         {"type", tinygltf::GetNumComponentsInType(uint32_t(a.type)) == 1   ? "SCALAR"
-                                  : tinygltf::GetNumComponentsInType(uint32_t(a.type)) == 2 ? "VEC2"
-                                  : tinygltf::GetNumComponentsInType(uint32_t(a.type)) == 3 ? "VEC3"
-                                  : tinygltf::GetNumComponentsInType(uint32_t(a.type)) == 4 ? "VEC4"
-                                                                                            : "MAT4"}};
-          if (a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3)
-            throw InputError(what + " " + name + ": matrix vertex attributes are not supported by --lightmap");
-          if (a.normalized) fields["normalized"] = true;
-          if (name == "POSITION" && a.componentType == kFloat && a.type == TINYGLTF_TYPE_VEC3)
-            fields = position_fields(bytes, split.xref.size());
-          else if (name == "POSITION" && !target)
-            throw InputError(what + ": quantized positions (KHR_mesh_quantization) are not supported by --lightmap");
-          index = o.add_accessor(bytes.data(), bytes.size(), std::move(fields), true);
-        }
-      };
-      regather(primitive["attributes"], false);
-      if (primitive.contains("targets") && primitive["targets"].is_array())
-        for (Json& target : primitive["targets"])
-          if (target.is_object()) regather(target, true);
+      regather_primitive(o, model, primitive, split.xref, what, "--lightmap");
       const int tex_coord = add_lightmap_uvs(o, primitive, split);
-      // A Draco-compressed primitive is now written decoded (its attributes and indices were
-      // regathered from tinygltf's decoded accessors): its compressed data no longer applies.
-      if (primitive.contains("extensions") && primitive["extensions"].is_object()) {
-        primitive["extensions"].erase("KHR_draco_mesh_compression");
-        if (primitive["extensions"].empty()) primitive.erase("extensions");
-      }
       const Json extras = lightmap_extras(image_uri, tex_coord, settings);
       primitive["extras"]["gilt_lightmap"] = extras;
       Json& material = material_for(j, primitive);
@@ -595,59 +623,46 @@ void write_lightmap_gltf(const std::string& input, const std::string& output, co
   }
   if (!baked_any)
     throw InputError(input + ": no surface of the model holds a solution (mirrors and glass are not baked)");
-  // Once no primitive is compressed any more, the file no longer needs a Draco decoder.
-  bool draco_left = false;
-  if (j.contains("meshes") && j["meshes"].is_array())
-    for (const Json& mesh : j["meshes"])
-      if (mesh.is_object() && mesh.contains("primitives") && mesh["primitives"].is_array())
-        for (const Json& primitive : mesh["primitives"])
-          draco_left = draco_left || (primitive.is_object() && primitive.contains("extensions") &&
-                                      primitive["extensions"].is_object() &&
-                                      primitive["extensions"].contains("KHR_draco_mesh_compression"));
-  if (!draco_left)
-    for (const char* list : {"extensionsUsed", "extensionsRequired"})
-      if (j.contains(list) && j[list].is_array()) {
-        Json kept = Json::array();
-        for (const Json& name : j[list])
-          if (name != "KHR_draco_mesh_compression") kept.push_back(name);
-        if (kept.empty()) j.erase(list);
-        else j[list] = std::move(kept);
-      }
+  drop_draco_if_unused(j);
   finish_output(o, output);
 }
 
-/// OBJ or PLY in: a new glTF of the meshes as read.
-void write_lightmap_converted(const std::string& output, const rc::scene::Scene& scene,
-                              const Lightmap& lightmap, const ExportSettings& settings,
-                              const std::string& image_uri) {
+/// OBJ or PLY in, glTF out: a new model of the meshes as read, one node, one mesh, one primitive
+/// per scene mesh written, one material per material used.
+struct ConvertedModel {
   GltfOutput o;
-  o.glb = rc::io::lower_extension(output) == ".glb";
-  o.out_path = fs::absolute(output).lexically_normal();
-  Json& j = o.json();
-  const std::string& input = scene.model_files[size_t(lightmap.file)];
-  j = {{"asset", {{"version", "2.0"}, {"generator", "gilt radiosity --lightmap"}}},
-       {"scene", 0},
-       {"scenes", Json::array({Json{{"nodes", Json::array({0})}}})},
-       {"nodes", Json::array({Json{{"name", fs::path(input).stem().string()}, {"mesh", 0}}})},
-       {"meshes", Json::array({Json{{"name", fs::path(input).stem().string()}, {"primitives", Json::array()}}})},
-       {"materials", Json::array()},
-       {"buffers", Json::array()},
-       {"bufferViews", Json::array()},
-       {"accessors", Json::array()}};
+  std::string input;
   std::map<uint32_t, size_t> material_index;
   bool emissive_strength = false;
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    if (lightmap.corner_uv[m].empty()) continue;
-    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
-    const UvSplit split = split_by_uv(mesh.indices, lightmap.corner_uv[m]);
+
+  ConvertedModel(const rc::scene::Scene& scene, int32_t file, const std::string& output,
+                 const char* generator) {
+    o.glb = rc::io::lower_extension(output) == ".glb";
+    o.out_path = fs::absolute(output).lexically_normal();
+    input = scene.model_files[size_t(file)];
+    const std::string name = fs::path(input).stem().string();
+    o.json() = {{"asset", {{"version", "2.0"}, {"generator", generator}}},
+                {"scene", 0},
+                {"scenes", Json::array({Json{{"nodes", Json::array({0})}}})},
+                {"nodes", Json::array({Json{{"name", name}, {"mesh", 0}}})},
+                {"meshes", Json::array({Json{{"name", name}, {"primitives", Json::array()}}})},
+                {"materials", Json::array()},
+                {"buffers", Json::array()},
+                {"bufferViews", Json::array()},
+                {"accessors", Json::array()}};
+  }
+
+  /// A primitive of the mesh's vertices xref[k], k = 0, 1, …: their positions, normals and UVs
+  /// (OBJ and PLY count v up from the bottom, glTF down from the top); no index list yet.
+  Json primitive(const rc::scene::TriangleMesh& mesh, const std::vector<uint32_t>& xref) {
     Json primitive = {{"attributes", Json::object()}};
-    std::string positions(split.xref.size() * 12, '\0');
-    for (size_t k = 0; k < split.xref.size(); ++k) std::memcpy(&positions[12 * k], &mesh.positions[split.xref[k]], 12);
+    std::string positions(xref.size() * 12, '\0');
+    for (size_t k = 0; k < xref.size(); ++k) std::memcpy(&positions[12 * k], &mesh.positions[xref[k]], 12);
     primitive["attributes"]["POSITION"] =
-        o.add_accessor(positions.data(), positions.size(), position_fields(positions, split.xref.size()), true);
+        o.add_accessor(positions.data(), positions.size(), position_fields(positions, xref.size()), true);
     if (!mesh.normals.empty()) {
       std::vector<rc::Vec3> normals;
-      for (uint32_t v : split.xref) {
+      for (uint32_t v : xref) {
         const rc::Vec3 n = mesh.normals[v];
         const float len = glm::length(n);
         normals.push_back(len > 0.0f ? n / len : rc::Vec3(0.0f, 0.0f, 1.0f));
@@ -656,15 +671,19 @@ void write_lightmap_converted(const std::string& output, const rc::scene::Scene&
           normals.data(), normals.size() * 12, {{"componentType", kFloat}, {"count", normals.size()}, {"type", "VEC3"}},
           true);
     }
-    if (!mesh.uvs.empty()) {  // OBJ and PLY count v up from the bottom, glTF down from the top
+    if (!mesh.uvs.empty()) {
       std::vector<rc::Vec2> uvs;
-      for (uint32_t v : split.xref) uvs.emplace_back(mesh.uvs[v].x, 1.0f - mesh.uvs[v].y);
+      for (uint32_t v : xref) uvs.emplace_back(mesh.uvs[v].x, 1.0f - mesh.uvs[v].y);
       primitive["attributes"]["TEXCOORD_0"] = o.add_accessor(
           uvs.data(), uvs.size() * 8, {{"componentType", kFloat}, {"count", uvs.size()}, {"type", "VEC2"}}, true);
     }
-    const int tex_coord = add_lightmap_uvs(o, primitive, split);
-    const Json extras = lightmap_extras(image_uri, tex_coord, settings);
-    primitive["extras"]["gilt_lightmap"] = extras;
+    return primitive;
+  }
+
+  /// Adds the primitive with the mesh's material (made on first use, with `extras`).
+  void add(Json primitive, const rc::scene::Scene& scene, const rc::scene::TriangleMesh& mesh,
+           const Json& extras) {
+    Json& j = o.json();
     auto [it, added] = material_index.try_emplace(mesh.material, j["materials"].size());
     if (added) {
       const rc::scene::Material& mat = scene.materials[mesh.material];
@@ -672,8 +691,8 @@ void write_lightmap_converted(const std::string& output, const rc::scene::Scene&
                        {"pbrMetallicRoughness",
                         {{"baseColorFactor", {mat.albedo.r, mat.albedo.g, mat.albedo.b, 1.0f}},
                          {"metallicFactor", 0.0},
-                         {"roughnessFactor", 1.0}}},
-                       {"extras", {{"gilt_lightmap", extras}}}};
+                         {"roughnessFactor", 1.0}}}};
+      if (!extras.is_null()) material["extras"] = extras;
       const float peak = std::max({mat.emission.r, mat.emission.g, mat.emission.b});
       if (peak > 0.0f) {
         const float scale = peak > 1.0f ? 1.0f / peak : 1.0f;
@@ -688,13 +707,97 @@ void write_lightmap_converted(const std::string& output, const rc::scene::Scene&
     primitive["material"] = it->second;
     j["meshes"][0]["primitives"].push_back(std::move(primitive));
   }
-  if (emissive_strength) j["extensionsUsed"] = Json::array({"KHR_materials_emissive_strength"});
-  if (o.data.empty())
-    throw InputError(input + ": no surface of the model holds a solution (mirrors and glass are not baked)");
-  finish_output(o, output);
+
+  void finish(const std::string& output) {
+    if (emissive_strength) o.json()["extensionsUsed"] = Json::array({"KHR_materials_emissive_strength"});
+    if (o.data.empty())
+      throw InputError(input +
+                       ": no surface of the model holds a solution (mirrors and glass are not baked)");
+    finish_output(o, output);
+  }
+};
+
+void write_lightmap_converted(const std::string& output, const rc::scene::Scene& scene,
+                              const Lightmap& lightmap, const ExportSettings& settings,
+                              const std::string& image_uri) {
+  ConvertedModel model(scene, lightmap.file, output, "gilt radiosity --lightmap");
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (lightmap.corner_uv[m].empty()) continue;
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
+    const UvSplit split = split_by_uv(mesh.indices, lightmap.corner_uv[m]);
+    Json primitive = model.primitive(mesh, split.xref);
+    const int tex_coord = add_lightmap_uvs(model.o, primitive, split);
+    const Json extras = {{"gilt_lightmap", lightmap_extras(image_uri, tex_coord, settings)}};
+    primitive["extras"] = extras;
+    model.add(std::move(primitive), scene, mesh, extras);
+  }
+  model.finish(output);
+}
+
+/// --onto input, OBJ or PLY in, glTF out: the meshes as read, their vertices split into the
+/// colours' wedges.
+void write_onto_converted(const std::string& output, const rc::scene::Scene& scene,
+                          const InputColours& colours, const ExportSettings& settings) {
+  ConvertedModel model(scene, colours.file, output, "gilt radiosity --onto input");
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (colours.per_mesh[m].empty()) continue;
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
+    const Wedges& w = colours.wedges[m];
+    Json primitive = model.primitive(mesh, w.vertex);
+    add_indices(model.o, primitive, w.of_corner);
+    add_colour_attributes(model.o, primitive["attributes"], colours.per_mesh[m], settings);
+    model.add(std::move(primitive), scene, mesh, Json());
+  }
+  model.finish(output);
 }
 
 }  // namespace
+
+void write_onto_gltf(const std::string& input, const std::string& output, const rc::scene::Scene& scene,
+                     const InputColours& colours, const ExportSettings& settings) {
+  const std::string in_ext = rc::io::lower_extension(input);
+  if (in_ext != ".gltf" && in_ext != ".glb") {
+    if (colours.wedges.empty())
+      throw std::logic_error("write_onto_gltf: an OBJ or PLY input's colours were not split");
+    write_onto_converted(output, scene, colours, settings);
+    return;
+  }
+  std::optional<tinygltf::Model> model;  // read when a primitive's vertices are split
+  GltfOutput o = begin_output(input, output);
+  Json& j = o.json();
+  std::map<int32_t, int32_t> mesh_of_node;
+  const auto scene_meshes_of_node = split_instances(
+      j, scene, colours.file, [&](size_t m) { return !colours.per_mesh[m].empty(); }, mesh_of_node);
+  Json& meshes = array(j, "meshes");
+  Json& accessors = array(j, "accessors");
+  for (const auto& [node, list] : scene_meshes_of_node) {
+    Json& primitives = meshes[size_t(mesh_of_node.at(node))]["primitives"];
+    for (size_t m : list) {
+      const rc::scene::TriangleMesh& mesh = scene.meshes[m];
+      Json& primitive = primitives[size_t(mesh.origin.primitive)];
+      const Json& position = accessors[size_t(primitive["attributes"]["POSITION"].get<int64_t>())];
+      if (position.value("count", size_t(0)) != mesh.positions.size())
+        throw std::logic_error("write_onto_gltf: vertex count of a primitive changed while loading");
+      const bool split =
+          !colours.wedges.empty() && !is_identity(colours.wedges[m], mesh.indices, mesh.positions.size());
+      if (split) {
+        if (!model) model = rc::io::read_gltf_file(input);
+        const std::string what = input + ": mesh " + std::to_string(mesh.origin.mesh) + " primitive " +
+                                 std::to_string(mesh.origin.primitive);
+        regather_primitive(o, *model, primitive, colours.wedges[m].vertex, what,
+                           "--onto input's vertex split (--keep-vertices turns it off)");
+        add_indices(o, primitive, colours.wedges[m].of_corner);
+      } else if (colours.per_mesh[m].size() != mesh.positions.size()) {
+        throw std::logic_error("write_onto_gltf: colours for some vertices only");
+      }
+      add_colour_attributes(o, primitive["attributes"], colours.per_mesh[m], settings);
+    }
+  }
+  if (o.data.empty())
+    throw InputError(input + ": no surface of the model holds a solution (mirrors and glass are not baked)");
+  drop_draco_if_unused(j);
+  finish_output(o, output);
+}
 
 void check_lightmap_output(const std::string& path, const rc::scene::Scene& scene) {
   const std::string& input = scene.model_files[size_t(onto_input_file(scene))];

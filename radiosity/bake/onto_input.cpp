@@ -2,10 +2,15 @@
 
 #include "radiosity/bake/onto_input.h"
 
+#include <array>
 #include <bit>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <limits>
+#include <numeric>
+#include <unordered_map>
 
 #include "radiosity/bake/view.h"
 #include "radiosity/mesh/element_scene.h"
@@ -143,13 +148,89 @@ std::vector<char> input_faces_buried(const rc::scene::Scene& scene, std::span<co
   return buried;
 }
 
-InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& solution, VertexFit fit, Quantity quantity,
-                               BakeGather gather) {
+Rgb InputColours::at_corner(const rc::scene::Scene& scene, size_t m, size_t corner) const {
+  const rc::scene::TriangleMesh& mesh = scene.meshes[m];
+  const uint32_t v = mesh.indices[corner];
+  if (per_mesh.empty()) return per_file_vertex[mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v]];
+  return per_mesh[m][wedges.empty() || wedges[m].of_corner.empty() ? v : wedges[m].of_corner[corner]];
+}
+
+bool InputColours::covers(size_t m) const {
+  return per_mesh.empty() ? !per_file_vertex.empty() : !per_mesh[m].empty();
+}
+
+namespace {
+
+bool is_gltf(const std::string& path) {
+  const std::string ext = rc::io::lower_extension(path);
+  return ext == ".gltf" || ext == ".glb";
+}
+
+}  // namespace
+
+InputVertices input_vertices(const std::string& output, const rc::scene::Scene& scene, bool keep) {
+  if (!is_gltf(output)) return InputVertices::as_read;
+  if (!keep) return InputVertices::split;
+  return is_gltf(scene.model_files[size_t(onto_input_file(scene))]) ? InputVertices::as_read
+                                                                    : InputVertices::file;
+}
+
+namespace {
+
+/// The baked faces of every mesh read from the model file, as one mesh whose vertices are welded
+/// where their positions are equal bit for bit (a glTF primitive's vertices are split at its UV
+/// and normal seams, and an OBJ's at its own `v` lines; the light is continuous across both), or
+/// not `by_position`, one per vertex of the file (an OBJ's `v` lines).
+struct WeldedInput {
+  std::vector<Vec3> positions;
+  std::vector<uint32_t> indices;
+  std::vector<uint32_t> face_material;
+  std::vector<std::pair<uint32_t, uint32_t>>
+      corner_origin;  ///< per corner: scene mesh, corner in its index list
+};
+
+struct PositionBitsHash {
+  size_t operator()(const std::array<uint32_t, 3>& k) const {
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (uint32_t x : k) h = (h ^ x) * 0x100000001B3ull;
+    return size_t(h ^ (h >> 29));
+  }
+};
+
+WeldedInput weld_input(const rc::scene::Scene& scene,
+                       const std::function<bool(const rc::scene::TriangleMesh&)>& baked, bool by_position) {
+  WeldedInput w;
+  std::unordered_map<std::array<uint32_t, 3>, uint32_t, PositionBitsHash> index_of;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const rc::scene::TriangleMesh& mesh = scene.meshes[m];
+    if (!baked(mesh)) continue;
+    for (size_t c = 0; c < mesh.indices.size(); ++c) {
+      const uint32_t v = mesh.indices[c];
+      const Vec3 p = mesh.positions[v];
+      const std::array<uint32_t, 3> key =
+          by_position
+              ? std::array<uint32_t, 3>{std::bit_cast<uint32_t>(p.x), std::bit_cast<uint32_t>(p.y),
+                                        std::bit_cast<uint32_t>(p.z)}
+              : std::array<uint32_t, 3>{mesh.origin.vertex.empty() ? v : mesh.origin.vertex[v], 0u, 0u};
+      const auto [it, added] = index_of.try_emplace(key, uint32_t(w.positions.size()));
+      if (added) w.positions.push_back(p);
+      w.indices.push_back(it->second);
+      w.corner_origin.emplace_back(uint32_t(m), uint32_t(c));
+      if (c % 3 == 0) w.face_material.push_back(mesh.material);
+    }
+  }
+  return w;
+}
+
+}  // namespace
+
+InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& solution, VertexFit fit,
+                               Quantity quantity, BakeGather gather, InputVertices vertices) {
   const auto start = std::chrono::steady_clock::now();
   InputColours out;
   out.file = onto_input_file(scene);
   const std::string ext = rc::io::lower_extension(scene.model_files[size_t(out.file)]);
-  const bool per_file_vertex = ext == ".obj" || ext == ".ply";
+  const bool per_file_vertex = vertices == InputVertices::as_read && (ext == ".obj" || ext == ".ply");
   const float spacing = 0.5f * solution.mesh_report.max_edge;
   const SolutionAtInput at_input(scene, solution, quantity, gather);
   const auto value = [&](const rc::scene::Material& m, const Vec3& p, const Vec3& n) {
@@ -165,7 +246,65 @@ InputColours fit_input_colours(const rc::scene::Scene& scene, const Solution& so
     return buried;
   };
 
-  if (!per_file_vertex) {  // glTF: each primitive instance on its own
+  if (vertices != InputVertices::as_read) {  // glTF out: every face of the file at once, welded
+    const WeldedInput welded = weld_input(scene, baked, /*by_position=*/vertices == InputVertices::split);
+    const std::vector<char> buried = buried_faces(welded.positions, welded.indices);
+    const SurfaceField field = [&](const Vec3& p, const Vec3& n, size_t face) -> std::optional<Rgb> {
+      if (buried[face]) return std::nullopt;
+      return value(scene.materials[welded.face_material[face]], p, n);
+    };
+    rc::util::Progress progress("bake: onto the input",
+                                fit == VertexFit::point ? welded.positions.size() : welded.indices.size() / 3,
+                                fit == VertexFit::point ? "vertices" : "faces", gather.progress);
+    SplitRules rules;
+    rules.face_key = welded.face_material;
+    Wedges wedges;
+    std::vector<Rgb> colours;
+    if (vertices == InputVertices::file) {  // one colour per vertex of the file, as its own format holds
+      wedges = one_wedge_per_vertex(welded.indices);
+      const std::vector<Rgb> per_vertex =
+          fit_vertex_colours(welded.positions, welded.indices, field, fit, spacing, &out.stats, &progress);
+      for (uint32_t v : wedges.vertex) colours.push_back(per_vertex[v]);
+    } else {
+      colours = fit_split_colours(welded.positions, welded.indices, field, fit, spacing, rules, wedges, &out.stats,
+                                  &progress);
+    }
+    out.welded_vertices = welded.positions.size();
+    // Each scene mesh's own wedges: wedges of the fit at the mesh's vertices (its seams stay:
+    // each side keeps its own UVs and normals). Vertex v's first wedge keeps its number, v, and
+    // further ones follow the mesh's vertices, so that a mesh nothing splits stays as it was.
+    out.per_mesh.resize(scene.meshes.size());
+    out.wedges.resize(scene.meshes.size());
+    std::vector<std::vector<uint32_t>> first(scene.meshes.size());  // per vertex: the fit's wedge that is v
+    std::vector<std::unordered_map<uint64_t, uint32_t>> extra(scene.meshes.size());
+    for (size_t c = 0; c < welded.indices.size(); ++c) {
+      const auto [m, corner] = welded.corner_origin[c];
+      const size_t vertices = scene.meshes[m].positions.size();
+      Wedges& mw = out.wedges[m];
+      if (mw.of_corner.empty()) {
+        mw.of_corner.assign(scene.meshes[m].indices.size(), 0);
+        mw.vertex.resize(vertices);
+        std::iota(mw.vertex.begin(), mw.vertex.end(), 0u);
+        out.per_mesh[m].assign(vertices, Rgb(0.0f));  // vertices no baked face uses stay black
+        first[m].assign(vertices, UINT32_MAX);
+      }
+      const uint32_t v = scene.meshes[m].indices[corner], w = wedges.of_corner[c];
+      if (first[m][v] == UINT32_MAX) {
+        first[m][v] = w;
+        out.per_mesh[m][v] = colours[w];
+      }
+      if (first[m][v] == w) {
+        mw.of_corner[corner] = v;
+        continue;
+      }
+      const auto [it, added] = extra[m].try_emplace((uint64_t(w) << 32) | v, uint32_t(mw.vertex.size()));
+      if (added) {
+        mw.vertex.push_back(v);
+        out.per_mesh[m].push_back(colours[w]);
+      }
+      mw.of_corner[corner] = it->second;
+    }
+  } else if (!per_file_vertex) {  // glTF: each primitive instance on its own
     out.per_mesh.resize(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const rc::scene::TriangleMesh& mesh = scene.meshes[m];
@@ -304,9 +443,13 @@ void check_onto_output(const std::string& path, const rc::scene::Scene& scene) {
   std::error_code ec;
   if (fs::equivalent(input, path, ec))
     throw InputError("-o " + path + ": is the input model; --onto input never modifies its input");
-  if (in_gltf != out_gltf || (!in_gltf && in_ext != out_ext))
-    throw InputError("-o " + path + ": --onto input writes the input's own format, and the input is " + input +
-                     (in_gltf ? " (use .gltf or .glb)" : " (use " + in_ext + ")"));
+  if ((in_gltf && !out_gltf) || (!in_gltf && !out_gltf && in_ext != out_ext))
+    throw InputError("-o " + path +
+                     ": --onto input writes the input's own format or glTF, and the input is " + input +
+                     (in_gltf ? " (use .gltf or .glb)" : " (use " + in_ext + ", .gltf or .glb)"));
+  const fs::path folder = fs::absolute(path).parent_path();
+  if (!fs::is_directory(folder, ec))
+    throw InputError("-o " + path + ": folder " + folder.string() + " does not exist");
 }
 
 void write_onto_input(const std::string& path, const rc::scene::Scene& scene, const InputColours& colours,
@@ -315,12 +458,14 @@ void write_onto_input(const std::string& path, const rc::scene::Scene& scene, co
   if (colours.file < 0 || size_t(colours.file) >= scene.model_files.size())
     throw std::logic_error("write_onto_input: no model file");
   const std::string& input = scene.model_files[size_t(colours.file)];
-  if (rc::io::lower_extension(input) == ".obj")
-    write_onto_obj(input, path, colours, settings);
-  else if (rc::io::lower_extension(input) == ".ply")
-    write_onto_ply(input, path, colours, settings);
-  else
+  if (!is_gltf(path) && !colours.wedges.empty())
+    throw std::logic_error("write_onto_input: colours fitted for split vertices, written to " + path);
+  if (is_gltf(path))
     write_onto_gltf(input, path, scene, colours, settings);
+  else if (rc::io::lower_extension(input) == ".obj")
+    write_onto_obj(input, path, colours, settings);
+  else
+    write_onto_ply(input, path, colours, settings);
 }
 
 }  // namespace gilt::radiosity::bake

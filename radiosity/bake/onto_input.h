@@ -64,15 +64,38 @@ struct BakeSides {
 /// Irradiances whose ratio exceeds this are "different" sides (BakeSides::differ).
 inline constexpr float kSidesDiffer = 2.0f;
 
+/// Which vertices a bake onto the input model colours.
+enum class InputVertices : uint8_t {
+  as_read,  ///< the file's own: OBJ `v` lines, PLY vertices, glTF primitives' vertices
+  file,     ///< an OBJ's or PLY's own vertices, written as glTF: one colour per file vertex
+  split,    ///< welded by position, then split where the light jumps across an edge (glTF out)
+};
+
 /// Colours for the vertices of the meshes read from one model file.
 struct InputColours {
   int32_t file = -1;                        ///< index into Scene::model_files
-  /// glTF: per scene mesh (one per primitive placed by a node), one per vertex; empty: not baked.
+  /// glTF: per scene mesh (one per primitive placed by a node), one per vertex, or one per wedge
+  /// when `wedges` splits its vertices; empty: not baked.
   std::vector<std::vector<Rgb>> per_mesh;
+  /// A split bake (fit_input_colours with `split`; any glTF output): per scene mesh, its vertices
+  /// split into wedges where the light jumps across an edge (vertex_split.h); the wedges'
+  /// vertices are the mesh's own. Empty: no split.
+  std::vector<Wedges> wedges;
+  size_t welded_vertices = 0;  ///< a split bake's positions over the whole file (file: its vertices)
+  /// Vertices the glTF output holds for the baked meshes (each mesh's vertices and its wedges).
+  size_t written_vertices() const {
+    size_t n = 0;
+    for (const std::vector<Rgb>& c : per_mesh) n += c.size();
+    return n;
+  }
   /// OBJ and PLY: one per vertex of the file (its `v` lines, its vertex element), fitted over the
   /// faces of every material at once, since the file has one colour per vertex.
   std::vector<Rgb> per_file_vertex;
   FitStats stats;
+  /// The colour at corner `corner` (an index into its index list) of scene mesh m.
+  Rgb at_corner(const rc::scene::Scene& scene, size_t m, size_t corner) const;
+  /// Whether scene mesh m was baked.
+  bool covers(size_t m) const;
   BakeGatherCount gather;   ///< with a final gather: how its points were evaluated
   BakeSides sides;          ///< which side of the surface its points read
   size_t buried_faces = 0;  ///< input faces left out of the fit: inside closed solids or under objects
@@ -142,8 +165,20 @@ std::vector<char> input_faces_buried(const rc::scene::Scene& scene, std::span<co
 /// solution's target edge. Each point's irradiance E is turned into the quantity by its face's
 /// material (B = π·Le + ρ·E, L = B/π) before fitting, so a vertex shared by two materials gets
 /// the colour nearest both.
-InputColours fit_input_colours(const rc::scene::Scene& scene, const solver::Solution& solution, VertexFit fit, Quantity quantity,
-                               BakeGather gather = {});
+///
+/// With InputVertices::split (a glTF output), every mesh of the file is fitted at once, its
+/// vertices welded where their positions are equal, then split into wedges by
+/// fit_split_colours (creases, materials, shadow lines along edges); with ::file, at once over
+/// the file's own vertices. Colours go in per_mesh and wedges.
+InputColours fit_input_colours(const rc::scene::Scene& scene, const solver::Solution& solution, VertexFit fit,
+                               Quantity quantity, BakeGather gather = {},
+                               InputVertices vertices = InputVertices::as_read);
+
+/// The vertices `--onto input` gives colours for, writing `output` (`keep`: --keep-vertices):
+/// glTF, whose index lists let one position carry several colours, splits them, unless kept;
+/// kept, a glTF input keeps its own, and an OBJ or PLY one its file's (InputVertices::file).
+/// OBJ and PLY outputs keep the file's own.
+InputVertices input_vertices(const std::string& output, const rc::scene::Scene& scene, bool keep);
 
 /// cos 30°: the mesher splits vertices at creases sharper than 30° (MeshSettings), so a point of
 /// the input under a vertex belongs to the vertex's side when its normal is within 30° of the vertex's.

@@ -59,8 +59,52 @@ std::vector<float> floats(const tinygltf::Model& m, int index) {
   return out;
 }
 
+/// An index accessor's values (any component type); 0, 1, … for a primitive without one.
+std::vector<uint32_t> index_values(const tinygltf::Model& m, int index, size_t vertices) {
+  std::vector<uint32_t> out;
+  if (index < 0) {
+    for (size_t v = 0; v < vertices; ++v) out.push_back(uint32_t(v));
+    return out;
+  }
+  const std::string bytes = accessor_bytes(m, index);
+  const size_t size =
+      size_t(tinygltf::GetComponentSizeInBytes(uint32_t(m.accessors.at(size_t(index)).componentType)));
+  for (size_t at = 0; at + size <= bytes.size(); at += size) {
+    uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + at, size);  // little-endian
+    out.push_back(v);
+  }
+  return out;
+}
+
+/// A primitive whose vertices the bake split (Vertices::split): the same faces in the same order,
+/// each corner's vertex holding the input corner's attributes byte for byte (positions too), and
+/// the input's vertices first, at their own numbers.
+void expect_same_corners(const tinygltf::Model& in, const tinygltf::Primitive& pa, const tinygltf::Model& out,
+                         const tinygltf::Primitive& pb) {
+  const size_t in_count = in.accessors.at(size_t(pa.attributes.at("POSITION"))).count;
+  const size_t out_count = out.accessors.at(size_t(pb.attributes.at("POSITION"))).count;
+  EXPECT_GE(out_count, in_count);
+  const std::vector<uint32_t> ia = index_values(in, pa.indices, in_count),
+                              ib = index_values(out, pb.indices, out_count);
+  ASSERT_EQ(ib.size(), ia.size());
+  for (const auto& [name, accessor] : pa.attributes) {
+    const std::string a = accessor_bytes(in, accessor), b = accessor_bytes(out, pb.attributes.at(name));
+    const size_t element = a.size() / in_count;
+    ASSERT_EQ(b.size(), element * out_count) << name;
+    EXPECT_EQ(b.substr(0, a.size()), a) << name << ": the input's vertices keep their numbers";
+    size_t differ = 0;
+    for (size_t c = 0; c < ia.size(); ++c)
+      differ += a.compare(element * ia[c], element, b, element * ib[c], element) != 0;
+    EXPECT_EQ(differ, 0u) << name << ": corners whose vertex is not the input's";
+  }
+}
+
 /// Compares an --onto input output with its input; returns how many meshes the output split off.
-size_t expect_same_structure(const tinygltf::Model& in, const tinygltf::Model& out, const std::string& quantity_attr) {
+/// With `split`, a primitive may have its vertices split (expect_same_corners) instead of
+/// keeping its index list and attributes.
+size_t expect_same_structure(const tinygltf::Model& in, const tinygltf::Model& out,
+                             const std::string& quantity_attr, bool allow_split = false) {
   EXPECT_EQ(out.nodes.size(), in.nodes.size());
   EXPECT_EQ(out.scenes.size(), in.scenes.size());
   EXPECT_EQ(out.materials.size(), in.materials.size());
@@ -104,6 +148,13 @@ size_t expect_same_structure(const tinygltf::Model& in, const tinygltf::Model& o
     for (size_t p = 0; p < std::min(ma.primitives.size(), mb.primitives.size()); ++p) {
       const tinygltf::Primitive &pa = ma.primitives[p], &pb = mb.primitives[p];
       EXPECT_EQ(pb.material, pa.material);
+      if (allow_split && pb.indices != pa.indices) {
+        expect_same_corners(in, pa, out, pb);
+        EXPECT_TRUE(pb.targets.empty() || pb.targets.size() == pa.targets.size());
+        for (const char* name : {"COLOR_0", quantity_attr.c_str()})
+          EXPECT_EQ(pb.attributes.count(name), 1u) << name;
+        continue;
+      }
       EXPECT_EQ(pb.mode, pa.mode);
       EXPECT_EQ(pb.indices, pa.indices);
       EXPECT_EQ(pb.targets, pa.targets);
@@ -361,6 +412,21 @@ TEST(OntoInput, ElementCheckPointsHoldWhatTheCheckCompared) {
   fs::remove_all(dir);
 }
 
+/// A floor and a wall standing on its back edge, sharing the OBJ's vertices 3 and 4, in one
+/// material: the sun lights the floor and not the wall (it faces away), so the crease between
+/// them is a jump in the light.
+fs::path write_floor_and_wall(const fs::path& dir) {
+  write_file(dir / "model.obj",
+             "mtllib model.mtl\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nv -1 1 -1\nv 1 1 -1\n"
+             "usemtl grey\nf 1 2 3\nf 1 3 4\nf 4 3 6\nf 4 6 5\n");
+  write_file(dir / "model.mtl", "newmtl grey\nKd 0.5 0.5 0.5\n");
+  write_file(dir / "scene.json", R"({
+    "meshes": [{"file": "model.obj"}],
+    "lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2},
+               {"type": "environment", "radiance": 0.1}]})");
+  return dir / "scene.json";
+}
+
 TEST(OntoInput, OutputsPassTheKhronosValidator) {
   // scripts/setup.sh test installs the validator into the build folder from npm.
   const fs::path modules = fs::path(GILT_BUILD_DIR) / "gltf-validator" / "node_modules";
@@ -383,6 +449,16 @@ TEST(OntoInput, OutputsPassTheKhronosValidator) {
   for (const char* name : {"lightmapped.gltf", "lightmapped.glb"}) {
     outputs.push_back(dir / name);
     run(quoted(scene) + " --lightmap 64 --elements 400 -o " + quoted(outputs.back()), dir);
+  }
+  // An OBJ written as glTF, its vertices split at the crease; and kept.
+  const fs::path obj_dir = dir / "obj";
+  fs::create_directories(obj_dir);
+  const fs::path obj_scene = write_floor_and_wall(obj_dir);
+  for (const char* name : {"obj-split.glb", "obj-kept.gltf"}) {
+    outputs.push_back(dir / name);
+    run(quoted(obj_scene) + " --onto input --elements 400 " + (name[4] == 'k' ? "--keep-vertices " : "") +
+            "-o " + quoted(outputs.back()),
+        dir);
   }
   const fs::path scenes = fs::path(GILT_SOURCE_DIR) / ".." / "shared" / "scenes";
   if (fs::exists(scenes / "wrap" / "truck-lit.json")) {
@@ -470,6 +546,55 @@ TEST(OntoInput, AnObjComesBackLineForLine) {
   const double red = expect_same_obj(obj, slurp(dir / "out" / "baked.obj"), "../model.mtl");
   EXPECT_GT(red, 0.05);  // lit: L = ρ E / π with E ≈ 2.8 is about 0.45 on the grey floor (0.70 as sRGB)
   EXPECT_FALSE(fs::exists(dir / "out" / "baked.mtl"));
+  fs::remove_all(dir);
+}
+
+TEST(OntoInput, AnObjWrittenAsGltfKeepsItsFacesAndSplitsItsCrease) {
+  const fs::path dir = fresh_dir("obj-gltf");
+  const fs::path scene = write_floor_and_wall(dir);
+  const rc::scene::Scene input = rc::io::load_scene((dir / "model.obj").string());
+  ASSERT_EQ(input.meshes.size(), 1u);
+  const rc::scene::TriangleMesh& mesh = input.meshes[0];
+  const auto baked = [&](const std::string& name, const std::string& flags) {
+    run(quoted(scene) + " --onto input --elements 400 --quantity irradiance " + flags + " -o " +
+            quoted(dir / name),
+        dir);
+    const tinygltf::Model out = load(dir / name);
+    EXPECT_EQ(out.meshes.size(), 1u);
+    EXPECT_EQ(out.meshes.at(0).primitives.size(), 1u);
+    return out;
+  };
+  // The same faces in the same order, each corner at its OBJ vertex's position bit for bit.
+  const auto corners = [&](const tinygltf::Model& out) {
+    const tinygltf::Primitive& p = out.meshes.at(0).primitives.at(0);
+    const std::vector<float> position = floats(out, p.attributes.at("POSITION"));
+    const std::vector<float> colour = floats(out, p.attributes.at("_IRRADIANCE"));
+    const std::vector<uint32_t> index = index_values(out, p.indices, position.size() / 3);
+    EXPECT_EQ(index.size(), mesh.indices.size());
+    std::map<uint32_t, std::set<std::vector<float>>> colours_of;  // per OBJ vertex (mesh order)
+    for (size_t c = 0; c < std::min(index.size(), mesh.indices.size()); ++c) {
+      const rc::Vec3 want = mesh.positions[mesh.indices[c]];
+      EXPECT_EQ(0, std::memcmp(&position.at(3 * size_t(index[c])), &want, 12)) << "corner " << c;
+      colours_of[mesh.indices[c]].insert(
+          {colour.at(3 * size_t(index[c])), colour.at(3 * size_t(index[c]) + 1)});
+    }
+    return std::make_pair(position.size() / 3, colours_of);
+  };
+  const auto [split_count, split_colours] = corners(baked("split.glb", ""));
+  EXPECT_GE(split_count, mesh.positions.size() + 2);
+  // The crease's two vertices carry the floor's light on the floor and the wall's on the wall:
+  // the floor takes the sun (E ≈ 2 · 0.98 + sky), the wall the sky and the floor's light only.
+  for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
+    const rc::Vec3 p = mesh.positions[v];
+    if (p.z != -1.0f || p.y != 0.0f) continue;
+    ASSERT_EQ(split_colours.at(v).size(), 2u) << "vertex " << v;
+    const float a = split_colours.at(v).begin()->at(0), b = split_colours.at(v).rbegin()->at(0);
+    EXPECT_GT(std::max(a, b), 2.0f * std::min(a, b)) << a << " " << b;
+  }
+  // --keep-vertices: one vertex (and colour) per OBJ vertex.
+  const auto [kept_count, kept_colours] = corners(baked("kept.gltf", "--keep-vertices"));
+  EXPECT_EQ(kept_count, mesh.positions.size());
+  for (const auto& [v, set] : kept_colours) EXPECT_EQ(set.size(), 1u) << "vertex " << v;
   fs::remove_all(dir);
 }
 
@@ -640,9 +765,14 @@ TEST(OntoInput, SharedScenesKeepTheirStructure) {
   for (const auto& c : cases) {
     if (!fs::exists(c.model)) continue;
     for (const char* ext : {".gltf", ".glb"}) {
+      // Kept, every primitive is the input's; split, each face's corners are.
       const fs::path out = dir / (c.model.stem().string() + ext);
-      run(quoted(c.scene) + " --onto input --elements 2000 --quantity irradiance -o " + quoted(out), dir);
+      run(quoted(c.scene) + " --onto input --keep-vertices --elements 2000 --quantity irradiance -o " +
+              quoted(out),
+          dir);
       expect_same_structure(load(c.model), load(out), "_IRRADIANCE");
+      run(quoted(c.scene) + " --onto input --elements 2000 --quantity irradiance -o " + quoted(out), dir);
+      expect_same_structure(load(c.model), load(out), "_IRRADIANCE", /*split=*/true);
     }
   }
   fs::remove_all(dir);
