@@ -15,7 +15,7 @@ For every scene of FAMILY_DIR/family.json it runs, on the scene's own camera:
            python3-openimageio, hence /usr/bin/python3);
   exports  `gilt radiosity SCENE --time T --check N --json` for each export: `elements` (the
            element mesh, checked at random points inside the input's faces, with the share of
-           points an exported face of the same orientation covers), `input` (--onto input) and
+           points an exported face of the same orientation covers), `input` (--onto input, as .glb) and
            `lightmap` (--lightmap 1024): relMSE and mean ratio against path-traced irradiance.
 A family written with `generate.py --furnace` is measured as furnaces instead: the path tracer
 and both radiosity views against the exact Le / (1 − ρ), with the darkest pixel and the count of
@@ -151,7 +151,8 @@ def scene_rows(args, entry, family_dir, log):
         if kind == "elements":
             extra, target = [], os.path.join(out, "elements.glb")
         elif kind == "input":
-            extra, target = ["--onto", "input"], os.path.join(out, "input.obj")  # the input's own format
+            # glTF, whose vertices split where the light jumps (an OBJ holds one colour per vertex)
+            extra, target = ["--onto", "input"], os.path.join(out, "input.glb")
         elif kind == "lightmap":
             extra, target = ["--lightmap", "1024"], os.path.join(out, "lightmap.glb")
         else:
