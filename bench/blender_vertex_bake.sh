@@ -20,19 +20,24 @@ cat > "$work/open.json" <<'JSON'
             {"type": "environment", "radiance": 1.0}]}
 JSON
 cd "$work"
-echo "== reference: 2000 points, $reference path-traced samples each"
+# Blender bakes each face's front; the reference for it is taken on the front too (--one-sided).
+# gilt's bakes are scored against their own checks, which hold each point's reference on the
+# side the bake read (a wall lit on both sides carries the side the mesher kept).
+echo "== reference: 2000 points, $reference path-traced samples each, every point on its face's front"
 "$gilt" radiosity open.json --onto input --fit point --link-tolerance 1e-1 --final-gather off --quantity irradiance \
-  --check 2000 --check-samples "$reference" --check-points ref.csv -o ref.obj -q --threads 2 | grep check:
+  --one-sided --check 2000 --check-samples "$reference" --check-points ref.csv -o ref.obj -q --threads 2 | grep check:
 # The OBJ keeps one colour per `v` line; the GLB splits vertices where the light jumps across an edge.
 for ext in obj glb; do
   echo "== gilt radiosity --onto input --time $seconds -o gilt.$ext"
   /usr/bin/time -f "gilt wall %e s" "$gilt" radiosity open.json --onto input --time "$seconds" --quantity irradiance \
-    --check 2000 --check-samples 256 --check-points "gilt-$ext.csv" -o "gilt.$ext" -q --threads 2 | grep -E "solve:|time:|positions"
+    --check 2000 --check-samples 1024 --check-points "gilt-$ext.csv" -o "gilt.$ext" -q --threads 2 |
+    grep -E "solve:|time:|positions|check:"
 done
 echo "== Blender Cycles vertex bake, $samples samples"
 SUN="0.35,-1,0.45,8" ENV=1.0 blender -b --factory-startup -P "$shared/tools/cycles_bake.py" -- open.obj "$samples" \
   blender.npy 2 2>&1 | grep BAKE_SECONDS
 for ext in obj glb; do
   echo "== scored: gilt.$ext against Blender"
-  $py "$here/scripts/score_vertex_bake.py" "gilt-$ext.csv" open.obj blender.npy --reference ref.csv --label "blender $samples"
+  $py "$here/scripts/score_vertex_bake.py" "gilt-$ext.csv" open.obj blender.npy --reference ref.csv --own-reference \
+    --label "blender $samples"
 done

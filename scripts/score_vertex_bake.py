@@ -15,6 +15,10 @@ the relative error (less ruled by the few worst points). gilt's own bake (the CS
 columns) is scored beside it the same way. --reference takes the path-traced columns from another
 check of the same scene and seed (the same points, drawn again; say with many more samples), so
 several bakes can be scored by one low-noise reference without paying for it each time.
+With --own-reference, gilt's bake is scored against POINTS.csv's own path-traced columns and only
+the Blender bake against --reference: gilt's check holds each point's reference on the side of
+the surface gilt's bake read, which need not be the front that Blender bakes (a wall lit on both
+sides), so a reference made with `--one-sided` (every point's front) scores Blender.
 """
 import argparse
 import csv
@@ -49,6 +53,8 @@ def main():
     ap.add_argument("bake")
     ap.add_argument("--label", default="blender")
     ap.add_argument("--reference", help="CSV of the same check points whose reference columns to use")
+    ap.add_argument("--own-reference", action="store_true",
+                    help="score gilt against POINTS.csv's own reference columns, only Blender against --reference")
     a = ap.parse_args()
     import numpy as np
 
@@ -74,6 +80,9 @@ def main():
     rows = list(csv.DictReader(open(a.points)))
     if not rows:
         sys.exit(f"score_vertex_bake: {a.points} holds no points")
+    for r in rows:  # gilt's own reference, on the side its bake read
+        for c in "rgb":
+            r[f"own_reference_{c}"] = r[f"reference_{c}"]
     if a.reference:
         at = {(r["x"], r["y"], r["z"]): r for r in csv.DictReader(open(a.reference))}
         joined = []
@@ -89,6 +98,7 @@ def main():
             sys.exit(f"score_vertex_bake: {a.reference} shares no point with {a.points} (another scene or seed?)")
         rows = joined
     ref = np.array([[float(r[f"reference_{c}"]) for c in "rgb"] for r in rows])
+    own = np.array([[float(r[f"own_reference_{c}"]) for c in "rgb"] for r in rows]) if a.own_reference else ref
     se = np.array([[float(r[f"standard_error_{c}"]) for c in "rgb"] for r in rows])
     albedo = np.array([[float(r[f"albedo_{c}"]) for c in "rgb"] for r in rows])
     gilt = np.array([[float(r[f"baked_{c}"]) for c in "rgb"] for r in rows])
@@ -107,20 +117,22 @@ def main():
             value += float(r[f"w{k}"]) * bake[first[fi] + f.index(v[k]), 1:4]
         other[i] = math.pi * value / albedo[i]
     keep = ~np.isnan(other[:, 0])
-    floor = 0.01 * ref[keep].mean()
 
-    def score(x):
-        d = x[keep] - ref[keep]
-        r = ref[keep]
+    def score(x, reference):
+        r = reference[keep]
+        floor = 0.01 * r.mean()
+        d = x[keep] - r
         rel = np.abs(d) / (r + floor)
-        return ((d * d) / (r * r + floor * floor)).mean(), rel.mean(), np.median(rel.mean(axis=1))
+        return ((d * d) / (r * r + floor * floor)).mean(), rel.mean(), np.median(rel.mean(axis=1)), x[keep].mean() / r.mean()
 
+    floor = 0.01 * ref[keep].mean()
     share = (se[keep] ** 2 / (ref[keep] ** 2 + floor * floor)).mean()
-    print(f"points {int(keep.sum())} (faces not found: {missing}); reference's own share of relMSE {share:.4g}")
-    for name, x in (("gilt", gilt), (a.label, other)):
-        m, e, med = score(x)
+    print(f"points {int(keep.sum())} (faces not found: {missing}); reference's own share of relMSE {share:.4g}"
+          + ("; gilt scored against its own check's reference" if a.own_reference else ""))
+    for name, x, reference in (("gilt", gilt, own), (a.label, other, ref)):
+        m, e, med, ratio = score(x, reference)
         print(f"{name:>10}: relMSE {m:.4g}  mean relative error {100 * e:.1f} %  median {100 * med:.1f} %  "
-              f"mean {x[keep].mean() / ref[keep].mean():.3f} of the reference")
+              f"mean {ratio:.3f} of the reference")
 
 
 if __name__ == "__main__":
