@@ -647,8 +647,10 @@ struct SolveState {
         receivers(s, so.mesh, st.progress),
         strata(std::max(1, int(std::round(std::sqrt(double(st.visibility_samples)))))) {
     sol.convex_enclosure = receivers.occluders.empty();
-    // The solver is chosen on the mesh before refinement, as plan_solve() sees it.
+    // The solver is chosen on the mesh before refinement, as plan_solve() sees it, and chosen
+    // again after it (choose_after_refinement).
     sol.solver = choose_solver(settings, mesh.element_count(), &sol.solver_reason);
+    elements_as_meshed = mesh.element_count();
     hierarchical = sol.solver == SolverKind::hierarchical;
     hs = settings.hierarchical;
     hs.tolerance = settings.tolerance;
@@ -669,6 +671,7 @@ struct SolveState {
   // a loop are summed over the processes, and rank 0's clock makes every decision about time.
   const rc::util::Processes& group = rc::util::processes();
   bool hierarchical = false;
+  size_t elements_as_meshed = 0;  ///< what the solver was first chosen on
   HierarchicalSettings hs;
   std::vector<Rgb> direct_punctual, direct_emitted;  // irradiance per vertex
   std::vector<Rgb> direct_delta;  // the part of direct_punctual from point, spot and directional lights
@@ -823,6 +826,26 @@ struct SolveState {
       gather_direct(first_new);
       sol.refined_elements += marked.size();
     }
+  }
+
+  /// `automatic` chose progressive refinement on the mesh as meshed; refinement at steep direct
+  /// light can multiply its elements (a small generated dome: 9,742 to 59,630), and progressive
+  /// refinement's cost grows with their square. From kHierarchicalElements on, the hierarchical
+  /// solver takes the interreflection instead. Pass 1 is done by then: its emitting surfaces
+  /// came from the shooting patches rather than the tree walk, which gives the same irradiance.
+  /// On the small lit family at `--time 15` the bakes' mean went from 0.787 to 1.009 of the path
+  /// tracer's on the dome, 0.988 to 0.998 on the colonnade and 0.972 to 0.978 on the storeys
+  /// (bench/README.md, "The solver chosen after refinement").
+  void choose_after_refinement() {
+    if (settings.solver != SolverKind::automatic || hierarchical ||
+        mesh.element_count() < kHierarchicalElements)
+      return;
+    sol.solver = SolverKind::hierarchical;
+    sol.solver_reason = std::to_string(elements_as_meshed) + " elements as meshed, " +
+                        std::to_string(mesh.element_count()) +
+                        " after refining at steep direct light: progressive refinement would cost about n², "
+                        "hierarchical about n log n";
+    hierarchical = true;
   }
 
   /// The direct light's totals on the final mesh. Reads the direct light; writes nv, ne,
@@ -1259,6 +1282,7 @@ Solution solve(const rc::scene::Scene& scene, const SolverSettings& settings) {
   // Pass 1, direct light, refining the mesh where it changes steeply.
   state.gather_direct(0);
   state.refine_direct();
+  state.choose_after_refinement();
   state.keep_direct();
   // Pass 2, the interreflection.
   if (state.hierarchical) {
