@@ -278,6 +278,24 @@ TEST(HierarchicalRadiosity, AutomaticChoosesByElementCount) {
   EXPECT_EQ(rad::solver::choose_solver(s, 10 * rad::solver::kHierarchicalElements), rad::solver::SolverKind::progressive);
 }
 
+// `automatic` chooses again after the direct light's refinement: the Cornell box meshed at about
+// 17,000 elements stays below kHierarchicalElements until its shadow edges are bisected, and is
+// then solved hierarchically, the reason saying both counts. (Without the second choice it was
+// progressive refinement on 21,000 elements, whose cost grows with their square.)
+TEST(HierarchicalRadiosity, AutomaticChoosesAgainAfterRefinement) {
+  rc::scene::Scene scene = rc::io::builtin_scene("cornell");
+  scene.commit();
+  const rad::solver::Solution sol =
+      rad::solver::solve(scene, settings(rad::solver::SolverKind::automatic, 17000));
+  const size_t meshed = sol.mesh_report.elements;
+  ASSERT_LT(meshed, rad::solver::kHierarchicalElements);
+  ASSERT_GE(sol.mesh.element_count(), rad::solver::kHierarchicalElements);
+  EXPECT_EQ(sol.solver, rad::solver::SolverKind::hierarchical) << sol.solver_reason;
+  EXPECT_NE(sol.solver_reason.find("after refining"), std::string::npos) << sol.solver_reason;
+  EXPECT_GT(sol.links, 0u);
+  EXPECT_LT(sol.residual, 1e-2);
+}
+
 // A closed room crowded with a grid of boxes, lit by a lamp: many of the faces that turn towards
 // a source are partly hidden from it by their neighbours, and a cluster link shares one visible
 // fraction among all of its receiving elements that face the source. Partly visible cluster
