@@ -20,13 +20,11 @@
 #include <string>
 #include <vector>
 
+#include "raytrace_core/scene/mip_map.h"
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/util/rgb.h"
 
 namespace gilt::raytrace_core::scene {
-
-/// What happens outside [0, 1] along one texture axis (glTF's sampler wrap modes).
-enum class TextureWrap : uint8_t { repeat, clamp, mirror };
 
 /// An image file a material reads.
 struct TextureImage {
