@@ -1,5 +1,6 @@
 // In-memory MIP pyramids (raytrace_core/scene/mip_map.h): box levels that are exact means,
-// texel-exact reads at texel centres, the wrap modes.
+// texel-exact reads at texel centres, the wrap modes, and agreement with OpenImageIO's
+// TextureSystem (TextureSet's other plan) on filtered lookups.
 //
 // Tolerances: texels are stored as half floats, whose 11-bit significand rounds a value v to
 // within 2⁻¹¹ |v| (kHalf below). A stored level's texel and the mean of the stored texels under
@@ -8,14 +9,23 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <vector>
 
 #include "raytrace_core/scene/mip_map.h"
+#include "raytrace_core/scene/texture.h"
+#include "raytrace_core/util/error.h"
 
 namespace gilt {
 namespace {
 
+namespace fs = std::filesystem;
 namespace rc = raytrace_core;
 using rc::scene::MipMap;
 using rc::scene::TextureWrap;
@@ -159,6 +169,108 @@ TEST(MipMap, BytesForCountsPaddedTiles) {
   EXPECT_EQ(MipMap::bytes_for(16, 8, 3), size_t(8 + 2 + 1 + 1 + 1) * 16 * 3 * 2);
   EXPECT_EQ(MipMap::bytes_for(16, 8, 3, rc::scene::TexelFormat::unorm8), size_t(8 + 2 + 1 + 1 + 1) * 16 * 3);
   EXPECT_EQ(MipMap(hashed_image(16, 8, 3)).bytes(), MipMap::bytes_for(16, 8, 3));
+}
+
+class TexturePlans : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("gilt_mip_map_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::create_directories(dir_);
+    ::setenv("GILT_TEXTURE_CACHE", (dir_ / "cache").c_str(), 1);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  /// Writes an 8-bit RGB image of the hashed values, as a binary PPM; returns its path.
+  std::string ppm(const std::string& name, int width, int height) {
+    const rc::scene::LinearImage image = hashed_image(width, height, 3);
+    const fs::path path = dir_ / name;
+    std::ofstream out(path, std::ios::binary);
+    out << "P6\n" << width << ' ' << height << "\n255\n";
+    for (float v : image.pixels) out.put(char(std::lround(v * 255.0f)));
+    return path.string();
+  }
+  fs::path dir_;
+};
+
+TEST_F(TexturePlans, PyramidsAgreeWithOpenImageIOsTextureSystem) {
+  // The same 64 × 64 sRGB image through both plans: in memory (budget unlimited) and through
+  // OpenImageIO's TextureSystem (budget 0). Both read half floats of the same linear values,
+  // box-filtered into the same levels (OpenImageIO's copy is made with maketx's box filter),
+  // blend the same two levels with the same weights and read each bilinearly, so they may
+  // differ by a half's rounding of each (≤ 2⁻¹¹ of values ≤ 1) and OpenImageIO's own
+  // arithmetic in its filter; 1/255, one step of an 8-bit output, bounds both with room. The
+  // footprints are isotropic (square, axis-aligned): for elongated ones OpenImageIO takes
+  // several probes along the long axis at the level of the short one, where trilinear reads
+  // the level of the long axis, and the two differ by design.
+  const std::string file = ppm("hashed.ppm", 64, 64);
+  const std::vector<rc::scene::TextureImage> images{{file, true, TextureWrap::repeat, TextureWrap::repeat},
+                                                    {file, true, TextureWrap::clamp, TextureWrap::mirror}};
+  const rc::scene::TextureSet memory(images, size_t(1) << 40);
+  const rc::scene::TextureSet cache(images, 0);
+  ASSERT_EQ(memory.plan(), rc::scene::TexturePlan::in_memory);
+  ASSERT_EQ(cache.plan(), rc::scene::TexturePlan::oiio_cache);
+  EXPECT_EQ(memory.file_count(), 1u);  // two images of one file and role share one pyramid
+  constexpr float kCode = 1.0f / 255.0f;
+  for (const float texels : {0.0f, 1.0f, 2.5f, 7.0f}) {
+    const float d = texels / 64.0f;
+    float worst = 0.0f;
+    for (int image = 0; image < 2; ++image)
+      for (int k = 0; k < 400; ++k) {
+        // Points over [−0.25, 1.25]² in a fixed low-discrepancy pattern, past the edges too.
+        const rc::Vec2 st(-0.25f + 1.5f * std::fmod(0.5f + k * 0.618034f, 1.0f),
+                          -0.25f + 1.5f * (k + 0.5f) / 400.0f);
+        const rc::scene::Texel a = memory.lookup(image, st, {d, 0.0f}, {0.0f, d});
+        const rc::scene::Texel b = cache.lookup(image, st, {d, 0.0f}, {0.0f, d});
+        worst = std::max({worst, std::fabs(a.rgb.r - b.rgb.r), std::fabs(a.rgb.g - b.rgb.g),
+                          std::fabs(a.rgb.b - b.rgb.b)});
+      }
+    EXPECT_LE(worst, kCode) << "footprint " << texels << " texels";
+  }
+}
+
+TEST_F(TexturePlans, PlanFollowsTheBudgetAndLoadIsTimed) {
+  const std::string file = ppm("small.ppm", 16, 16);
+  const std::vector<rc::scene::TextureImage> images{{file, true}, {file, false}};
+  // Colour and data reads of one file are two pyramids: half floats for the colour, the 8-bit
+  // codes for the data.
+  const size_t bytes = MipMap::bytes_for(16, 16, 3, rc::scene::TexelFormat::half) +
+                       MipMap::bytes_for(16, 16, 3, rc::scene::TexelFormat::unorm8);
+  const rc::scene::TextureSet fits(images, bytes);
+  EXPECT_EQ(fits.plan(), rc::scene::TexturePlan::in_memory);
+  EXPECT_EQ(fits.file_count(), 2u);
+  EXPECT_EQ(fits.pyramid_bytes(), bytes);
+  EXPECT_GT(fits.load_seconds(), 0.0);
+  const rc::scene::TextureSet over(images, bytes - 1);
+  EXPECT_EQ(over.plan(), rc::scene::TexturePlan::oiio_cache);
+  // The environment sets the default budget.
+  ::setenv("GILT_TEXTURE_MEMORY_MB", "0", 1);
+  EXPECT_EQ(rc::scene::texture_memory_budget(), 0u);
+  EXPECT_EQ(rc::scene::TextureSet(images).plan(), rc::scene::TexturePlan::oiio_cache);
+  ::setenv("GILT_TEXTURE_MEMORY_MB", "lots", 1);
+  EXPECT_THROW(rc::scene::texture_memory_budget(), rc::InputError);
+  ::unsetenv("GILT_TEXTURE_MEMORY_MB");
+  EXPECT_EQ(rc::scene::texture_memory_budget(), size_t(4) << 30);
+}
+
+TEST_F(TexturePlans, UnreadableFilesAreInputErrorsNamingThem) {
+  // A missing file, and a file that is not an image, under both plans.
+  const std::string missing = (dir_ / "missing.png").string();
+  const std::string garbage = (dir_ / "garbage.png").string();
+  std::ofstream(garbage) << "not a PNG";
+  const std::string good = ppm("good.ppm", 4, 4);
+  for (const std::string& bad : {missing, garbage})
+    for (const size_t budget : {size_t(1) << 40, size_t(0)}) {
+      try {
+        rc::scene::TextureSet set({{good, true}, {bad, true}}, budget);
+        ADD_FAILURE() << bad << " was accepted";
+      } catch (const rc::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(fs::path(bad).filename().string()), std::string::npos)
+            << e.what();
+      }
+    }
 }
 
 }  // namespace
