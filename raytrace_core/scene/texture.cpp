@@ -5,6 +5,7 @@
 #include <OpenImageIO/texture.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -160,12 +161,27 @@ MipMap decode(const FileRole& file) {
   const OIIO::ImageSpec& spec = in->spec();
   LinearImage image{spec.width, spec.height, std::min(spec.nchannels, MipMap::kMaxChannels), {}};
   image.pixels.resize(size_t(image.width) * size_t(image.height) * size_t(image.channels));
-  if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
-    throw InputError(file.path + ": texture cannot be read: " + in->geterror());
-  if (file.srgb) {
-    const int alpha = alpha_channel(spec.alpha_channel, image.channels);
-    for (size_t i = 0; i < image.pixels.size(); ++i)
-      if (int(i % size_t(image.channels)) != alpha) image.pixels[i] = srgb_to_linear(image.pixels[i]);
+  const size_t channels = size_t(image.channels);
+  const int alpha = file.srgb ? alpha_channel(spec.alpha_channel, image.channels) : -1;
+  if (spec.format == OIIO::TypeDesc::UINT8 && spec.channelformats.empty()) {
+    // 8-bit codes (PNG, JPEG): read as they are and mapped through tables of their 256 values,
+    // rather than one std::pow per value.
+    std::vector<uint8_t> codes(image.pixels.size());
+    if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::UINT8, codes.data()))
+      throw InputError(file.path + ": texture cannot be read: " + in->geterror());
+    std::array<float, 256> as_stored{}, decoded{};
+    for (int c = 0; c < 256; ++c) {
+      as_stored[size_t(c)] = float(c) / 255.0f;
+      decoded[size_t(c)] = file.srgb ? srgb_to_linear(as_stored[size_t(c)]) : as_stored[size_t(c)];
+    }
+    for (size_t i = 0; i < codes.size(); ++i)
+      image.pixels[i] = (int(i % channels) == alpha ? as_stored : decoded)[codes[i]];
+  } else {
+    if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+      throw InputError(file.path + ": texture cannot be read: " + in->geterror());
+    if (file.srgb)
+      for (size_t i = 0; i < image.pixels.size(); ++i)
+        if (int(i % channels) != alpha) image.pixels[i] = srgb_to_linear(image.pixels[i]);
   }
   return MipMap(image, storage_for(spec, file.srgb));
 }
