@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "raytrace_core/scene/texture.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
 
@@ -31,6 +32,15 @@ nlohmann::json run_statistics(const rc::scene::Scene& scene, const std::string& 
                       {"seconds", stats.seconds},
                       {"non_finite_samples", stats.non_finite},
                       {"notes", result.notes}};
+  // The scene's textures: how they were held and how long they took to load (not in "seconds").
+  const rc::scene::TextureSet* textures = scene.texture_set();
+  j["texture_load_seconds"] = textures ? textures->load_seconds() : 0.0;
+  if (textures)
+    j["textures"] = {{"images", textures->size()},
+                     {"files", textures->file_count()},
+                     {"plan", rc::scene::texture_plan_name(textures->plan())},
+                     {"pyramid_bytes", textures->pyramid_bytes()},
+                     {"load_seconds", textures->load_seconds()}};
   if (const auto& solution = result.solution) {
     j["radiosity"] = {{"elements", solution->mesh.element_count()}, {"shots", solution->shots},
                       {"residual", solution->residual}, {"seconds", solution->seconds}};

@@ -1,10 +1,11 @@
 // `gilt info SCENE`: what the scene holds and, for each method, which passes will run and which
 // are skipped and why.
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
-#include <algorithm>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -151,7 +152,8 @@ struct SceneSummary {
   size_t emissive = 0;   ///< materials
   size_t vertices = 0;
   size_t bytes = 0;      ///< geometry and BVH, estimated
-  size_t textured = 0, texels = 0, texture_bytes = 0, normal_mapped = 0;
+  size_t textured = 0, texels = 0, texture_bytes = 0, texture_files = 0, normal_mapped = 0;
+  std::optional<rc::scene::TexturePlan> texture_plan;  ///< none without textures
 };
 
 /// Reads the scene's lights, materials, meshes and spheres; writes the summary's counts and
@@ -171,14 +173,18 @@ void count_geometry(const rc::scene::Scene& scene, SceneSummary& s) {
   s.bytes += bvh + scene.spheres.size() * sizeof(rc::scene::Sphere);
 }
 
-/// Reads the scene's materials and texture set; writes the summary's texture counts and their
-/// memory: the images the materials read, at the linear half-float copies' size with their MIP
-/// levels (4/3 of the finest).
+/// Reads the scene's materials and texture set; writes the summary's texture counts, plan and
+/// memory: the half-float MIP pyramids of the distinct files the materials read (what they take
+/// in memory, or would take where the plan is OpenImageIO's cache).
 void count_textures(const rc::scene::Scene& scene, SceneSummary& s) {
   s.textured = size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
                                     [](const rc::scene::Material& m) { return m.is_textured(); }));
-  s.texels = scene.texture_set() ? scene.texture_set()->texel_count() : 0;
-  s.texture_bytes = s.texels * 2 * 4 / 3;
+  if (const rc::scene::TextureSet* set = scene.texture_set()) {
+    s.texels = set->texel_count();
+    s.texture_bytes = set->pyramid_bytes();
+    s.texture_files = set->file_count();
+    s.texture_plan = set->plan();
+  }
 }
 
 /// Reads the scene's materials and the summary; adds to each method's plan what it does with
@@ -216,7 +222,7 @@ void add_material_notes(const rc::scene::Scene& scene, SceneSummary& s, std::vec
       else if (p.method == "photon" || p.method == "sppm")
         p.runs.push_back("albedo textures: read where photons land and at the points the camera sees");
       else
-        p.runs.push_back("albedo textures: read at every hit (MIP-mapped, bilinear)");
+        p.runs.push_back("albedo textures: read at every hit (MIP-mapped, trilinear)");
     }
   s.normal_mapped =
       size_t(std::count_if(scene.materials.begin(), scene.materials.end(),
@@ -242,9 +248,15 @@ void print_info_json(const InfoOptions& o, const rc::scene::Scene& scene, const 
                       {"materials", s.materials},
                       {"emissive_materials", s.emissive},
                       {"bounds", {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}}},
-                      {"textures", {{"images", scene.textures.size()}, {"textured_materials", s.textured},
-                                    {"normal_mapped_materials", s.normal_mapped},
-                                    {"texels", s.texels}, {"memory_estimate_bytes", s.texture_bytes}}},
+                      {"textures",
+                       {{"images", scene.textures.size()},
+                        {"textured_materials", s.textured},
+                        {"normal_mapped_materials", s.normal_mapped},
+                        {"files", s.texture_files},
+                        {"texels", s.texels},
+                        {"plan", s.texture_plan ? rc::scene::texture_plan_name(*s.texture_plan) : "none"},
+                        {"memory_bytes", s.texture_bytes},
+                        {"memory_budget_bytes", rc::scene::texture_memory_budget()}}},
                       {"memory_estimate_bytes", s.bytes}};
   j["cameras"] = nlohmann::json::array();
   for (const rc::scene::NamedCamera& c : scene.cameras)
@@ -276,9 +288,25 @@ void print_info_text(const InfoOptions& o, const rc::scene::Scene& scene, const 
     std::printf("%s %zu '%s' (%s)%s", i ? ";" : "", i, scene.cameras[i].name.c_str(),
                 camera_text(scene.cameras[i].camera).c_str(), is_view(scene, scene.cameras[i]) ? " [the view]" : "");
   std::printf("\n");
-  if (!scene.textures.empty())
-    std::printf("  textures:  %zu image(s) read by %zu material(s): %.1f Mtexel channels, about %.1f MB as linear half floats with MIP levels\n",
-                scene.textures.size(), s.textured, double(s.texels) / 1e6, double(s.texture_bytes) / 1e6);
+  if (!scene.textures.empty()) {
+    std::printf(
+        "  textures:  %zu image(s) from %zu file(s) read by %zu material(s): %.1f Mtexel channels, %.1f MB "
+        "as MIP pyramids\n",
+        scene.textures.size(), s.texture_files, s.textured, double(s.texels) / 1e6,
+        double(s.texture_bytes) / 1e6);
+    // The budget in mebibytes, the unit of GILT_TEXTURE_MEMORY_MB.
+    const double budget = double(rc::scene::texture_memory_budget()) / double(1 << 20);
+    if (s.texture_plan.value_or(rc::scene::TexturePlan::in_memory) == rc::scene::TexturePlan::in_memory)
+      std::printf(
+          "  texture plan: in-memory pyramids, within the budget of %.0f MiB (GILT_TEXTURE_MEMORY_MB)\n",
+          budget);
+    else
+      std::printf(
+          "  texture plan: OpenImageIO's cache, paging tiles in and out: the pyramids exceed the budget of "
+          "%.0f MiB "
+          "(GILT_TEXTURE_MEMORY_MB)\n",
+          budget);
+  }
   if (s.bytes < 1000000) std::printf("  memory:    about %.1f kB (geometry and BVH, estimated)\n", double(s.bytes) / 1e3);
   else std::printf("  memory:    about %.1f MB (geometry and BVH, estimated)\n", double(s.bytes) / 1e6);
   for (const MethodPlan& p : plans) {

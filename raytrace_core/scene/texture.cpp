@@ -1,15 +1,22 @@
 #include "raytrace_core/scene/texture.h"
 
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 #include <unistd.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
 #include <sstream>
 
 #include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/sampling.h"
 
 namespace gilt::raytrace_core::scene {
@@ -42,6 +49,13 @@ uint64_t fnv1a(const std::string& s) {
 /// The sRGB transfer function's inverse (IEC 61966-2-1): code value in [0, 1] to linear.
 float srgb_to_linear(float c) {
   return c <= 0.04045f ? c * (1.0f / 12.92f) : std::pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+}
+
+/// The alpha channel of an image of `channels` channels: the one its header names, else the last
+/// of grey-and-alpha or RGBA; −1 for none.
+int alpha_channel(int named, int channels) {
+  if (named >= 0 && named < channels) return named;
+  return channels == 2 || channels == 4 ? channels - 1 : -1;
 }
 
 OIIO::TextureOpt::Wrap oiio_wrap(TextureWrap w) {
@@ -80,7 +94,7 @@ std::string linear_copy(const std::string& file) {
     throw InputError(file + ": texture cannot be read: " + source_image.geterror());
   OIIO::ImageSpec spec = source_image.spec();
   const int channels = spec.nchannels;
-  const int alpha = spec.alpha_channel >= 0 ? spec.alpha_channel : (channels == 2 || channels == 4 ? channels - 1 : -1);
+  const int alpha = alpha_channel(spec.alpha_channel, channels);
   std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
   source_image.get_pixels(source_image.roi(), OIIO::TypeDesc::FLOAT, pixels.data());
   for (size_t i = 0; i < pixels.size(); ++i)
@@ -106,39 +120,182 @@ std::string linear_copy(const std::string& file) {
   return target.string();
 }
 
+/// A file and the role it is read in (colour or data): images naming the same pair share one
+/// pyramid, whatever their wrap modes.
+struct FileRole {
+  std::string path;
+  bool srgb = true;
+  auto operator<=>(const FileRole&) const = default;
+};
+
+/// A file's size and channels, from its header.
+struct ImageHeader {
+  int width = 0, height = 0, channels = 0;
+  TexelFormat format = TexelFormat::half;  ///< how its pyramid stores it
+};
+
+/// How a file's pyramid stores its texels: a data image of 8-bit codes keeps them (exactly, and
+/// in half the memory; its coarser levels rounded to codes, as OpenImageIO's are); colour
+/// images decoded from sRGB, and deeper data, as half floats.
+TexelFormat storage_for(const OIIO::ImageSpec& spec, bool srgb) {
+  const bool eight_bit = spec.format == OIIO::TypeDesc::UINT8 && spec.channelformats.empty();
+  return !srgb && eight_bit ? TexelFormat::unorm8 : TexelFormat::half;
+}
+
+ImageHeader read_header(const FileRole& file) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file.path);
+  if (!in) throw InputError(file.path + ": texture cannot be read: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
+    throw InputError(file.path + ": texture cannot be read: it holds no pixels");
+  return ImageHeader{spec.width, spec.height, spec.nchannels, storage_for(spec, file.srgb)};
+}
+
+/// The first subimage of a file in linear values, up to MipMap::kMaxChannels channels: colour
+/// channels of an sRGB image decoded, alpha and data images as stored; made into its pyramid.
+MipMap decode(const FileRole& file) {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // colours as stored, not multiplied by alpha
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file.path, &config);
+  if (!in) throw InputError(file.path + ": texture cannot be read: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  LinearImage image{spec.width, spec.height, std::min(spec.nchannels, MipMap::kMaxChannels), {}};
+  image.pixels.resize(size_t(image.width) * size_t(image.height) * size_t(image.channels));
+  const size_t channels = size_t(image.channels);
+  const int alpha = file.srgb ? alpha_channel(spec.alpha_channel, image.channels) : -1;
+  if (spec.format == OIIO::TypeDesc::UINT8 && spec.channelformats.empty()) {
+    // 8-bit codes (PNG, JPEG): read as they are and mapped through tables of their 256 values,
+    // rather than one std::pow per value.
+    std::vector<uint8_t> codes(image.pixels.size());
+    if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::UINT8, codes.data()))
+      throw InputError(file.path + ": texture cannot be read: " + in->geterror());
+    std::array<float, 256> as_stored{}, decoded{};
+    for (int c = 0; c < 256; ++c) {
+      as_stored[size_t(c)] = float(c) / 255.0f;
+      decoded[size_t(c)] = file.srgb ? srgb_to_linear(as_stored[size_t(c)]) : as_stored[size_t(c)];
+    }
+    for (size_t i = 0; i < codes.size(); ++i)
+      image.pixels[i] = (int(i % channels) == alpha ? as_stored : decoded)[codes[i]];
+  } else {
+    if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+      throw InputError(file.path + ": texture cannot be read: " + in->geterror());
+    if (file.srgb)
+      for (size_t i = 0; i < image.pixels.size(); ++i)
+        if (int(i % channels) != alpha) image.pixels[i] = srgb_to_linear(image.pixels[i]);
+  }
+  return MipMap(image, storage_for(spec, file.srgb));
+}
+
+/// Calls body(f) for every file f on the thread pool; then throws the error of the first file (in
+/// order, so the message does not depend on timing) whose body threw, naming the file.
+void for_each_file(const std::vector<FileRole>& files, const std::function<void(size_t)>& body) {
+  std::vector<std::string> errors(files.size());
+  util::parallel_for(files.size(), [&](size_t f) {
+    try {
+      body(f);
+    } catch (const InputError& e) {
+      errors[f] = e.what();
+    } catch (const std::exception& e) {  // out of memory, say
+      errors[f] = files[f].path + ": texture cannot be read: " + e.what();
+    }
+  });
+  for (const std::string& e : errors)
+    if (!e.empty()) throw InputError(e);
+}
+
+/// Filtered channels (1 grey, 2 grey and alpha, 3 RGB, 4 RGBA) as a texel.
+Texel to_texel(const float* v, int channels) {
+  Texel out;
+  if (channels <= 2) {
+    out.rgb = Rgb(v[0]);
+    if (channels == 2) out.alpha = v[1];
+  } else {
+    out.rgb = Rgb(v[0], v[1], v[2]);
+    if (channels == 4) out.alpha = v[3];
+  }
+  // Filtering with negative lobes or a half-float copy can stray below zero.
+  out.rgb = Rgb(std::max(out.rgb.r, 0.0f), std::max(out.rgb.g, 0.0f), std::max(out.rgb.b, 0.0f));
+  out.alpha = std::clamp(out.alpha, 0.0f, 1.0f);
+  return out;
+}
+
 }  // namespace
 
+size_t texture_memory_budget() {
+  const char* text = std::getenv("GILT_TEXTURE_MEMORY_MB");
+  if (!text || !*text) return size_t(4) << 30;
+  char* end = nullptr;
+  const unsigned long long mb = std::strtoull(text, &end, 10);
+  if (*end != '\0' || text[0] == '-')
+    throw InputError(std::string("GILT_TEXTURE_MEMORY_MB=") + text + ": not a whole number of mebibytes");
+  return size_t(mb) << 20;
+}
+
+const char* texture_plan_name(TexturePlan plan) {
+  return plan == TexturePlan::in_memory ? "in-memory pyramids" : "OpenImageIO's cache";
+}
+
 struct TextureSet::Impl {
+  /// Under in_memory: one image's pyramid and wrap modes.
+  struct Image {
+    const MipMap* pyramid = nullptr;
+    TextureWrap wrap_s = TextureWrap::repeat, wrap_t = TextureWrap::repeat;
+  };
+  std::vector<std::optional<MipMap>> pyramids;  ///< one per distinct file and role
+  std::vector<Image> images;
+  // Under oiio_cache.
   OIIO::TextureSystem* system = nullptr;
   std::vector<OIIO::TextureSystem::TextureHandle*> handles;
+  std::vector<OIIO::TextureOpt> options;
+  // Either.
   std::vector<int> channels;
   std::vector<Vec2> texel_size;
-  std::vector<OIIO::TextureOpt> options;
+
   ~Impl() {
     if (system) OIIO::TextureSystem::destroy(system);
   }
+  /// Decodes every file into its pyramid, in parallel; points each image at its file's.
+  void open_pyramids(const std::vector<TextureImage>& all, const std::vector<FileRole>& files,
+                     const std::vector<size_t>& file_of);
+  /// Opens every image through OpenImageIO's TextureSystem.
+  void open_cache(const std::vector<TextureImage>& all);
 };
 
-TextureSet::TextureSet(const std::vector<TextureImage>& images) : impl_(std::make_unique<Impl>()), images_(images) {
-  impl_->system = OIIO::TextureSystem::create(/*shared=*/false);
-  OIIO::TextureSystem& ts = *impl_->system;
+void TextureSet::Impl::open_pyramids(const std::vector<TextureImage>& all, const std::vector<FileRole>& files,
+                                     const std::vector<size_t>& file_of) {
+  pyramids.resize(files.size());
+  for_each_file(files, [&](size_t f) { pyramids[f].emplace(decode(files[f])); });
+  for (size_t i = 0; i < all.size(); ++i) {
+    const MipMap& pyramid = *pyramids[file_of[i]];
+    images.push_back(Image{&pyramid, all[i].wrap_s, all[i].wrap_t});
+    channels.push_back(pyramid.channels());
+    texel_size.push_back(Vec2(1.0f / float(pyramid.width(0)), 1.0f / float(pyramid.height(0))));
+  }
+}
+
+void TextureSet::Impl::open_cache(const std::vector<TextureImage>& all) {
+  system = OIIO::TextureSystem::create(/*shared=*/false);
+  OIIO::TextureSystem& ts = *system;
   ts.attribute("automip", 1);             // data textures without MIP levels get them in memory
   ts.attribute("unassociatedalpha", 1);   // see linear_copy
   ts.attribute("max_memory_MB", 1024.0f);
   ts.attribute("autotile", 64);
-  for (const TextureImage& image : images_) {
+  for (const TextureImage& image : all) {
     const std::string path = image.srgb ? linear_copy(image.file) : image.file;
     OIIO::TextureSystem::TextureHandle* handle = ts.get_texture_handle(OIIO::ustring(path));
     int resolution[2] = {0, 0};
-    int channels = 0;
-    if (!handle || !ts.get_texture_info(handle, nullptr, 0, OIIO::ustring("resolution"), OIIO::TypeDesc(OIIO::TypeDesc::INT, 2), resolution) ||
-        !ts.get_texture_info(handle, nullptr, 0, OIIO::ustring("channels"), OIIO::TypeInt, &channels) || channels < 1) {
+    int n = 0;
+    if (!handle ||
+        !ts.get_texture_info(handle, nullptr, 0, OIIO::ustring("resolution"),
+                             OIIO::TypeDesc(OIIO::TypeDesc::INT, 2), resolution) ||
+        !ts.get_texture_info(handle, nullptr, 0, OIIO::ustring("channels"), OIIO::TypeInt, &n) || n < 1) {
       const std::string why = ts.geterror();
       throw InputError(image.file + ": texture cannot be read" + (why.empty() ? std::string() : ": " + why));
     }
-    impl_->handles.push_back(handle);
-    impl_->channels.push_back(channels);
-    impl_->texel_size.push_back(Vec2(1.0f / float(std::max(resolution[0], 1)), 1.0f / float(std::max(resolution[1], 1))));
+    handles.push_back(handle);
+    channels.push_back(n);
+    texel_size.push_back(
+        Vec2(1.0f / float(std::max(resolution[0], 1)), 1.0f / float(std::max(resolution[1], 1))));
     OIIO::TextureOpt opt;
     opt.swrap = oiio_wrap(image.wrap_s);
     opt.twrap = oiio_wrap(image.wrap_t);
@@ -146,9 +303,47 @@ TextureSet::TextureSet(const std::vector<TextureImage>& images) : impl_(std::mak
     // Bilinear within a level: the default, "smart" bicubic, is a B-spline that blurs even an
     // exactly placed texel when the footprint is below one texel.
     opt.interpmode = OIIO::TextureOpt::InterpBilinear;
-    impl_->options.push_back(opt);
-    texels_ += size_t(resolution[0]) * size_t(resolution[1]) * size_t(channels);
+    options.push_back(opt);
   }
+}
+
+// A driver over named passes: group the images by file, read the files' headers, choose the
+// plan by the pyramids' size, then open the images by it.
+TextureSet::TextureSet(const std::vector<TextureImage>& images, size_t memory_budget)
+    : impl_(std::make_unique<Impl>()), images_(images) {
+  const auto start = std::chrono::steady_clock::now();
+
+  // Group the images by file and role.
+  std::vector<FileRole> files;
+  std::vector<size_t> file_of;
+  std::map<FileRole, size_t> seen;
+  for (const TextureImage& image : images_) {
+    std::error_code ec;
+    fs::path path = fs::absolute(image.file, ec);
+    const FileRole key{ec ? image.file : path.lexically_normal().string(), image.srgb};
+    const auto [at, fresh] = seen.try_emplace(key, files.size());
+    if (fresh) files.push_back(FileRole{image.file, image.srgb});
+    file_of.push_back(at->second);
+  }
+  files_ = files.size();
+
+  // Read the headers: sizes, channels and the pyramids' bytes.
+  std::vector<ImageHeader> headers(files.size());
+  for_each_file(files, [&](size_t f) { headers[f] = read_header(files[f]); });
+  for (const ImageHeader& h : headers)
+    pyramid_bytes_ += MipMap::bytes_for(h.width, h.height, h.channels, h.format);
+  for (size_t i = 0; i < images_.size(); ++i) {
+    const ImageHeader& h = headers[file_of[i]];
+    texels_ += size_t(h.width) * size_t(h.height) * size_t(h.channels);
+  }
+
+  // Choose the plan and open the images by it.
+  plan_ = pyramid_bytes_ <= memory_budget ? TexturePlan::in_memory : TexturePlan::oiio_cache;
+  if (plan_ == TexturePlan::in_memory)
+    impl_->open_pyramids(images_, files, file_of);
+  else
+    impl_->open_cache(images_);
+  load_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 TextureSet::~TextureSet() = default;
@@ -158,25 +353,19 @@ int TextureSet::channels(int32_t image) const { return impl_->channels[size_t(im
 Vec2 TextureSet::texel_size(int32_t image) const { return impl_->texel_size[size_t(image)]; }
 
 Texel TextureSet::lookup(int32_t image, Vec2 st, Vec2 dx, Vec2 dy) const {
-  OIIO::TextureSystem& ts = *impl_->system;
   const size_t i = size_t(image);
-  OIIO::TextureOpt opt = impl_->options[i];
   float v[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+  if (plan_ == TexturePlan::in_memory) {
+    const Impl::Image& im = impl_->images[i];
+    im.pyramid->filter(st, dx, dy, im.wrap_s, im.wrap_t, v);
+    return to_texel(v, im.pyramid->channels());
+  }
+  OIIO::TextureSystem& ts = *impl_->system;
+  OIIO::TextureOpt opt = impl_->options[i];
   const int n = std::min(impl_->channels[i], 4);
   if (!ts.texture(impl_->handles[i], ts.get_perthread_info(), opt, st.x, st.y, dx.x, dx.y, dy.x, dy.y, n, v))
     return Texel{};
-  Texel out;
-  if (n <= 2) {  // grey, or grey and alpha
-    out.rgb = Rgb(v[0]);
-    if (n == 2) out.alpha = v[1];
-  } else {
-    out.rgb = Rgb(v[0], v[1], v[2]);
-    if (n == 4) out.alpha = v[3];
-  }
-  // Filtering with negative lobes or a half-float copy can stray below zero.
-  out.rgb = Rgb(std::max(out.rgb.r, 0.0f), std::max(out.rgb.g, 0.0f), std::max(out.rgb.b, 0.0f));
-  out.alpha = std::clamp(out.alpha, 0.0f, 1.0f);
-  return out;
+  return to_texel(v, n);
 }
 
 Texel TextureSet::triangle_mean(int32_t image, Vec2 a, Vec2 b, Vec2 c) const {

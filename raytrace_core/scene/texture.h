@@ -1,18 +1,22 @@
 #pragma once
-// Image textures: what a scene's materials read and how, and the filtered lookups, through
-// OpenImageIO's TextureSystem (tiled, MIP-mapped, cached; Peachey's and Greene & Heckbert's
-// filtering, which we do not re-write).
+// Image textures: what a scene's materials read and how, and the filtered lookups. OpenImageIO
+// reads the files (every format it reads). A scene whose pyramids fit the memory budget (see
+// texture_memory_budget()) holds them in memory (mip_map.h): every distinct file decoded once, in
+// parallel, at load, and lookups without locks. A scene whose textures would not fit is read
+// through OpenImageIO's TextureSystem instead (tiled, MIP-mapped, cached), which pages tiles in
+// and out as lookups need them.
 //
 // Texture coordinates reach the lookup in OpenImageIO's convention, (s, t) = (0, 0) at the
 // image's top-left corner. Each format's loader folds its own convention into the reference's
 // affine map: glTF's UVs already are (s, t); OBJ's v runs up the image, so its map is t = 1 − v.
 //
 // Colour textures are stored sRGB-encoded, but light adds up in linear values, and a filtered
-// (or averaged) texel must be the mean of linear values, not of codes. So an sRGB image is first
-// converted once into a linear, half-float, MIP-mapped copy (OpenImageIO's make_texture, as
-// `maketx --colorconvert sRGB linear` does) that the lookups then read. The copies live in a
-// cache folder keyed by the source file's path, size and time (see texture_cache_folder());
-// data textures (normal, metallic-roughness) are read as they are.
+// (or averaged) texel must be the mean of linear values, not of codes. So an sRGB image is
+// decoded to linear once: into its in-memory pyramid, or, for OpenImageIO's cache, into a linear,
+// half-float, MIP-mapped copy (OpenImageIO's make_texture, as `maketx --colorconvert sRGB linear`
+// does) kept in a cache folder keyed by the source file's path, size and time (see
+// texture_cache_folder()). Data textures (normal, metallic-roughness) are read as they are.
+// Alpha stays as stored (unassociated) in both.
 
 #include <array>
 #include <cstdint>
@@ -20,13 +24,11 @@
 #include <string>
 #include <vector>
 
+#include "raytrace_core/scene/mip_map.h"
 #include "raytrace_core/util/math.h"
 #include "raytrace_core/util/rgb.h"
 
 namespace gilt::raytrace_core::scene {
-
-/// What happens outside [0, 1] along one texture axis (glTF's sampler wrap modes).
-enum class TextureWrap : uint8_t { repeat, clamp, mirror };
 
 /// An image file a material reads.
 struct TextureImage {
@@ -55,12 +57,24 @@ struct Texel {
   float alpha = 1.0f;
 };
 
+/// How a TextureSet holds its images.
+enum class TexturePlan : uint8_t {
+  in_memory,   ///< MIP pyramids in memory, built at load (mip_map.h)
+  oiio_cache,  ///< OpenImageIO's TextureSystem, paging tiles through its cache
+};
+
+/// Bytes of in-memory pyramids a scene may hold: $GILT_TEXTURE_MEMORY_MB mebibytes, else 4 GiB.
+size_t texture_memory_budget();
+
 /// The images of one scene, opened for filtered lookups. Thread-safe.
 class TextureSet {
  public:
-  /// Opens every image (converting sRGB ones into the cache first). Throws InputError naming a
-  /// file that cannot be read.
-  explicit TextureSet(const std::vector<TextureImage>& images);
+  /// Opens every image: reads the files' headers, then, if their pyramids take at most
+  /// memory_budget bytes, decodes each distinct file once, in parallel, into a pyramid; else
+  /// opens them through OpenImageIO's cache (converting sRGB ones into linear copies first).
+  /// Throws InputError naming a file that cannot be read.
+  explicit TextureSet(const std::vector<TextureImage>& images,
+                      size_t memory_budget = texture_memory_budget());
   ~TextureSet();
   TextureSet(const TextureSet&) = delete;
   TextureSet& operator=(const TextureSet&) = delete;
@@ -75,6 +89,15 @@ class TextureSet {
 
   /// Width × height × channels of each image's finest level, summed.
   size_t texel_count() const { return texels_; }
+  /// Which plan the images were opened with.
+  TexturePlan plan() const { return plan_; }
+  /// Bytes the in-memory pyramids take (or, under oiio_cache, would have taken), each distinct
+  /// file counted once.
+  size_t pyramid_bytes() const { return pyramid_bytes_; }
+  /// Distinct files (with their colour or data role) the images read.
+  size_t file_count() const { return files_; }
+  /// Wall-clock seconds the constructor took (headers, decoding, pyramids or cache copies).
+  double load_seconds() const { return load_seconds_; }
   size_t size() const { return images_.size(); }
   /// Channels of one image (1 grey, 2 grey and alpha, 3 RGB, 4 RGBA).
   int channels(int32_t image) const;
@@ -86,7 +109,14 @@ class TextureSet {
   std::unique_ptr<Impl> impl_;
   std::vector<TextureImage> images_;
   size_t texels_ = 0;
+  TexturePlan plan_ = TexturePlan::in_memory;
+  size_t pyramid_bytes_ = 0;
+  size_t files_ = 0;
+  double load_seconds_ = 0.0;
 };
+
+/// "in-memory pyramids" or "OpenImageIO's cache".
+const char* texture_plan_name(TexturePlan plan);
 
 /// Folder the linear copies of sRGB textures are kept in: $GILT_TEXTURE_CACHE, else
 /// $XDG_CACHE_HOME/gilt/textures, else ~/.cache/gilt/textures, else the system's temporary folder.

@@ -61,6 +61,39 @@ TEST_F(Cli, RendersBuiltInSceneAndReportsJson) {
   EXPECT_GT(j["triangles"].get<int>(), 0);
 }
 
+// A textured OBJ: `render --json` reports how its textures were held and how long they took to
+// load, and `info` names the plan; a budget of 0 MiB turns it to OpenImageIO's cache.
+TEST_F(Cli, TexturePlanAndLoadTimeAreReported) {
+  {
+    std::ofstream image(dir_ / "red.ppm", std::ios::binary);
+    image << "P6\n2 2\n255\n";
+    for (int i = 0; i < 4; ++i) image.put(char(255)).put(char(0)).put(char(0));
+  }
+  write("quad.mtl", "newmtl red\nKd 1 1 1\nmap_Kd red.ppm\n");
+  const fs::path scene = write("quad.obj",
+                               "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                               "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl red\nf 1/1 2/2 3/3 4/4\n");
+  const fs::path out = dir_ / "q.exr";
+  for (const bool cache : {false, true}) {
+    const std::string env = cache ? "GILT_TEXTURE_MEMORY_MB=0 " : "GILT_TEXTURE_MEMORY_MB= ";
+    const Result r =
+        gilt::test::run_command(env + "'" + GILT_BINARY_PATH + "' render '" + scene.string() +
+                                    "' --spp 1 --width 8 --height 8 --json -o '" + out.string() + "'",
+                                dir_);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["texture_load_seconds"].get<double>(), 0.0);
+    EXPECT_EQ(j["textures"]["files"], 1);
+    EXPECT_EQ(j["textures"]["plan"], cache ? "OpenImageIO's cache" : "in-memory pyramids");
+    const Result info =
+        gilt::test::run_command(env + "'" + GILT_BINARY_PATH + "' info '" + scene.string() + "'", dir_);
+    ASSERT_EQ(info.code, 0) << info.err;
+    EXPECT_NE(info.out.find(cache ? "texture plan: OpenImageIO's cache" : "texture plan: in-memory pyramids"),
+              std::string::npos)
+        << info.out;
+  }
+}
+
 // Same seed, different thread counts, separate runs: the EXR files are identical byte for byte
 // (no time stamp or thread-dependent value reaches the file).
 TEST_F(Cli, SameSeedGivesIdenticalFilesAcrossRunsAndThreads) {

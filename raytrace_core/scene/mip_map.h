@@ -1,0 +1,89 @@
+#pragma once
+// A MIP pyramid held in memory in the layout its lookups want (Williams 1983, "Pyramidal
+// parametrics"): every level in 4 × 4 tiles, so the 2 × 2 texels a bilinear read takes lie in one
+// or two cache lines; 1 to 4 channels, as half floats or as 8-bit codes (TexelFormat). Lookups take no lock
+// and allocate nothing. Trilinear filtering after pbrt-v4's MIPMap::Filter (Pharr, Jakob & Humphreys 2023),
+// with OpenImageIO's choice of levels for a footprint, so that the two agree (see filter()).
+//
+// Texture coordinates are OpenImageIO's, as in texture.h: (s, t) = (0, 0) at the image's top-left
+// corner, texel (x, y) of a w × h level centred at ((x + ½) / w, (y + ½) / h).
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "raytrace_core/util/math.h"
+
+namespace gilt::raytrace_core::scene {
+
+/// What happens outside [0, 1] along one texture axis (glTF's sampler wrap modes).
+enum class TextureWrap : uint8_t { repeat, clamp, mirror };
+
+/// Texel index i on an axis of n texels, wrapped into [0, n).
+int wrap_texel(int i, int n, TextureWrap wrap);
+
+/// How a pyramid stores its texels.
+enum class TexelFormat : uint8_t {
+  half,    ///< half floats: linear colour decoded from sRGB, and data deeper than 8 bits
+  unorm8,  ///< codes 0–255 read as code / 255: 8-bit data images, level 0 exactly as stored
+};
+
+/// An image of linear values, rows top to bottom, channels interleaved: what a pyramid is made of.
+struct LinearImage {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;  ///< width × height × channels
+};
+
+/// The levels of one image, finest first, held as half floats. Immutable once built; thread-safe.
+class MipMap {
+ public:
+  /// Most channels a pyramid holds; further channels of an image are dropped.
+  static constexpr int kMaxChannels = 4;
+
+  /// Builds the pyramid: level 0 is the image, each further level the box-filtered half of the
+  /// one below (see the .cpp for odd sizes), down to 1 × 1; each stored in `format`.
+  explicit MipMap(const LinearImage& image, TexelFormat format = TexelFormat::half);
+
+  /// Bytes the pyramid of a width × height image with `channels` channels takes, tiles padded.
+  static size_t bytes_for(int width, int height, int channels, TexelFormat format = TexelFormat::half);
+
+  int levels() const { return int(levels_.size()); }
+  int width(int level) const { return levels_[size_t(level)].width; }
+  int height(int level) const { return levels_[size_t(level)].height; }
+  int channels() const { return channels_; }
+  TexelFormat format() const { return format_; }
+  /// Bytes the levels take.
+  size_t bytes() const { return halves_.size() * sizeof(uint16_t) + codes_.size(); }
+
+  /// Channel c of texel (x, y) of a level, as stored (rounded to the format).
+  float texel(int level, int x, int y, int c) const;
+
+  /// Bilinear read of one level at (s, t), wrapped per axis; writes channels() values to out.
+  void bilerp(int level, Vec2 st, TextureWrap wrap_s, TextureWrap wrap_t, float* out) const;
+
+  /// Trilinear read over the footprint spanned by the (s, t) derivatives dx and dy: bilinear in
+  /// the two levels bracketing the footprint's width, blended; zero derivatives read level 0.
+  /// Writes channels() values to out.
+  void filter(Vec2 st, Vec2 dx, Vec2 dy, TextureWrap wrap_s, TextureWrap wrap_t, float* out) const;
+
+ private:
+  struct Level {
+    int width = 0, height = 0;
+    int tiles_x = 0;    ///< tiles per row
+    size_t offset = 0;  ///< first half float of the level in texels_
+  };
+  /// Index into the texels of channel 0 of texel (x, y) of a level.
+  size_t index(const Level& level, int x, int y) const;
+  template <typename T>
+  void bilerp_in(const T* texels, int level, Vec2 st, TextureWrap wrap_s, TextureWrap wrap_t,
+                 float* out) const;
+
+  std::vector<Level> levels_;
+  // The texels, level by level, tile by tile: one of the two, by format_.
+  std::vector<uint16_t> halves_;  ///< half floats' bits
+  std::vector<uint8_t> codes_;    ///< 8-bit codes
+  int channels_ = 0;
+  TexelFormat format_ = TexelFormat::half;
+};
+
+}  // namespace gilt::raytrace_core::scene
