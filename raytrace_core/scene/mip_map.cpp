@@ -1,8 +1,11 @@
 #include "raytrace_core/scene/mip_map.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
+
+#include "raytrace_core/util/parallel.h"
 
 // Imath's conversions by bit operations (or F16C where the build enables it), not through its
 // 256 kB table, which would compete with the texels for the cache.
@@ -49,30 +52,69 @@ std::vector<std::vector<Tap>> box_taps(int n_in, int n_out) {
   return taps;
 }
 
-/// The next level of a w × h image (channels `channels`, pixel stride `stride` floats).
-LinearImage reduce(const float* pixels, int w, int h, int stride, int channels) {
+/// Texel rows handed to one work item when a level is filtered or stored in parallel.
+constexpr size_t kRowsPerItem = 32;
+
+/// Calls body(first, last) over blocks of rows [first, last) of `rows` rows, in parallel.
+template <typename Body>
+void for_row_blocks(int rows, const Body& body) {
+  const size_t blocks = (size_t(rows) + kRowsPerItem - 1) / kRowsPerItem;
+  util::parallel_for(blocks, [&](size_t b) {
+    const int first = int(b * kRowsPerItem);
+    body(first, std::min(rows, first + int(kRowsPerItem)));
+  });
+}
+
+/// The next level of a w × h image with `channels` channels, whose channel c of texel (x, y) is
+/// value(x, y, c): the image's own floats, or an 8-bit image's codes through their tables.
+template <typename Value>
+LinearImage reduce(const Value& value, int w, int h, int channels) {
   LinearImage out{next_size(w), next_size(h), channels, {}};
-  const std::vector<std::vector<Tap>> along_x = box_taps(w, out.width), along_y = box_taps(h, out.height);
-  // Along x into `rows` (out.width × h), then along y.
-  std::vector<float> rows(size_t(out.width) * size_t(h) * size_t(channels), 0.0f);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < out.width; ++x) {
-      float* to = &rows[(size_t(y) * size_t(out.width) + size_t(x)) * size_t(channels)];
-      for (const Tap& tap : along_x[size_t(x)]) {
-        const float* from = pixels + (size_t(y) * size_t(w) + size_t(tap.source)) * size_t(stride);
-        for (int c = 0; c < channels; ++c) to[c] += tap.weight * from[c];
-      }
-    }
   const size_t row = size_t(out.width) * size_t(channels);
+  if (w % 2 == 0 && h % 2 == 0) {
+    // Even sizes (every level of a power-of-two image): each texel the mean of its 2 × 2 block,
+    // in one pass. The same sums, in the same order, as the two passes below.
+    out.pixels.resize(row * size_t(out.height));
+    for_row_blocks(out.height, [&](int first, int last) {
+      for (int y = first; y < last; ++y)
+        for (int x = 0; x < out.width; ++x)
+          for (int c = 0; c < channels; ++c) {
+            const float upper = 0.5f * value(2 * x, 2 * y, c) + 0.5f * value(2 * x + 1, 2 * y, c);
+            const float lower = 0.5f * value(2 * x, 2 * y + 1, c) + 0.5f * value(2 * x + 1, 2 * y + 1, c);
+            out.pixels[size_t(y) * row + size_t(x) * size_t(channels) + size_t(c)] =
+                0.5f * upper + 0.5f * lower;
+          }
+    });
+    return out;
+  }
+  const std::vector<std::vector<Tap>> along_x = box_taps(w, out.width), along_y = box_taps(h, out.height);
+  // Along x into `rows` (out.width × h), then along y; each in blocks of rows, in parallel.
+  std::vector<float> rows(row * size_t(h), 0.0f);
+  for_row_blocks(h, [&](int first, int last) {
+    for (int y = first; y < last; ++y)
+      for (int x = 0; x < out.width; ++x) {
+        float* to = &rows[size_t(y) * row + size_t(x) * size_t(channels)];
+        for (const Tap& tap : along_x[size_t(x)])
+          for (int c = 0; c < channels; ++c) to[c] += tap.weight * value(tap.source, y, c);
+      }
+  });
   out.pixels.assign(row * size_t(out.height), 0.0f);
-  for (int y = 0; y < out.height; ++y)
-    for (const Tap& tap : along_y[size_t(y)]) {
-      float* to = &out.pixels[size_t(y) * row];
-      const float* from = &rows[size_t(tap.source) * row];
-      for (size_t k = 0; k < row; ++k) to[k] += tap.weight * from[k];
-    }
+  for_row_blocks(out.height, [&](int first, int last) {
+    for (int y = first; y < last; ++y)
+      for (const Tap& tap : along_y[size_t(y)]) {
+        float* to = &out.pixels[size_t(y) * row];
+        const float* from = &rows[size_t(tap.source) * row];
+        for (size_t k = 0; k < row; ++k) to[k] += tap.weight * from[k];
+      }
+  });
   return out;
 }
+
+/// A value stored as a half float's bits, clamped to the finite halves.
+uint16_t to_half(float x) { return imath_float_to_half(std::clamp(x, -kHalfMax, kHalfMax)); }
+
+/// A value in [0, 1] stored as the nearest 8-bit code.
+uint8_t to_code(float x) { return uint8_t(std::clamp(x, 0.0f, 1.0f) * 255.0f + 0.5f); }
 
 /// A stored texel channel's value.
 float value_of(uint16_t half) { return imath_half_to_float(half); }
@@ -84,6 +126,7 @@ float usable(float x) { return std::fabs(x) < 1e9f ? x : 0.0f; }
 }  // namespace
 
 int wrap_texel(int i, int n, TextureWrap wrap) {
+  if (unsigned(i) < unsigned(n)) return i;  // inside: every mode leaves it
   switch (wrap) {
     case TextureWrap::clamp:
       return std::clamp(i, 0, n - 1);
@@ -117,42 +160,102 @@ MipMap::MipMap(const LinearImage& image, TexelFormat format)
       image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
     throw std::invalid_argument(
         "MipMap: an image needs a size, channels and width × height × channels values");
-  const size_t count = bytes_for(image.width, image.height, image.channels, TexelFormat::unorm8);
+  const size_t stride = size_t(image.channels);
+  const float* pixels = image.pixels.data();
+  const auto at = [&](int x, int y, int c) {
+    return pixels[(size_t(y) * size_t(image.width) + size_t(x)) * stride + size_t(c)];
+  };
+  allocate(image.width, image.height);
   if (format_ == TexelFormat::half)
-    halves_.resize(count);
+    store(0, [&](int x, int y, int c) { return to_half(at(x, y, c)); });
   else
-    codes_.resize(count);
-  // Each level is made from the one below in full precision, then stored (half floats rounded to
-  // nearest, codes to the nearest code), so rounding does not build up from level to level.
-  LinearImage below;  // the level just stored, or empty while that is the image itself
+    store(0, [&](int x, int y, int c) { return to_code(at(x, y, c)); });
+  if (levels() > 1) store_from(1, reduce(at, image.width, image.height, channels_));
+}
+
+MipMap::MipMap(const CodeImage& image, TexelFormat format)
+    : channels_(std::min(image.channels, kMaxChannels)), format_(format) {
+  if (image.width < 1 || image.height < 1 || image.channels < 1 ||
+      image.codes.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
+    throw std::invalid_argument(
+        "MipMap: an image needs a size, channels and width × height × channels codes");
+  const size_t stride = size_t(image.channels);
+  const uint8_t* codes = image.codes.data();
+  const auto code = [&](int x, int y, int c) {
+    return codes[(size_t(y) * size_t(image.width) + size_t(x)) * stride + size_t(c)];
+  };
+  allocate(image.width, image.height);
+  // Level 0 through each channel's table of what its 256 codes store as: one look-up per value.
+  if (format_ == TexelFormat::half) {
+    std::array<std::array<uint16_t, 256>, kMaxChannels> stored{};
+    for (int c = 0; c < channels_; ++c)
+      for (int k = 0; k < 256; ++k)
+        stored[size_t(c)][size_t(k)] = to_half(image.values[size_t(c)][size_t(k)]);
+    store(0, [&](int x, int y, int c) { return stored[size_t(c)][code(x, y, c)]; });
+  } else {
+    std::array<std::array<uint8_t, 256>, kMaxChannels> stored{};
+    for (int c = 0; c < channels_; ++c)
+      for (int k = 0; k < 256; ++k)
+        stored[size_t(c)][size_t(k)] = to_code(image.values[size_t(c)][size_t(k)]);
+    store(0, [&](int x, int y, int c) { return stored[size_t(c)][code(x, y, c)]; });
+  }
+  if (levels() > 1)
+    store_from(1, reduce([&](int x, int y, int c) { return image.values[size_t(c)][code(x, y, c)]; },
+                         image.width, image.height, channels_));
+}
+
+void MipMap::allocate(int width, int height) {
   size_t offset = 0;
   for (;;) {
-    const bool first = below.pixels.empty();
-    const float* pixels = first ? image.pixels.data() : below.pixels.data();
-    const int w = first ? image.width : below.width, h = first ? image.height : below.height;
-    const int stride = first ? image.channels : channels_;
-    Level level{w, h, tiles(w), offset};
-    levels_.push_back(level);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const float* from = pixels + (size_t(y) * size_t(w) + size_t(x)) * size_t(stride);
+    levels_.push_back(Level{width, height, tiles(width), offset});
+    offset += size_t(tiles(width)) * size_t(tiles(height)) * size_t(kTile * kTile) * size_t(channels_);
+    if (width == 1 && height == 1) break;
+    width = next_size(width), height = next_size(height);
+  }
+  if (format_ == TexelFormat::half)
+    halves_.resize(offset);
+  else
+    codes_.resize(offset);
+}
+
+template <typename Stored>
+void MipMap::store(int l, const Stored& stored) {
+  const Level& level = levels_[size_t(l)];
+  for_row_blocks(level.height, [&](int first, int last) {
+    for (int y = first; y < last; ++y)
+      for (int x = 0; x < level.width; ++x) {
         const size_t to = index(level, x, y);
         for (int c = 0; c < channels_; ++c) {
-          if (format_ == TexelFormat::half)
-            halves_[to + size_t(c)] = imath_float_to_half(std::clamp(from[c], -kHalfMax, kHalfMax));
+          if constexpr (sizeof(stored(x, y, c)) == sizeof(uint16_t))
+            halves_[to + size_t(c)] = stored(x, y, c);
           else
-            codes_[to + size_t(c)] = uint8_t(std::lround(std::clamp(from[c], 0.0f, 1.0f) * 255.0f));
+            codes_[to + size_t(c)] = stored(x, y, c);
         }
       }
-    offset += size_t(tiles(w)) * size_t(tiles(h)) * size_t(kTile * kTile) * size_t(channels_);
-    if (w == 1 && h == 1) break;
-    below = reduce(pixels, w, h, stride, channels_);
+  });
+}
+
+void MipMap::store_from(int l, LinearImage image) {
+  // Each level is made from the one below in full precision, then stored (half floats rounded to
+  // nearest, codes to the nearest code), so rounding does not build up from level to level.
+  for (; l < levels(); ++l) {
+    const size_t stride = size_t(channels_);
+    const auto at = [&](int x, int y, int c) {
+      return image.pixels[(size_t(y) * size_t(image.width) + size_t(x)) * stride + size_t(c)];
+    };
+    if (format_ == TexelFormat::half)
+      store(l, [&](int x, int y, int c) { return to_half(at(x, y, c)); });
+    else
+      store(l, [&](int x, int y, int c) { return to_code(at(x, y, c)); });
+    if (l + 1 < levels()) image = reduce(at, image.width, image.height, channels_);
   }
 }
 
-size_t MipMap::index(const Level& level, int x, int y) const {
-  const size_t tile = size_t(y / kTile) * size_t(level.tiles_x) + size_t(x / kTile);
-  const size_t within = size_t(y % kTile) * kTile + size_t(x % kTile);
+inline size_t MipMap::index(const Level& level, int x, int y) const {
+  // x, y ≥ 0, so the divisions and remainders by the tile's side are shifts and masks.
+  const unsigned ux = unsigned(x), uy = unsigned(y);
+  const size_t tile = size_t(uy / kTile) * size_t(level.tiles_x) + size_t(ux / kTile);
+  const size_t within = size_t(uy % kTile) * kTile + size_t(ux % kTile);
   return level.offset + (tile * (kTile * kTile) + within) * size_t(channels_);
 }
 

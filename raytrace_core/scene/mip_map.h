@@ -8,6 +8,7 @@
 // Texture coordinates are OpenImageIO's, as in texture.h: (s, t) = (0, 0) at the image's top-left
 // corner, texel (x, y) of a w × h level centred at ((x + ½) / w, (y + ½) / h).
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -34,6 +35,16 @@ struct LinearImage {
   std::vector<float> pixels;  ///< width × height × channels
 };
 
+/// An image of 8-bit codes as read from a file (PNG, JPEG), rows top to bottom, channels
+/// interleaved, with the linear value each channel's codes stand for (sRGB decoded for colour,
+/// code / 255 for data and alpha). A pyramid made from it looks each code up once, rather than
+/// going through a float copy of the image.
+struct CodeImage {
+  int width = 0, height = 0, channels = 0;
+  std::vector<uint8_t> codes;                      ///< width × height × channels
+  std::array<std::array<float, 256>, 4> values{};  ///< values[c][code], for the first 4 channels
+};
+
 /// The levels of one image, finest first, held as half floats. Immutable once built; thread-safe.
 class MipMap {
  public:
@@ -43,6 +54,9 @@ class MipMap {
   /// Builds the pyramid: level 0 is the image, each further level the box-filtered half of the
   /// one below (see the .cpp for odd sizes), down to 1 × 1; each stored in `format`.
   explicit MipMap(const LinearImage& image, TexelFormat format = TexelFormat::half);
+  /// The same from an 8-bit image: level 0 holds each code's value (in `format`), the levels
+  /// above are filtered from the values as the float constructor filters its pixels.
+  MipMap(const CodeImage& image, TexelFormat format);
 
   /// Bytes the pyramid of a width × height image with `channels` channels takes, tiles padded.
   static size_t bytes_for(int width, int height, int channels, TexelFormat format = TexelFormat::half);
@@ -72,6 +86,14 @@ class MipMap {
     int tiles_x = 0;    ///< tiles per row
     size_t offset = 0;  ///< first half float of the level in texels_
   };
+  /// Lays out the levels of a width × height image and sizes the texels.
+  void allocate(int width, int height);
+  /// Stores level l: stored(x, y, c) is channel c of texel (x, y) in the format's type. Rows are
+  /// stored in parallel.
+  template <typename Stored>
+  void store(int l, const Stored& stored);
+  /// Stores `image` as level l and every coarser level filtered from it.
+  void store_from(int l, LinearImage image);
   /// Index into the texels of channel 0 of texel (x, y) of a level.
   size_t index(const Level& level, int x, int y) const;
   template <typename T>

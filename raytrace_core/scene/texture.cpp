@@ -159,30 +159,28 @@ MipMap decode(const FileRole& file) {
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file.path, &config);
   if (!in) throw InputError(file.path + ": texture cannot be read: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
-  LinearImage image{spec.width, spec.height, std::min(spec.nchannels, MipMap::kMaxChannels), {}};
-  image.pixels.resize(size_t(image.width) * size_t(image.height) * size_t(image.channels));
-  const size_t channels = size_t(image.channels);
-  const int alpha = file.srgb ? alpha_channel(spec.alpha_channel, image.channels) : -1;
+  const int channels = std::min(spec.nchannels, MipMap::kMaxChannels);
+  const size_t values = size_t(spec.width) * size_t(spec.height) * size_t(channels);
+  const int alpha = file.srgb ? alpha_channel(spec.alpha_channel, channels) : -1;
   if (spec.format == OIIO::TypeDesc::UINT8 && spec.channelformats.empty()) {
-    // 8-bit codes (PNG, JPEG): read as they are and mapped through tables of their 256 values,
-    // rather than one std::pow per value.
-    std::vector<uint8_t> codes(image.pixels.size());
-    if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::UINT8, codes.data()))
+    // 8-bit codes (PNG, JPEG): read as they are; the pyramid maps them through tables of their
+    // 256 values, rather than one std::pow per value.
+    CodeImage image{spec.width, spec.height, channels, std::vector<uint8_t>(values), {}};
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, image.codes.data()))
       throw InputError(file.path + ": texture cannot be read: " + in->geterror());
-    std::array<float, 256> as_stored{}, decoded{};
-    for (int c = 0; c < 256; ++c) {
-      as_stored[size_t(c)] = float(c) / 255.0f;
-      decoded[size_t(c)] = file.srgb ? srgb_to_linear(as_stored[size_t(c)]) : as_stored[size_t(c)];
-    }
-    for (size_t i = 0; i < codes.size(); ++i)
-      image.pixels[i] = (int(i % channels) == alpha ? as_stored : decoded)[codes[i]];
-  } else {
-    if (!in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
-      throw InputError(file.path + ": texture cannot be read: " + in->geterror());
-    if (file.srgb)
-      for (size_t i = 0; i < image.pixels.size(); ++i)
-        if (int(i % channels) != alpha) image.pixels[i] = srgb_to_linear(image.pixels[i]);
+    for (int c = 0; c < channels; ++c)
+      for (int k = 0; k < 256; ++k) {
+        const float stored = float(k) / 255.0f;
+        image.values[size_t(c)][size_t(k)] = file.srgb && c != alpha ? srgb_to_linear(stored) : stored;
+      }
+    return MipMap(image, storage_for(spec, file.srgb));
   }
+  LinearImage image{spec.width, spec.height, channels, std::vector<float>(values)};
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+    throw InputError(file.path + ": texture cannot be read: " + in->geterror());
+  if (file.srgb)
+    for (size_t i = 0; i < image.pixels.size(); ++i)
+      if (int(i % size_t(channels)) != alpha) image.pixels[i] = srgb_to_linear(image.pixels[i]);
   return MipMap(image, storage_for(spec, file.srgb));
 }
 

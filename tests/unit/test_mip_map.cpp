@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "raytrace_core/scene/mip_map.h"
@@ -156,6 +157,36 @@ TEST(MipMap, EightBitCodesAreKeptExactly) {
           for (int i = 0; i < 2; ++i) sum += pyramid.texel(0, 2 * x + i, 2 * y + j, c);
         EXPECT_NEAR(pyramid.texel(1, x, y, c), sum / 4.0f, 0.5f / 255.0f + 1e-6f);
       }
+}
+
+TEST(MipMap, CodesThroughTablesMakeTheSamePyramidAsTheirValues) {
+  // An 8-bit image is made into its pyramid straight from its codes and each channel's table of
+  // values (an sRGB curve for colour, code / 255 for alpha). That must be the pyramid of the
+  // image of those values, texel for texel and bit for bit, in both formats. The sizes are odd
+  // and even, and tall enough (70 rows) that rows are filtered in several blocks in parallel.
+  for (const auto& [w, h] : {std::pair{70, 70}, std::pair{37, 70}, std::pair{64, 6}})
+    for (const rc::scene::TexelFormat format :
+         {rc::scene::TexelFormat::half, rc::scene::TexelFormat::unorm8}) {
+      rc::scene::CodeImage codes{w, h, 4, {}, {}};
+      for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < 256; ++k)
+          codes.values[size_t(c)][size_t(k)] = c == 3 ? float(k) / 255.0f : std::pow(float(k) / 255.0f, 2.2f);
+      rc::scene::LinearImage values{w, h, 4, {}};
+      const rc::scene::LinearImage hashed = hashed_image(w, h, 4);
+      for (size_t i = 0; i < hashed.pixels.size(); ++i) {
+        const auto code = uint8_t(std::lround(hashed.pixels[i] * 255.0f));
+        codes.codes.push_back(code);
+        values.pixels.push_back(codes.values[i % 4][code]);
+      }
+      const MipMap from_codes(codes, format), from_values(values, format);
+      ASSERT_EQ(from_codes.levels(), from_values.levels());
+      for (int l = 0; l < from_codes.levels(); ++l)
+        for (int y = 0; y < from_codes.height(l); ++y)
+          for (int x = 0; x < from_codes.width(l); ++x)
+            for (int c = 0; c < 4; ++c)
+              ASSERT_EQ(from_codes.texel(l, x, y, c), from_values.texel(l, x, y, c))
+                  << w << "×" << h << " level " << l << " texel " << x << ',' << y << " channel " << c;
+    }
 }
 
 TEST(MipMap, RefusesAnEmptyImage) {
