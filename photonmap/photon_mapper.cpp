@@ -173,7 +173,7 @@ rc::Rgb PhotonMapper::radiance(const rc::scene::Ray& camera_ray, rc::render::Sam
     const bool wo_above = glm::dot(wo_world, si.ng) > 0.0f, wi_above = glm::dot(wi_world, si.ng) > 0.0f;
     if (wi_above != (bs->transmission ? !wo_above : wo_above)) break;
     beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    ray = rc::scene::spawn_ray(si, wi_world);
+    ray = rc::scene::continue_ray(si, wi_world);
   }
   return radiance;
 }
@@ -219,7 +219,7 @@ rc::Rgb PhotonMapper::shade(const rc::scene::SurfaceInteraction& si, const rc::V
     const bool wi_above = glm::dot(wi_world, si.ng) > 0.0f;
     if (wi_above != (bs->transmission ? !wo_above : wo_above)) continue;
     rc::Rgb g = bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-    rc::scene::Ray ray = rc::scene::spawn_ray(si, wi_world);
+    rc::scene::Ray ray = rc::scene::continue_ray(si, wi_world);
     bool through_specular = false;
     for (int depth = 0; depth < settings_.max_depth; ++depth) {
       ++ctx.rays;
@@ -263,7 +263,7 @@ rc::Rgb PhotonMapper::shade(const rc::scene::SurfaceInteraction& si, const rc::V
         const std::optional<rc::scene::BsdfSample> bj = rc::scene::bsdf_sample(mj, woj, sampler.uniform(), sampler.uniform2());
         if (!bj || !(bj->pdf > 0.0f) || bj->f.is_black()) break;
         g *= bj->f * (std::fabs(bj->wi.z) / bj->pdf);
-        ray = rc::scene::spawn_ray(sj, fj.to_world(bj->wi));
+        ray = rc::scene::continue_ray(sj, fj.to_world(bj->wi));
         through_specular = true;
         continue;
       }

@@ -188,7 +188,7 @@ void trace_visible_row(SppmRun& run, size_t y) {
       const rc::Vec3 wi_world = frame.to_world(bs->wi);
       if ((glm::dot(wi_world, si.ng) > 0.0f) != (bs->transmission ? !wo_above : wo_above)) break;
       beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-      ray = rc::scene::spawn_ray(si, wi_world);
+      ray = rc::scene::continue_ray(si, wi_world);
     }
     if (direct.is_finite()) ps.direct_sum += direct;
   }

@@ -53,7 +53,7 @@ bool scatter_specular(const rc::scene::Material& m, const rc::scene::SurfaceInte
   const auto bs = rc::scene::bsdf_sample(m, wo, u_lobe, sampler.uniform2());
   if (!bs || !(bs->pdf > 0.0f)) return false;
   beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf);
-  ray = rc::scene::spawn_ray(si, frame.to_world(bs->wi));
+  ray = rc::scene::continue_ray(si, frame.to_world(bs->wi));
   return true;
 }
 
@@ -216,7 +216,7 @@ Rgb RadiosityView::gather(const rc::scene::SurfaceInteraction& si, const rc::Fra
   if (!wo_above) wi = -wi;                            // the frame's z is the front's shading normal
   if (glm::dot(wi, side) <= 0.0f) return Rgb(0.0f);  // the shading normal leans the ray through the surface
   Rgb beta(rc::kPi), out(0.0f);
-  rc::scene::Ray ray = rc::scene::spawn_ray(si, wi);
+  rc::scene::Ray ray = rc::scene::continue_ray(si, wi);
   // Emitters and the sky are next-event estimation's after a diffuse bounce; through glass or a
   // mirror, shadow rays cannot see them, and the ray is their only way in.
   bool via_specular = false;
@@ -272,7 +272,7 @@ Rgb RadiosityView::gather(const rc::scene::SurfaceInteraction& si, const rc::Fra
       if (!above) next = -next;
       if (glm::dot(next, lit) <= 0.0f) return out;
       beta *= rc::scene::diffuse_reflectance(mj);  // Lambertian: f cos / pdf
-      ray = rc::scene::spawn_ray(sj, next);
+      ray = rc::scene::continue_ray(sj, next);
       via_specular = false;
       continue;
     }

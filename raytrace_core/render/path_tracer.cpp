@@ -79,7 +79,7 @@ Rgb path_radiance(const scene::Scene& scene, const scene::Ray& camera_ray, Sampl
     bsdf_pdf_prev = bs->pdf;
     prev = si;
     prev_query = light_query(si, m, wo_above);
-    ray = scene::spawn_ray(si, wi_world);
+    ray = scene::continue_ray(si, wi_world);
 
     // Russian roulette on the throughput.
     if (depth + 1 >= settings.rr_depth) {

@@ -36,7 +36,7 @@ Rgb trace(const scene::Scene& scene, const scene::Ray& ray, SampleContext& ctx, 
 
   auto follow = [&](const Vec3& wi_local, const Rgb& weight) {
     const Vec3 wi_world = frame.to_world(wi_local);
-    Rgb l = trace(scene, scene::spawn_ray(si, wi_world), ctx, settings, depth + 1);
+    Rgb l = trace(scene, scene::continue_ray(si, wi_world), ctx, settings, depth + 1);
     return weight * l;
   };
   if (m.kind == scene::MaterialKind::mirror) {

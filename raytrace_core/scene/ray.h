@@ -19,8 +19,12 @@ struct Ray {
   float tmax = kInfinity;
   /// Angle by which a cone around the ray widens per unit distance: a camera ray carries its
   /// pixel's, so that a hit knows the pixel's footprint there (ray cones, Akenine-Möller et al.
-  /// 2019, "Texture Level of Detail Strategies for Real-Time Ray Tracing"). 0 for other rays.
+  /// 2019, "Texture Level of Detail Strategies for Real-Time Ray Tracing"), and a ray that
+  /// continues a camera path carries it on (continue_ray, scene.h). 0 for other rays.
   float spread = 0.0f;
+  /// The cone's width at the origin: 0 at the camera's pinhole, the width the cone had reached
+  /// at the surface a continued ray leaves.
+  float width = 0.0f;
 };
 
 /// A point on a surface with the bound on its rounding error and its geometric normal.

@@ -19,6 +19,7 @@
 #include "raytrace_core/scene/normal_map.h"
 #include "raytrace_core/util/closest_point.h"
 #include "raytrace_core/util/error.h"
+#include "raytrace_core/util/parallel.h"
 
 namespace gilt::raytrace_core::scene {
 namespace {
@@ -484,8 +485,13 @@ void Scene::commit() {
   collect_lights(meshes, spheres, materials, punctual_lights, sphere_geom_id(),
                  {lights_, first_light_of_mesh_, light_of_sphere_, environment_lights_});
   committed_ = true;  // light_power needs bounds and geometry queries
+  // In blocks, in parallel: a textured emitter's power filters its texture over the triangle.
   std::vector<float> power(lights_.size());
-  for (size_t i = 0; i < lights_.size(); ++i) power[i] = light_power(*this, lights_[i]).average();
+  constexpr size_t kLightsPerItem = 256;
+  util::parallel_for((lights_.size() + kLightsPerItem - 1) / kLightsPerItem, [&](size_t b) {
+    for (size_t i = b * kLightsPerItem; i < std::min(lights_.size(), (b + 1) * kLightsPerItem); ++i)
+      power[i] = light_power(*this, lights_[i]).average();
+  });
   light_distribution_ = util::Distribution1D(power);
   light_sampler_ = LightSampler(*this, lights_, power);
 }
@@ -691,8 +697,11 @@ SurfaceInteraction Scene::surface(const Ray& ray, const Hit& hit) const {
     si = sphere_point(hit.prim_id, Vec3(p - DVec3(spheres[hit.prim_id].center)));
   } else {
     si = triangle_point(hit.geom_id, hit.prim_id, Vec2(hit.u, hit.v));
-    if (ray.spread > 0.0f) pixel_footprint(ray, hit, si);
   }
+  si.cone_width = ray.width + ray.spread * hit.t * glm::length(ray.direction);
+  si.cone_spread = ray.spread;
+  if (!std::isfinite(si.cone_width)) si.cone_width = si.cone_spread = 0.0f;
+  if (si.cone_width > 0.0f && hit.geom_id != sphere_geom_id()) pixel_footprint(ray, hit, si);
   si.front_face = glm::dot(ray.direction, si.ng) < 0.0f;
   return si;
 }
@@ -704,9 +713,8 @@ void Scene::pixel_footprint(const Ray& ray, const Hit& hit, SurfaceInteraction& 
   // The cone's circle, `width` across, laid on the triangle's plane: an ellipse whose short axis
   // is `width` long, across the ray, and whose long axis, along the ray's trace on the plane, is
   // width / |cos θ| (θ bounded off grazing, where the footprint would cover the whole plane).
-  const float length = glm::length(ray.direction);
-  const Vec3 d = ray.direction / length;
-  const float width = ray.spread * hit.t * length;
+  const Vec3 d = glm::normalize(ray.direction);
+  const float width = si.cone_width;
   const float cos_theta = std::max(std::fabs(glm::dot(d, si.ng)), 0.05f);
   const Vec3 across = glm::cross(si.ng, d);
   const float across_length = glm::length(across);

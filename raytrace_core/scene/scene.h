@@ -89,13 +89,29 @@ struct Hit {
 struct SurfaceInteraction : SurfacePoint {
   Vec3 ns{0.0f, 0.0f, 1.0f};  ///< unit shading normal, on the same side as ng
   Vec2 uv{0.0f};
-  /// Change of uv across the footprint of the camera pixel whose ray made the hit (Ray::spread),
-  /// along its two axes; zero for other rays, whose lookups read the finest level.
+  /// Change of uv across the footprint of the camera pixel whose cone made the hit (Ray::spread,
+  /// Ray::width), along its two axes; zero for other rays, whose lookups read the finest level.
   Vec2 duv_dx{0.0f}, duv_dy{0.0f};
+  /// The cone of the ray that made the hit, at the hit: its width (Ray::width + Ray::spread × the
+  /// distance) and its spread. continue_ray carries it on.
+  float cone_width = 0.0f, cone_spread = 0.0f;
   uint32_t material = 0;
   int32_t light = -1;          ///< index into Scene::lights() when the surface emits, else −1
   bool front_face = true;      ///< the ray arrived on the ng side
 };
+
+/// A ray leaving si in `direction` that carries on the cone of the camera ray whose path reached
+/// si: it starts as wide as the cone was at si and widens by the pixel's angle. So a hit after
+/// any bounce filters its textures over the pixel's angle times the path's length so far, never
+/// less than the camera ray's own footprint there. pbrt-v4 takes the footprint the camera would
+/// see at such a hit (CameraBase::Approximate_dp_dxy); the path's length is at least the
+/// camera's distance, so this footprint is at least as wide, and needs no camera.
+inline Ray continue_ray(const SurfaceInteraction& si, const Vec3& direction) {
+  Ray ray = spawn_ray(si, direction);
+  ray.width = si.cone_width;
+  ray.spread = si.cone_spread;
+  return ray;
+}
 
 /// A scene ready for ray queries after commit().
 class Scene {

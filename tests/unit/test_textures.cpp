@@ -351,6 +351,53 @@ TEST_F(Textures, CameraRaysFilterOverTheirPixelsFootprint) {
   EXPECT_NEAR(albedo(ray), 0.5f, kMipCode);
 }
 
+TEST_F(Textures, ContinuedRaysCarryThePixelsConeAlongThePath) {
+  // The checker of the test above. A camera ray of spread 1/64 hits the quad head-on at distance
+  // 1 (width 1/64: one texel), and the path goes on: a ray continued from that hit is 1/64 wide
+  // at its origin and widens by 1/64 per unit. Hitting the quad again after 7 units (a mirror
+  // elsewhere, say), its cone is 1/64 + 7/64 = 1/8 wide: 8 texels, so the lookup reads levels
+  // whose texels average whole periods, 0.5 within one code. A ray spawned plainly (a shadow
+  // ray, a photon) carries no cone and reads the finest level.
+  std::vector<unsigned char> texels;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      texels.insert(texels.end(), 3, (x + y) % 2 ? (unsigned char)255 : (unsigned char)0);
+  const rc::scene::Scene scene =
+      textured_quad(rc::scene::TextureImage{ppm("checker2.ppm", 64, 64, texels), false,
+                                            rc::scene::TextureWrap::repeat, rc::scene::TextureWrap::repeat},
+                    rc::Rgb(1.0f));
+  const rc::Vec3 texel_centre((20 + 0.5f) / 64.0f, (31 + 0.5f) / 64.0f, 0.0f);
+  rc::scene::Ray camera_ray{texel_centre + rc::Vec3(0, 0, 1), {0.0f, 0.0f, -1.0f}, 4.0f};
+  camera_ray.spread = 1.0f / 64.0f;
+  const std::optional<rc::scene::Hit> first = scene.intersect(camera_ray);
+  ASSERT_TRUE(first.has_value());
+  const rc::scene::SurfaceInteraction si = scene.surface(camera_ray, *first);
+  EXPECT_NEAR(si.cone_width, 1.0f / 64.0f, 1e-6f);
+  EXPECT_EQ(si.cone_spread, 1.0f / 64.0f);
+  const rc::scene::Ray continued = rc::scene::continue_ray(si, {0.0f, 0.0f, 1.0f});
+  EXPECT_EQ(continued.width, si.cone_width);
+  EXPECT_EQ(continued.spread, si.cone_spread);
+
+  // The continued cone, moved to arrive head-on 7 units later at the texel's centre.
+  rc::scene::Ray later = continued;
+  later.origin = texel_centre + rc::Vec3(0, 0, 7);
+  later.direction = {0.0f, 0.0f, -1.0f};
+  later.tmax = 8.0f;
+  const std::optional<rc::scene::Hit> second = scene.intersect(later);
+  ASSERT_TRUE(second.has_value());
+  const rc::scene::SurfaceInteraction sj = scene.surface(later, *second);
+  EXPECT_NEAR(sj.cone_width, 8.0f / 64.0f, 1e-5f);
+  rc::scene::Material scratch;
+  EXPECT_NEAR(scene.shading_material(sj, scratch).albedo.r, 0.5f, 1.0f / 255.0f);
+
+  const rc::scene::Ray plain = rc::scene::spawn_ray(si, {0.0f, 0.0f, 1.0f});
+  EXPECT_EQ(plain.width, 0.0f);
+  EXPECT_EQ(plain.spread, 0.0f);
+  later.width = later.spread = 0.0f;
+  const float sharp = scene.shading_material(scene.surface(later, *scene.intersect(later)), scratch).albedo.r;
+  EXPECT_TRUE(std::fabs(sharp) < 1e-4f || std::fabs(sharp - 1.0f) < 1e-4f) << sharp;
+}
+
 TEST_F(Textures, BlendStopsRaysInProportionToAlpha) {
   // Constant alpha 0.3, BLEND: each ray stops with probability 0.3, fixed by the ray itself. Over
   // n = 20,000 rays the fraction's standard deviation is √(0.3 · 0.7 / n) = 0.0032; 4 of them.
