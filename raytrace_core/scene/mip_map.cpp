@@ -1,9 +1,19 @@
 #include "raytrace_core/scene/mip_map.h"
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <istream>
+#include <new>
+#include <ostream>
 #include <stdexcept>
+#include <utility>
 
 #include "raytrace_core/util/parallel.h"
 
@@ -15,6 +25,9 @@
 namespace gilt::raytrace_core::scene {
 
 namespace {
+
+/// A transparent huge page: allocations of at least this size get their own mapping.
+constexpr size_t kHugePage = size_t(2) << 20;
 
 /// Texels on a tile's side; a tile of 4 channels is 128 bytes.
 constexpr int kTile = 4;
@@ -143,6 +156,54 @@ int wrap_texel(int i, int n, TextureWrap wrap) {
   return p < 0 ? p + n : p;
 }
 
+TexelMemory::TexelMemory(size_t bytes) : size_(bytes) {
+  if (bytes == 0) return;
+#ifdef __linux__
+  if (bytes >= kHugePage) {
+    data_ = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (data_ == MAP_FAILED) {
+      data_ = nullptr;
+      throw std::bad_alloc();
+    }
+    mapped_ = true;
+    madvise(data_, bytes, MADV_HUGEPAGE);  // advice: where the kernel has none to give, it is ignored
+    return;
+  }
+#endif
+  data_ = std::calloc(bytes, 1);
+  if (!data_) throw std::bad_alloc();
+}
+
+TexelMemory::~TexelMemory() { release(); }
+
+TexelMemory::TexelMemory(TexelMemory&& other) noexcept
+    : data_(std::exchange(other.data_, nullptr)),
+      size_(std::exchange(other.size_, 0)),
+      mapped_(other.mapped_) {}
+
+TexelMemory& TexelMemory::operator=(TexelMemory&& other) noexcept {
+  if (this != &other) {
+    release();
+    data_ = std::exchange(other.data_, nullptr);
+    size_ = std::exchange(other.size_, 0);
+    mapped_ = other.mapped_;
+  }
+  return *this;
+}
+
+void TexelMemory::release() {
+  if (!data_) return;
+#ifdef __linux__
+  if (mapped_) {
+    munmap(data_, size_);
+    data_ = nullptr;
+    return;
+  }
+#endif
+  std::free(data_);
+  data_ = nullptr;
+}
+
 size_t MipMap::bytes_for(int width, int height, int channels, TexelFormat format) {
   channels = std::min(channels, kMaxChannels);
   size_t texels = 0;  // channel values
@@ -212,10 +273,7 @@ void MipMap::allocate(int width, int height) {
     if (width == 1 && height == 1) break;
     width = next_size(width), height = next_size(height);
   }
-  if (format_ == TexelFormat::half)
-    halves_.resize(offset);
-  else
-    codes_.resize(offset);
+  texels_ = TexelMemory(offset * (format_ == TexelFormat::half ? sizeof(uint16_t) : sizeof(uint8_t)));
 }
 
 template <typename Stored>
@@ -227,9 +285,9 @@ void MipMap::store(int l, const Stored& stored) {
         const size_t to = index(level, x, y);
         for (int c = 0; c < channels_; ++c) {
           if constexpr (sizeof(stored(x, y, c)) == sizeof(uint16_t))
-            halves_[to + size_t(c)] = stored(x, y, c);
+            halves()[to + size_t(c)] = stored(x, y, c);
           else
-            codes_[to + size_t(c)] = stored(x, y, c);
+            codes()[to + size_t(c)] = stored(x, y, c);
         }
       }
   });
@@ -251,6 +309,45 @@ void MipMap::store_from(int l, LinearImage image) {
   }
 }
 
+MipMap::MipMap(int width, int height, int channels, TexelFormat format)
+    : channels_(channels), format_(format) {
+  allocate(width, height);
+}
+
+namespace {
+
+/// The first bytes of a written pyramid: names this layout (4 × 4 tiles, channels interleaved,
+/// levels finest first), so that a file of another layout is not taken for one.
+constexpr char kPyramidMagic[16] = "gilt-mip-4x4-v1";
+
+}  // namespace
+
+bool MipMap::write(std::ostream& out) const {
+  const int32_t header[4] = {levels_[0].width, levels_[0].height, channels_, int32_t(format_)};
+  out.write(kPyramidMagic, sizeof kPyramidMagic);
+  out.write(reinterpret_cast<const char*>(header), sizeof header);
+  out.write(static_cast<const char*>(texels_.data()), std::streamsize(texels_.size()));
+  return out.good();
+}
+
+std::optional<MipMap> MipMap::read(std::istream& in) {
+  char magic[sizeof kPyramidMagic];
+  int32_t header[4];
+  if (!in.read(magic, sizeof magic) || std::memcmp(magic, kPyramidMagic, sizeof magic) != 0)
+    return std::nullopt;
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return std::nullopt;
+  const auto [width, height, channels, format] = header;
+  if (width < 1 || height < 1 || width > (1 << 20) || height > (1 << 20) || channels < 1 ||
+      channels > kMaxChannels ||
+      (format != int32_t(TexelFormat::half) && format != int32_t(TexelFormat::unorm8)))
+    return std::nullopt;
+  MipMap pyramid(width, height, channels, TexelFormat(format));
+  const auto bytes = std::streamsize(pyramid.texels_.size());
+  if (in.read(static_cast<char*>(pyramid.texels_.data()), bytes).gcount() != bytes) return std::nullopt;
+  if (in.peek() != std::char_traits<char>::eof()) return std::nullopt;  // more than the header implies
+  return pyramid;
+}
+
 inline size_t MipMap::index(const Level& level, int x, int y) const {
   // x, y ≥ 0, so the divisions and remainders by the tile's side are shifts and masks.
   const unsigned ux = unsigned(x), uy = unsigned(y);
@@ -261,14 +358,14 @@ inline size_t MipMap::index(const Level& level, int x, int y) const {
 
 float MipMap::texel(int level, int x, int y, int c) const {
   const size_t i = index(levels_[size_t(level)], x, y) + size_t(c);
-  return format_ == TexelFormat::half ? value_of(halves_[i]) : value_of(codes_[i]);
+  return format_ == TexelFormat::half ? value_of(halves()[i]) : value_of(codes()[i]);
 }
 
 void MipMap::bilerp(int level, Vec2 st, TextureWrap wrap_s, TextureWrap wrap_t, float* out) const {
   if (format_ == TexelFormat::half)
-    bilerp_in(halves_.data(), level, st, wrap_s, wrap_t, out);
+    bilerp_in(halves(), level, st, wrap_s, wrap_t, out);
   else
-    bilerp_in(codes_.data(), level, st, wrap_s, wrap_t, out);
+    bilerp_in(codes(), level, st, wrap_s, wrap_t, out);
 }
 
 template <typename T>

@@ -15,6 +15,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -302,6 +304,67 @@ TEST_F(TexturePlans, UnreadableFilesAreInputErrorsNamingThem) {
             << e.what();
       }
     }
+}
+
+TEST(MipMap, WrittenAndReadBackBitForBit) {
+  // A pyramid written and read back holds the same texels; a stream of something else, cut
+  // short, or longer than its header implies, is not taken for a pyramid.
+  for (const rc::scene::TexelFormat format : {rc::scene::TexelFormat::half, rc::scene::TexelFormat::unorm8}) {
+    const MipMap pyramid(hashed_image(13, 6, 3), format);
+    std::stringstream stream;
+    ASSERT_TRUE(pyramid.write(stream));
+    const std::string bytes = stream.str();
+    std::istringstream whole(bytes);
+    const std::optional<MipMap> back = MipMap::read(whole);
+    ASSERT_TRUE(back.has_value());
+    ASSERT_EQ(back->levels(), pyramid.levels());
+    EXPECT_EQ(back->format(), format);
+    for (int l = 0; l < pyramid.levels(); ++l)
+      for (int y = 0; y < pyramid.height(l); ++y)
+        for (int x = 0; x < pyramid.width(l); ++x)
+          for (int c = 0; c < 3; ++c) ASSERT_EQ(back->texel(l, x, y, c), pyramid.texel(l, x, y, c));
+    std::istringstream cut(bytes.substr(0, bytes.size() - 1)), longer(bytes + "x"), other("P6\n4 4\n255\n");
+    EXPECT_FALSE(MipMap::read(cut).has_value());
+    EXPECT_FALSE(MipMap::read(longer).has_value());
+    EXPECT_FALSE(MipMap::read(other).has_value());
+  }
+}
+
+TEST_F(TexturePlans, LargePyramidsAreKeptInTheCacheFolderAndReadBack) {
+  // A 1024 × 512 image's pyramid (over 1 MiB) is written to the cache folder by the first load
+  // and read back by the second, which then reads the same values. A cached file spoilt (cut
+  // short) is passed over: the image is decoded again and the file made whole. A small image
+  // is not cached.
+  const std::string large = ppm("large.ppm", 1024, 512), small = ppm("small.ppm", 16, 16);
+  const std::vector<rc::scene::TextureImage> images{{large, true}, {small, true}};
+  const auto cached_files = [&] {
+    std::vector<fs::path> files;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir_ / "cache", ec))
+      if (entry.path().extension() == ".pyramid") files.push_back(entry.path());
+    return files;
+  };
+  const auto lookups = [](const rc::scene::TextureSet& set) {
+    std::vector<float> values;
+    for (int k = 0; k < 200; ++k)
+      for (const float d : {0.0f, 1.0f / 256.0f}) {
+        const rc::Vec2 st(std::fmod(0.5f + k * 0.618034f, 1.0f), (k + 0.5f) / 200.0f);
+        const rc::scene::Texel t = set.lookup(0, st, {d, 0.0f}, {0.0f, d});
+        values.insert(values.end(), {t.rgb.r, t.rgb.g, t.rgb.b});
+      }
+    return values;
+  };
+  const rc::scene::TextureSet first(images);
+  const std::vector<fs::path> files = cached_files();
+  ASSERT_EQ(files.size(), 1u);  // the large image's only
+  EXPECT_EQ(fs::file_size(files[0]), 32 + MipMap::bytes_for(1024, 512, 3));
+  const rc::scene::TextureSet second(images);
+  EXPECT_EQ(lookups(second), lookups(first));
+
+  fs::resize_file(files[0], fs::file_size(files[0]) / 2);
+  const rc::scene::TextureSet third(images);
+  EXPECT_EQ(lookups(third), lookups(first));
+  EXPECT_EQ(fs::file_size(files[0]), 32 + MipMap::bytes_for(1024, 512, 3));
 }
 
 }  // namespace
