@@ -38,6 +38,7 @@ nlohmann::json run_statistics(const rc::scene::Scene& scene, const std::string& 
   if (textures)
     j["textures"] = {{"images", textures->size()},
                      {"files", textures->file_count()},
+                     {"cached_files", textures->cached_file_count()},
                      {"plan", rc::scene::texture_plan_name(textures->plan())},
                      {"pyramid_bytes", textures->pyramid_bytes()},
                      {"load_seconds", textures->load_seconds()}};

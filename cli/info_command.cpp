@@ -152,7 +152,8 @@ struct SceneSummary {
   size_t emissive = 0;   ///< materials
   size_t vertices = 0;
   size_t bytes = 0;      ///< geometry and BVH, estimated
-  size_t textured = 0, texels = 0, texture_bytes = 0, texture_files = 0, normal_mapped = 0;
+  size_t textured = 0, texels = 0, texture_bytes = 0, texture_files = 0, cached_texture_files = 0,
+         normal_mapped = 0;
   std::optional<rc::scene::TexturePlan> texture_plan;  ///< none without textures
 };
 
@@ -183,6 +184,7 @@ void count_textures(const rc::scene::Scene& scene, SceneSummary& s) {
     s.texels = set->texel_count();
     s.texture_bytes = set->pyramid_bytes();
     s.texture_files = set->file_count();
+    s.cached_texture_files = set->cached_file_count();
     s.texture_plan = set->plan();
   }
 }
@@ -253,6 +255,7 @@ void print_info_json(const InfoOptions& o, const rc::scene::Scene& scene, const 
                         {"textured_materials", s.textured},
                         {"normal_mapped_materials", s.normal_mapped},
                         {"files", s.texture_files},
+                        {"cached_files", s.cached_texture_files},
                         {"texels", s.texels},
                         {"plan", s.texture_plan ? rc::scene::texture_plan_name(*s.texture_plan) : "none"},
                         {"memory_bytes", s.texture_bytes},
@@ -298,8 +301,10 @@ void print_info_text(const InfoOptions& o, const rc::scene::Scene& scene, const 
     const double budget = double(rc::scene::texture_memory_budget()) / double(1 << 20);
     if (s.texture_plan.value_or(rc::scene::TexturePlan::in_memory) == rc::scene::TexturePlan::in_memory)
       std::printf(
-          "  texture plan: in-memory pyramids, within the budget of %.0f MiB (GILT_TEXTURE_MEMORY_MB)\n",
-          budget);
+          "  texture plan: in-memory pyramids, within the budget of %.0f MiB (GILT_TEXTURE_MEMORY_MB); %zu "
+          "of %zu "
+          "read back from the cache folder %s\n",
+          budget, s.cached_texture_files, s.texture_files, rc::scene::texture_cache_folder().c_str());
     else
       std::printf(
           "  texture plan: OpenImageIO's cache, paging tiles in and out: the pyramids exceed the budget of "

@@ -5,6 +5,7 @@
 #include <OpenImageIO/texture.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -212,7 +213,8 @@ fs::path pyramid_cache_path(const FileRole& file) {
 /// 0.35 s on 2 threads and read back in a fraction of that (bench/README.md). The cache is an
 /// aid, never a requirement: a folder that cannot be written, or a cached file that is not a
 /// whole pyramid of this build's layout, is passed over, and the image decoded.
-MipMap load_pyramid(const FileRole& file, const ImageHeader& header) {
+MipMap load_pyramid(const FileRole& file, const ImageHeader& header, bool& from_cache) {
+  from_cache = false;
   if (MipMap::bytes_for(header.width, header.height, header.channels, header.format) < kCachedPyramidBytes)
     return decode(file);
   const fs::path cached = pyramid_cache_path(file);
@@ -221,8 +223,10 @@ MipMap load_pyramid(const FileRole& file, const ImageHeader& header) {
     std::optional<MipMap> pyramid = MipMap::read(in);
     if (pyramid && pyramid->width(0) == header.width && pyramid->height(0) == header.height &&
         pyramid->format() == header.format &&
-        pyramid->channels() == std::min(header.channels, MipMap::kMaxChannels))
+        pyramid->channels() == std::min(header.channels, MipMap::kMaxChannels)) {
+      from_cache = true;
       return std::move(*pyramid);
+    }
   }
   MipMap pyramid = decode(file);
   // Written under a name of its own and renamed into place, so a reader never sees a
@@ -298,6 +302,7 @@ struct TextureSet::Impl {
     TextureWrap wrap_s = TextureWrap::repeat, wrap_t = TextureWrap::repeat;
   };
   std::vector<std::optional<MipMap>> pyramids;  ///< one per distinct file and role
+  size_t cached_files = 0;                      ///< pyramids read back from the cache folder
   std::vector<Image> images;
   // Under oiio_cache.
   OIIO::TextureSystem* system = nullptr;
@@ -321,7 +326,13 @@ void TextureSet::Impl::open_pyramids(const std::vector<TextureImage>& all, const
                                      const std::vector<ImageHeader>& headers,
                                      const std::vector<size_t>& file_of) {
   pyramids.resize(files.size());
-  for_each_file(files, [&](size_t f) { pyramids[f].emplace(load_pyramid(files[f], headers[f])); });
+  std::vector<char> from_cache(files.size(), 0);
+  for_each_file(files, [&](size_t f) {
+    bool cached = false;
+    pyramids[f].emplace(load_pyramid(files[f], headers[f], cached));
+    from_cache[f] = cached;
+  });
+  cached_files = size_t(std::count(from_cache.begin(), from_cache.end(), 1));
   for (size_t i = 0; i < all.size(); ++i) {
     const MipMap& pyramid = *pyramids[file_of[i]];
     images.push_back(Image{&pyramid, all[i].wrap_s, all[i].wrap_t});
@@ -400,6 +411,7 @@ TextureSet::TextureSet(const std::vector<TextureImage>& images, size_t memory_bu
     impl_->open_pyramids(images_, files, headers, file_of);
   else
     impl_->open_cache(images_);
+  cached_files_ = impl_->cached_files;
   load_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -96,6 +96,8 @@ class TextureSet {
   size_t pyramid_bytes() const { return pyramid_bytes_; }
   /// Distinct files (with their colour or data role) the images read.
   size_t file_count() const { return files_; }
+  /// Files whose pyramids were read back from the cache folder rather than decoded.
+  size_t cached_file_count() const { return cached_files_; }
   /// Wall-clock seconds the constructor took (headers, decoding, pyramids or cache copies).
   double load_seconds() const { return load_seconds_; }
   size_t size() const { return images_.size(); }
@@ -112,6 +114,7 @@ class TextureSet {
   TexturePlan plan_ = TexturePlan::in_memory;
   size_t pyramid_bytes_ = 0;
   size_t files_ = 0;
+  size_t cached_files_ = 0;
   double load_seconds_ = 0.0;
 };
 

@@ -355,14 +355,17 @@ TEST_F(TexturePlans, LargePyramidsAreKeptInTheCacheFolderAndReadBack) {
     return values;
   };
   const rc::scene::TextureSet first(images);
+  EXPECT_EQ(first.cached_file_count(), 0u);
   const std::vector<fs::path> files = cached_files();
   ASSERT_EQ(files.size(), 1u);  // the large image's only
   EXPECT_EQ(fs::file_size(files[0]), 32 + MipMap::bytes_for(1024, 512, 3));
   const rc::scene::TextureSet second(images);
+  EXPECT_EQ(second.cached_file_count(), 1u);
   EXPECT_EQ(lookups(second), lookups(first));
 
   fs::resize_file(files[0], fs::file_size(files[0]) / 2);
   const rc::scene::TextureSet third(images);
+  EXPECT_EQ(third.cached_file_count(), 0u);
   EXPECT_EQ(lookups(third), lookups(first));
   EXPECT_EQ(fs::file_size(files[0]), 32 + MipMap::bytes_for(1024, 512, 3));
 }
