@@ -213,6 +213,37 @@ fs::path pyramid_cache_path(const FileRole& file) {
 /// 0.35 s on 2 threads and read back in a fraction of that (bench/README.md). The cache is an
 /// aid, never a requirement: a folder that cannot be written, or a cached file that is not a
 /// whole pyramid of this build's layout, is passed over, and the image decoded.
+/// Removes pyramids from `folder`, least recently used first (a read touches its file), until
+/// `incoming` more bytes fit within `budget`. False when they cannot. Another process removing
+/// the same files at the same time only makes some removals fail, which is harmless.
+bool make_room(const fs::path& folder, size_t incoming, size_t budget) {
+  if (incoming > budget) return false;
+  struct Entry {
+    fs::file_time_type time;
+    size_t bytes;
+    fs::path path;
+  };
+  std::vector<Entry> entries;
+  size_t total = 0;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+    if (e.path().extension() != ".pyramid") continue;
+    std::error_code stat;
+    const size_t bytes = size_t(e.file_size(stat));
+    const fs::file_time_type time = e.last_write_time(stat);
+    if (stat) continue;
+    entries.push_back(Entry{time, bytes, e.path()});
+    total += bytes;
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
+  for (const Entry& e : entries) {
+    if (total + incoming <= budget) break;
+    fs::remove(e.path, ec);
+    total -= e.bytes;
+  }
+  return total + incoming <= budget;
+}
+
 MipMap load_pyramid(const FileRole& file, const ImageHeader& header, bool& from_cache) {
   from_cache = false;
   if (MipMap::bytes_for(header.width, header.height, header.channels, header.format) < kCachedPyramidBytes)
@@ -225,6 +256,8 @@ MipMap load_pyramid(const FileRole& file, const ImageHeader& header, bool& from_
         pyramid->format() == header.format &&
         pyramid->channels() == std::min(header.channels, MipMap::kMaxChannels)) {
       from_cache = true;
+      std::error_code ec;
+      fs::last_write_time(cached, fs::file_time_type::clock::now(), ec);  // recently used
       return std::move(*pyramid);
     }
   }
@@ -237,7 +270,8 @@ MipMap load_pyramid(const FileRole& file, const ImageHeader& header, bool& from_
   const fs::path partial =
       cached.string() + ".part" + std::to_string(::getpid()) + "-" + std::to_string(serial.fetch_add(1));
   bool written = false;
-  if (!ec) {
+  const size_t file_bytes = pyramid.bytes() + 64;  // its header's 32 bytes, with room
+  if (!ec && make_room(cached.parent_path(), file_bytes, texture_cache_budget())) {
     std::ofstream out(partial, std::ios::binary);
     written = out && pyramid.write(out) && out.flush();
   }
@@ -281,15 +315,26 @@ Texel to_texel(const float* v, int channels) {
 
 }  // namespace
 
-size_t texture_memory_budget() {
-  const char* text = std::getenv("GILT_TEXTURE_MEMORY_MB");
-  if (!text || !*text) return size_t(4) << 30;
+namespace {
+
+/// Bytes from an environment variable in mebibytes, or `fallback` when it is unset or empty.
+size_t mebibytes_from_environment(const char* name, size_t fallback) {
+  const char* text = std::getenv(name);
+  if (!text || !*text) return fallback;
   char* end = nullptr;
   const unsigned long long mb = std::strtoull(text, &end, 10);
   if (*end != '\0' || text[0] == '-')
-    throw InputError(std::string("GILT_TEXTURE_MEMORY_MB=") + text + ": not a whole number of mebibytes");
+    throw InputError(std::string(name) + "=" + text + ": not a whole number of mebibytes");
   return size_t(mb) << 20;
 }
+
+}  // namespace
+
+size_t texture_memory_budget() {
+  return mebibytes_from_environment("GILT_TEXTURE_MEMORY_MB", size_t(4) << 30);
+}
+
+size_t texture_cache_budget() { return mebibytes_from_environment("GILT_TEXTURE_CACHE_MB", size_t(4) << 30); }
 
 const char* texture_plan_name(TexturePlan plan) {
   return plan == TexturePlan::in_memory ? "in-memory pyramids" : "OpenImageIO's cache";

@@ -66,6 +66,11 @@ enum class TexturePlan : uint8_t {
 /// Bytes of in-memory pyramids a scene may hold: $GILT_TEXTURE_MEMORY_MB mebibytes, else 4 GiB.
 size_t texture_memory_budget();
 
+/// Bytes the pyramids kept in the texture cache folder may take together: GILT_TEXTURE_CACHE_MB
+/// (mebibytes; InputError if it is not a whole number), else 4 GiB. Past it, the pyramids least
+/// recently used are removed to make room.
+size_t texture_cache_budget();
+
 /// The images of one scene, opened for filtered lookups. Thread-safe.
 class TextureSet {
  public:

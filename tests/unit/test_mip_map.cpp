@@ -370,5 +370,35 @@ TEST_F(TexturePlans, LargePyramidsAreKeptInTheCacheFolderAndReadBack) {
   EXPECT_EQ(fs::file_size(files[0]), 32 + MipMap::bytes_for(1024, 512, 3));
 }
 
+TEST_F(TexturePlans, TheCacheKeepsWithinItsBudgetDroppingTheLeastRecentlyUsed) {
+  // Two images whose pyramids (about 4.2 MB each) fit the cache one at a time (GILT_TEXTURE_CACHE_MB=6):
+  // loading the second removes the first's, and loading the first again removes the second's.
+  // A budget of 0 keeps nothing; one that is not a number is an input error.
+  const std::string a = ppm("a.ppm", 1024, 512), b = ppm("b.ppm", 512, 1024);
+  const auto cached = [&] {
+    size_t n = 0;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir_ / "cache", ec))
+      n += entry.path().extension() == ".pyramid";
+    return n;
+  };
+  ::setenv("GILT_TEXTURE_CACHE_MB", "6", 1);
+  EXPECT_EQ(rc::scene::texture_cache_budget(), size_t(6) << 20);
+  EXPECT_EQ(rc::scene::TextureSet({{a, true}}).cached_file_count(), 0u);
+  EXPECT_EQ(cached(), 1u);
+  EXPECT_EQ(rc::scene::TextureSet({{a, true}}).cached_file_count(), 1u);
+  EXPECT_EQ(rc::scene::TextureSet({{b, true}}).cached_file_count(), 0u);
+  EXPECT_EQ(cached(), 1u);
+  EXPECT_EQ(rc::scene::TextureSet({{b, true}}).cached_file_count(), 1u);
+  EXPECT_EQ(rc::scene::TextureSet({{a, true}}).cached_file_count(), 0u);  // a's was dropped for b's
+  ::setenv("GILT_TEXTURE_CACHE_MB", "0", 1);
+  fs::remove_all(dir_ / "cache");
+  EXPECT_EQ(rc::scene::TextureSet({{a, true}}).cached_file_count(), 0u);
+  EXPECT_EQ(cached(), 0u);
+  ::setenv("GILT_TEXTURE_CACHE_MB", "some", 1);
+  EXPECT_THROW(rc::scene::texture_cache_budget(), rc::InputError);
+  ::unsetenv("GILT_TEXTURE_CACHE_MB");
+}
+
 }  // namespace
 }  // namespace gilt
