@@ -13,6 +13,7 @@
 #include <new>
 #include <ostream>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "raytrace_core/util/parallel.h"
@@ -123,6 +124,14 @@ LinearImage reduce(const Value& value, int w, int h, int channels) {
   return out;
 }
 
+/// Throws std::invalid_argument unless an image has a size, channels, and `count` (of `what`:
+/// values, codes) = width × height × channels.
+void check_shape(int width, int height, int channels, size_t count, const char* what) {
+  if (width < 1 || height < 1 || channels < 1 || count != size_t(width) * size_t(height) * size_t(channels))
+    throw std::invalid_argument(
+        std::string("MipMap: an image needs a size, channels and width × height × channels ") + what);
+}
+
 /// A value stored as a half float's bits, clamped to the finite halves.
 uint16_t to_half(float x) { return imath_float_to_half(std::clamp(x, -kHalfMax, kHalfMax)); }
 
@@ -217,10 +226,7 @@ size_t MipMap::bytes_for(int width, int height, int channels, TexelFormat format
 
 MipMap::MipMap(const LinearImage& image, TexelFormat format)
     : channels_(std::min(image.channels, kMaxChannels)), format_(format) {
-  if (image.width < 1 || image.height < 1 || image.channels < 1 ||
-      image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
-    throw std::invalid_argument(
-        "MipMap: an image needs a size, channels and width × height × channels values");
+  check_shape(image.width, image.height, image.channels, image.pixels.size(), "values");
   const size_t stride = size_t(image.channels);
   const float* pixels = image.pixels.data();
   const auto at = [&](int x, int y, int c) {
@@ -236,10 +242,7 @@ MipMap::MipMap(const LinearImage& image, TexelFormat format)
 
 MipMap::MipMap(const CodeImage& image, TexelFormat format)
     : channels_(std::min(image.channels, kMaxChannels)), format_(format) {
-  if (image.width < 1 || image.height < 1 || image.channels < 1 ||
-      image.codes.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
-    throw std::invalid_argument(
-        "MipMap: an image needs a size, channels and width × height × channels codes");
+  check_shape(image.width, image.height, image.channels, image.codes.size(), "codes");
   const size_t stride = size_t(image.channels);
   const uint8_t* codes = image.codes.data();
   const auto code = [&](int x, int y, int c) {

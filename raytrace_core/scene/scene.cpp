@@ -698,10 +698,12 @@ SurfaceInteraction Scene::surface(const Ray& ray, const Hit& hit) const {
   } else {
     si = triangle_point(hit.geom_id, hit.prim_id, Vec2(hit.u, hit.v));
   }
-  si.cone_width = ray.width + ray.spread * hit.t * glm::length(ray.direction);
-  si.cone_spread = ray.spread;
-  if (!std::isfinite(si.cone_width)) si.cone_width = si.cone_spread = 0.0f;
-  if (si.cone_width > 0.0f && hit.geom_id != sphere_geom_id()) pixel_footprint(ray, hit, si);
+  if (ray.spread > 0.0f || ray.width > 0.0f) {  // a camera path's ray: its cone at the hit
+    si.cone_width = ray.width + ray.spread * hit.t * glm::length(ray.direction);
+    si.cone_spread = ray.spread;
+    if (!std::isfinite(si.cone_width)) si.cone_width = si.cone_spread = 0.0f;
+    if (si.cone_width > 0.0f && hit.geom_id != sphere_geom_id()) pixel_footprint(ray, hit, si);
+  }
   si.front_face = glm::dot(ray.direction, si.ng) < 0.0f;
   return si;
 }

@@ -70,16 +70,29 @@ OIIO::TextureOpt::Wrap oiio_wrap(TextureWrap w) {
   return OIIO::TextureOpt::WrapPeriodic;
 }
 
+/// The name, in the cache folder, of what is kept there for `file` under `kind` (what was made
+/// of it, and how): named by the file's absolute path, size and time, so an edited file gets a
+/// new name. Empty, with `ec` set, when the file cannot be looked at.
+std::string cache_name(const std::string& file, const std::string& kind, const char* extension,
+                       std::error_code& ec) {
+  const fs::path source = fs::absolute(file, ec);
+  const auto size = fs::file_size(source, ec);
+  if (ec) return {};
+  const auto time = fs::last_write_time(source, ec).time_since_epoch().count();
+  if (ec) return {};
+  const std::string key =
+      source.string() + '|' + std::to_string(size) + '|' + std::to_string(time) + '|' + kind;
+  char name[48];
+  std::snprintf(name, sizeof name, "%016llx%s", static_cast<unsigned long long>(fnv1a(key)), extension);
+  return name;
+}
+
 /// The linear, MIP-mapped copy of an sRGB image, made once and kept in the cache folder.
 std::string linear_copy(const std::string& file) {
   std::error_code ec;
-  const fs::path source = fs::absolute(file, ec);
-  const auto size = fs::file_size(source, ec);
+  const std::string name = cache_name(file, "srgb-linear-half-v1", ".exr", ec);
   if (ec) throw InputError(file + ": texture cannot be read: " + ec.message());
-  const auto time = fs::last_write_time(source, ec).time_since_epoch().count();
-  const std::string key = source.string() + '|' + std::to_string(size) + '|' + std::to_string(time) + "|srgb-linear-half-v1";
-  char name[40];
-  std::snprintf(name, sizeof name, "%016llx.exr", static_cast<unsigned long long>(fnv1a(key)));
+  const fs::path source = fs::absolute(file, ec);
   const fs::path folder = texture_cache_folder();
   const fs::path target = folder / name;
   if (fs::exists(target, ec)) return target.string();
@@ -191,28 +204,15 @@ MipMap decode(const FileRole& file) {
 /// they read back.
 constexpr size_t kCachedPyramidBytes = size_t(1) << 20;
 
-/// Where a file's pyramid is kept between runs: in the cache folder, named by the file's path,
-/// size and time and its role (as linear_copy's names are), so an edited file is decoded again.
-/// Empty when the file cannot be looked at.
+/// Where a file's pyramid is kept between runs, by its role; empty when the file cannot be
+/// looked at.
 fs::path pyramid_cache_path(const FileRole& file) {
   std::error_code ec;
-  const fs::path source = fs::absolute(file.path, ec);
-  const auto size = fs::file_size(source, ec);
-  if (ec) return {};
-  const auto time = fs::last_write_time(source, ec).time_since_epoch().count();
-  if (ec) return {};
-  const std::string key = source.lexically_normal().string() + '|' + std::to_string(size) + '|' +
-                          std::to_string(time) + (file.srgb ? "|srgb" : "|data") + "|pyramid-v1";
-  char name[40];
-  std::snprintf(name, sizeof name, "%016llx.pyramid", static_cast<unsigned long long>(fnv1a(key)));
-  return fs::path(texture_cache_folder()) / name;
+  const std::string name =
+      cache_name(file.path, file.srgb ? "srgb-pyramid-v1" : "data-pyramid-v1", ".pyramid", ec);
+  return ec ? fs::path() : fs::path(texture_cache_folder()) / name;
 }
 
-/// A file's pyramid: read back from the cache folder when an earlier run made it, else decoded
-/// and written there for the next run. The benchmark model's five 2048² images decode in about
-/// 0.35 s on 2 threads and read back in a fraction of that (bench/README.md). The cache is an
-/// aid, never a requirement: a folder that cannot be written, or a cached file that is not a
-/// whole pyramid of this build's layout, is passed over, and the image decoded.
 /// Removes pyramids from `folder`, least recently used first (a read touches its file), until
 /// `incoming` more bytes fit within `budget`. False when they cannot. Another process removing
 /// the same files at the same time only makes some removals fail, which is harmless.
@@ -244,6 +244,11 @@ bool make_room(const fs::path& folder, size_t incoming, size_t budget) {
   return total + incoming <= budget;
 }
 
+/// A file's pyramid: read back from the cache folder when an earlier run made it, else decoded
+/// and written there for the next run. The benchmark model's five 2048² images decode in about
+/// 0.35 s on 2 threads and read back in a fraction of that (bench/README.md). The cache is an
+/// aid, never a requirement: a folder that cannot be written, or a cached file that is not a
+/// whole pyramid of this build's layout, is passed over, and the image decoded.
 MipMap load_pyramid(const FileRole& file, const ImageHeader& header, bool& from_cache) {
   from_cache = false;
   if (MipMap::bytes_for(header.width, header.height, header.channels, header.format) < kCachedPyramidBytes)
