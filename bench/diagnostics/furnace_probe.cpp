@@ -5,15 +5,21 @@
 // and the share of vertices more than 5 % off. Usage: furnace_probe SCENE [progressive|hierarchical]
 // [mesh|two-pass] [LINK_TOLERANCE [RECEIVER_SHARE]]; the scene's single material gives Le and ρ. VERTCSV
 // names a CSV of every vertex (position, normal, direct and total as fractions, its elements, their least
-// area, twin or not); PROBE_VERTEX=v prints what 256 cosine rays from vertex v meet in the element scene. (On
-// the furnace family's dome it showed the middle of the enclosure's floor removed as buried under the
-// building's one-sided floor: rays from under it escaped.)
+// area, twin or not); PROBE_VERTEX=v prints what 256 cosine rays from vertex v (or from its visibility origin
+// PROBE_ORIGIN=k) meet in the element scene. (On the furnace family's dome it showed the middle of the
+// enclosure's floor removed as buried under the building's one-sided floor: rays from under it escaped.)
+// CAMERA_PIXELS prints what the scene's camera sees of the solution, 96 × 72 pixels on the elements, and
+// the vertices that carry most of its excess and its shortfall. (On the furnished furnace it found the
+// floor round table legs reading 1.4 of the direct light: the tree walk read the legs at the vertex and
+// the room behind them from origins beside the legs.)
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
+#include <tuple>
 #include <vector>
 
 #include "radiosity/bake/view.h"
@@ -92,7 +98,16 @@ int main(int argc, char** argv) {
     // What cosine-weighted rays from just in front of one vertex meet in the element scene.
     const size_t v = std::strtoul(probe, nullptr, 10);
     const rc::scene::Scene geo = rad::mesh::element_scene(scene, mesh);
-    const rc::Vec3 n = mesh.normals[v], p = mesh.positions[v] + 1e-3f * n;
+    const rc::Vec3 n = mesh.normals[v];
+    // From the vertex, or from one of its visibility origins (PROBE_ORIGIN=k).
+    rc::Vec3 p = mesh.positions[v] + 1e-3f * n;
+    if (const char* k = std::getenv("PROBE_ORIGIN")) {
+      const rc::scene::Scene elements = rad::mesh::element_scene(scene, mesh);
+      const auto origins =
+          rad::solver::visibility_origins(elements, mesh, rad::solver::receiver_points(elements, mesh));
+      p = origins.at(rad::solver::kVisibilityOrigins * v + std::strtoul(k, nullptr, 10)).p;
+      std::printf("origin %s at (%.4f %.4f %.4f)\n", k, p.x, p.y, p.z);
+    }
     const rc::Frame frame = rc::Frame::from_normal(n);
     rc::util::Rng rng(1);
     int counts[4] = {0, 0, 0, 0};
@@ -123,6 +138,62 @@ int main(int argc, char** argv) {
         "vertex %zu at (%.3f %.3f %.3f) n (%.2f %.2f %.2f): escaped %d, other %d, fronts %d, backs %d\n", v,
         mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z, n.x, n.y, n.z, counts[0], counts[1],
         counts[2], counts[3]);
+  }
+  if (std::getenv("CAMERA_PIXELS")) {
+    // What the scene's camera sees of the solution: each pixel of a 96 × 72 image meets an element
+    // (the side facing the ray, where the element has a twin) and reads its vertices' direct and
+    // total irradiance at the hit's barycentrics. Prints the pixels' means and the vertices that
+    // carry most of the excess, by the pixels' weights.
+    const rc::scene::Scene geo = rad::mesh::element_scene(scene, mesh);
+    std::map<std::tuple<long, long, long>, std::vector<uint32_t>> at;  // elements by centroid
+    auto centroid = [&](size_t e) {
+      const auto& el = mesh.elements[e];
+      return (mesh.positions[el[0]] + mesh.positions[el[1]] + mesh.positions[el[2]]) / 3.0f;
+    };
+    auto key = [](const rc::Vec3& c) {
+      return std::make_tuple(std::lround(c.x * 1e4f), std::lround(c.y * 1e4f), std::lround(c.z * 1e4f));
+    };
+    for (size_t e = 0; e < mesh.element_count(); ++e) at[key(centroid(e))].push_back(uint32_t(e));
+    const rc::scene::Camera camera = scene.effective_camera(96.0f / 72.0f);
+    std::vector<double> excess(mesh.vertex_count(), 0.0), weight(mesh.vertex_count(), 0.0);
+    double sum_d = 0.0, sum_t = 0.0;
+    int hits = 0;
+    for (int y = 0; y < 72; ++y)
+      for (int x = 0; x < 96; ++x) {
+        const rc::scene::Ray ray =
+            camera.generate_ray({(x + 0.5f) / 96.0f, (y + 0.5f) / 72.0f}, {0.5f, 0.5f}, 96.0f / 72.0f);
+        const auto h = geo.intersect(ray);
+        if (!h || h->geom_id != 0) continue;
+        uint32_t e = h->prim_id;
+        for (uint32_t other : at[key(centroid(e))])
+          if (glm::dot(mesh.element_normal[other], ray.direction) < 0.0f) e = other;
+        const auto& el = mesh.elements[e];
+        // The hit's barycentrics belong to the element met; a twin lists its corners in reverse.
+        float b[3] = {1.0f - h->u - h->v, h->u, h->v};
+        if (e != h->prim_id) std::swap(b[1], b[2]);
+        double d = 0.0, t = 0.0;
+        for (int k = 0; k < 3; ++k)
+          d += b[k] * sol.vertex_direct[el[k]].average() / direct,
+              t += b[k] * sol.vertex_irradiance[el[k]].average() / total;
+        for (int k = 0; k < 3; ++k) excess[el[k]] += b[k] * (t - 1.0), weight[el[k]] += b[k];
+        sum_d += d, sum_t += t, ++hits;
+      }
+    std::printf("camera: %d pixels on elements, direct %.4f, total %.4f\n", hits, sum_d / std::max(1, hits),
+                sum_t / std::max(1, hits));
+    std::vector<size_t> order(mesh.vertex_count());
+    for (size_t v = 0; v < order.size(); ++v) order[v] = v;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return excess[a] > excess[b]; });
+    // The fifteen that carry most excess, then the fifteen that carry most shortfall.
+    for (size_t j = 0; j < 30 && j < order.size(); ++j) {
+      const size_t v = j < 15 ? order[j] : order[order.size() - 1 - (j - 15)];
+      if (j == 15) std::printf("  ...\n");
+      const auto p = mesh.positions[v], n = mesh.normals[v];
+      std::printf(
+          "  vertex %zu at (%.3f %.3f %.3f) n (%.2f %.2f %.2f): pixels %.2f, excess %.3f, direct %.3f, total "
+          "%.3f\n",
+          v, p.x, p.y, p.z, n.x, n.y, n.z, weight[v], excess[v], sol.vertex_direct[v].average() / direct,
+          sol.vertex_irradiance[v].average() / total);
+    }
   }
   if (!sol.element_closure.empty()) {
     // The links' closure: the sum of each element's link factors, 1 in any closed scene.
