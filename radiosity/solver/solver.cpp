@@ -680,8 +680,15 @@ struct SolveState {
 
   double elapsed() const { return seconds_since(start); }
   auto albedo(uint32_t material) const { return rc::scene::diffuse_reflectance(scene.materials[material]); }
-  auto emitted(uint32_t material) const { return scene.materials[material].emission * kPi; }  // B0 = π Le
-  bool is_emitter(uint32_t e) const { return !scene.materials[mesh.element_material[e]].emission.is_black(); }
+  /// What element e emits, B0 = π Le. An emitter emits on the side its input face was wound to
+  /// face, as the path tracer's do, unless its material emits on both: the twin orient_sides puts
+  /// behind a lamp whose back sees a lit ceiling emits nothing (it made the lit family's vaulted
+  /// colonnade, hung with 432 lamps, read 1.23 of the path tracer).
+  Rgb element_emitted(size_t e) const {
+    const rc::scene::Material& m = scene.materials[mesh.element_material[e]];
+    return mesh.twin(e) && !m.two_sided_emission ? Rgb(0.0f) : m.emission * kPi;
+  }
+  bool is_emitter(size_t e) const { return !element_emitted(e).is_black(); }
   void add_counts(const Counts& c) {
     form_factors += c.form_factors;
     rays += c.rays;
@@ -718,7 +725,7 @@ struct SolveState {
     std::vector<Rgb> radiosity(mesh.element_count());
     for (size_t q = 0; q < patches.count() && !hierarchical; ++q) {
       if (!is_emitter(patches.of(q)[0])) continue;
-      for (uint32_t e : patches.of(q)) radiosity[e] = emitted(mesh.element_material[e]);
+      for (uint32_t e : patches.of(q)) radiosity[e] = element_emitted(e);
       ShootingPatch& sp = emitters.emplace_back();
       sp.assign(mesh, patches.of(q), radiosity);
       sp.emitter = true;
@@ -733,7 +740,7 @@ struct SolveState {
   void emitted_by_tree(size_t first_vertex) {
     const size_t nv_now = mesh.vertex_count();
     std::vector<Rgb> emission(mesh.element_count());
-    for (size_t e = 0; e < emission.size(); ++e) emission[e] = emitted(mesh.element_material[e]);
+    for (size_t e = 0; e < emission.size(); ++e) emission[e] = element_emitted(e);
     // The materials' own albedo is enough here (it only weighs links in the tree walk), and the
     // textured means cost a few seconds per 100,000 elements at every refinement step.
     std::vector<Rgb> rho(mesh.element_count());
@@ -900,7 +907,7 @@ struct SolveState {
       const Rgb rho = element_rho[e];
       const Rgb emitted_light =
           (direct_emitted[el[0]] + direct_emitted[el[1]] + direct_emitted[el[2]]) * (1.0f / 3.0f);
-      shot.emitted_power += double(emitted(mesh.element_material[e]).average()) * mesh.element_area[e];
+      shot.emitted_power += double(element_emitted(e).average()) * mesh.element_area[e];
       shot.emitted_power +=
           double((rho * (sol.element_direct[e] - emitted_light)).average()) * mesh.element_area[e];
       shot.unshot[e] = rho * sol.element_direct[e];
@@ -1191,8 +1198,12 @@ struct SolveState {
   /// its vertices); and the counts and seconds.
   void finish() {
     sol.vertex_radiosity.resize(nv);
+    // A vertex emits what its elements do (a twin's vertices are its own: see element_emitted).
+    std::vector<Rgb> vertex_emitted(nv, Rgb(0.0f));
+    for (size_t e = 0; e < ne; ++e)
+      for (uint32_t v : mesh.elements[e]) vertex_emitted[v] = element_emitted(e);
     for (size_t v = 0; v < nv; ++v)
-      sol.vertex_radiosity[v] = emitted(mesh.vertex_material[v]) + sol.vertex_albedo[v] * sol.vertex_irradiance[v];
+      sol.vertex_radiosity[v] = vertex_emitted[v] + sol.vertex_albedo[v] * sol.vertex_irradiance[v];
     sol.element_radiosity.resize(ne);
     for (size_t e = 0; e < ne; ++e) {
       const auto& el = mesh.elements[e];
