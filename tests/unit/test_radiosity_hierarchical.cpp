@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "radiosity/solver/solver.h"
+#include "raytrace_core/io/scene_io.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/rng.h"
-#include "raytrace_core/io/scene_io.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -53,19 +53,20 @@ void box(rc::scene::TriangleMesh& m, rc::Vec3 lo, rc::Vec3 hi, bool inward) {
   }
 }
 
-/// A closed 6 × 3 × 6 room of white (ρ = 0.7) boxes around a 0.8 × 0.8 lamp of radiance 20 under
-/// its ceiling, holding `boxes`.
-rc::scene::Scene lit_room(const rc::scene::TriangleMesh& boxes) {
+/// A closed 6 × 3 × 6 room of white (ρ = 0.7) boxes around a 0.8 × 0.8 lamp of radiance 20 facing
+/// down at height `lamp_y` (just under its ceiling by default), holding `boxes` (may be empty).
+rc::scene::Scene lit_room(const rc::scene::TriangleMesh& boxes, float lamp_y = 2.99f) {
   rc::scene::Scene scene;
   scene.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.7f)));
   scene.materials.push_back(rc::scene::Material::make_emitter("lamp", rc::Rgb(20.0f)));
   rc::scene::TriangleMesh room;
   box(room, {-3, 0, -3}, {3, 3, 3}, true);
   scene.meshes.push_back(room);
-  scene.meshes.push_back(boxes);
+  if (!boxes.indices.empty()) scene.meshes.push_back(boxes);
   rc::scene::TriangleMesh lamp;
   lamp.material = 1;
-  lamp.positions = {{-0.4f, 2.99f, -0.4f}, {0.4f, 2.99f, -0.4f}, {0.4f, 2.99f, 0.4f}, {-0.4f, 2.99f, 0.4f}};
+  lamp.positions = {
+      {-0.4f, lamp_y, -0.4f}, {0.4f, lamp_y, -0.4f}, {0.4f, lamp_y, 0.4f}, {-0.4f, lamp_y, 0.4f}};
   lamp.indices = {0, 1, 2, 0, 2, 3};
   scene.meshes.push_back(lamp);
   scene.commit();
@@ -540,20 +541,9 @@ TEST(HierarchicalRadiosity, ABallsFacesTakeTheLightOfTheirOwnSide) {
 // one-sided). The ceiling straight above the lamp sees only its back, so its direct light is
 // exactly zero: every solver must read it so, whatever the shadow rays.
 TEST(HierarchicalRadiosity, ALampsTwinDoesNotEmit) {
-  // lit_room's room and lamp, the lamp half a metre under the ceiling: the ceiling over it is lit
-  // by the room and sees the lamp's back from a distance.
-  rc::scene::Scene scene;
-  scene.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.7f)));
-  scene.materials.push_back(rc::scene::Material::make_emitter("lamp", rc::Rgb(20.0f)));
-  rc::scene::TriangleMesh room;
-  box(room, {-3, 0, -3}, {3, 3, 3}, true);
-  scene.meshes.push_back(room);
-  rc::scene::TriangleMesh lamp;
-  lamp.material = 1;
-  lamp.positions = {{-0.4f, 2.5f, -0.4f}, {0.4f, 2.5f, -0.4f}, {0.4f, 2.5f, 0.4f}, {-0.4f, 2.5f, 0.4f}};
-  lamp.indices = {0, 1, 2, 0, 2, 3};
-  scene.meshes.push_back(lamp);
-  scene.commit();
+  // The lamp half a metre under the ceiling: the ceiling over it is lit by the room and sees the
+  // lamp's back from a distance.
+  const rc::scene::Scene scene = lit_room({}, 2.5f);
   for (auto kind : {rad::solver::SolverKind::progressive, rad::solver::SolverKind::hierarchical}) {
     const rad::solver::Solution sol = rad::solver::solve(scene, settings(kind, 3000, 0));
     size_t lamp_twins = 0;
@@ -571,3 +561,4 @@ TEST(HierarchicalRadiosity, ALampsTwinDoesNotEmit) {
     EXPECT_GT(above, 0);
   }
 }
+
