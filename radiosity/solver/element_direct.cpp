@@ -7,6 +7,7 @@
 
 #include "radiosity/mesh/element_scene.h"
 #include "raytrace_core/scene/light.h"
+#include "raytrace_core/scene/straight_transmittance.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
 #include "raytrace_core/util/rng.h"
@@ -81,8 +82,10 @@ std::vector<Rgb> element_punctual_irradiance(const rc::scene::Scene& scene, cons
               const int k = pairing[size_t(i * side + j)];
               const rc::Vec2 u((k / side + rng.uniform()) / side, (k % side + rng.uniform()) / side);
               const Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(u));
-              if (!geometry.occluded(rc::scene::spawn_shadow_ray_to_infinity(at, w)))
-                sum += rc::scene::environment_radiance(light, w) * kPi;
+              // Through glass too: a path finds the sky through a window (see punctual_irradiance).
+              const Rgb through =
+                  rc::scene::straight_transmittance(geometry, rc::scene::spawn_shadow_ray_to_infinity(at, w));
+              if (!through.is_black()) sum += through * rc::scene::environment_radiance(light, w) * kPi;
               continue;
             }
             const rc::scene::LightSample ls = rc::scene::sample_light(scene, light, at, rng.uniform2());

@@ -28,6 +28,7 @@
 #include "radiosity/solver/probe_fraction.h"
 #include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/scene/light.h"
+#include "raytrace_core/scene/straight_transmittance.h"
 #include "raytrace_core/util/error.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/processes.h"
@@ -323,6 +324,9 @@ Patches build_patches(const RadiosityMesh& mesh, int patch_elements) {
 
 /// Irradiance at a vertex with unit normal n from a punctual or environment light of `scene`,
 /// with visibility traced against `geometry` from the vertex's visibility origins `from`.
+/// The sky reaches it through glass (straight_transmittance), as a path through a window finds
+/// it; a point, spot or directional light does not, for no path can meet one through glass,
+/// and the view, tracing the direct light the camera sees, would draw the surface unlit.
 Rgb punctual_irradiance(const rc::scene::Scene& scene, const rc::scene::Scene& geometry,
                         const rc::scene::Light& light, std::span<const rc::scene::SurfacePoint> from,
                         const Vec3& n, rc::util::Rng& rng, int samples, uint64_t& rays) {
@@ -339,7 +343,9 @@ Rgb punctual_irradiance(const rc::scene::Scene& scene, const rc::scene::Scene& g
         ++rays;
         const rc::scene::SurfacePoint& at = from[(first + size_t(i * side + j)) % kVisibilityOrigins];
         const Vec3 w = frame.to_world(rc::util::sample_cosine_hemisphere(u));
-        if (!geometry.occluded(rc::scene::spawn_shadow_ray_to_infinity(at, w))) open += rc::scene::environment_radiance(light, w);
+        const Rgb through =
+            rc::scene::straight_transmittance(geometry, rc::scene::spawn_shadow_ray_to_infinity(at, w));
+        if (!through.is_black()) open += through * rc::scene::environment_radiance(light, w);
       }
     return open * (kPi / float(side * side));
   }

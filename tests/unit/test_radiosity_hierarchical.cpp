@@ -7,6 +7,7 @@
 
 #include "radiosity/solver/solver.h"
 #include "raytrace_core/io/scene_io.h"
+#include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/rng.h"
 
@@ -562,3 +563,57 @@ TEST(HierarchicalRadiosity, ALampsTwinDoesNotEmit) {
   }
 }
 
+// A 6 × 3 × 6 room open at the top to a uniform sky, then glazed there with a 4 cm pane: the
+// sky must still light the floor, through the glass. With the same mesh and seed both rooms
+// trace the same directions from each vertex, so the glazed floor's direct light over the open
+// one's is a mean of the pane's transmittance (1 − F)² over the directions that reach the sky,
+// and lies between its values at the steepest and the most oblique of them: exactly, with no
+// allowance for noise. From the floor's middle (|x|, |z| < 0.5, rays leaving from visibility
+// origins up to 15 cm further out) the sky is seen up to 60° from the vertical (F = 0.089 for
+// η = 1.5), so the ratio lies in (0.911², 0.96²) = (0.830, 0.9216). Before glass let the sky
+// through, the glazed floor read no direct light at all.
+TEST(HierarchicalRadiosity, TheSkyLightsARoomThroughItsGlazedRoof) {
+  const auto room = [](bool glazed) {
+    rc::scene::Scene scene;
+    scene.materials.push_back(rc::scene::Material::make_diffuse("white", rc::Rgb(0.7f)));
+    scene.materials.push_back(rc::scene::Material::make_dielectric("glass", 1.5f));
+    rc::scene::TriangleMesh walls;
+    box(walls, {-3, 0, -3}, {3, 3, 3}, true);
+    walls.indices.erase(walls.indices.begin() + 18, walls.indices.begin() + 24);  // the ceiling
+    scene.meshes.push_back(walls);
+    if (glazed) {
+      rc::scene::TriangleMesh pane;
+      pane.material = 1;
+      box(pane, {-3, 3, -3}, {3, 3.04f, 3}, false);
+      scene.meshes.push_back(pane);
+    }
+    rc::scene::Light sky;
+    sky.kind = rc::scene::LightKind::environment;
+    sky.radiance = rc::Rgb(1.0f);
+    scene.punctual_lights.push_back(sky);
+    scene.commit();
+    return scene;
+  };
+  const rc::scene::Scene open = room(false), glazed = room(true);
+  const float steep = 0.96f * 0.96f;
+  const float f_oblique = rc::scene::fresnel_dielectric(0.5f, 1.5f);
+  const float oblique = (1.0f - f_oblique) * (1.0f - f_oblique);
+  for (auto kind : {rad::solver::SolverKind::progressive, rad::solver::SolverKind::hierarchical}) {
+    const rad::solver::Solution a = rad::solver::solve(open, settings(kind, 2000, 0));
+    const rad::solver::Solution b = rad::solver::solve(glazed, settings(kind, 2000, 0));
+    ASSERT_EQ(a.mesh.vertex_count(), b.mesh.vertex_count());
+    double through_open = 0.0, through_glass = 0.0;
+    for (size_t v = 0; v < a.mesh.vertex_count(); ++v) {
+      const rc::Vec3 p = a.mesh.positions[v];
+      // The floor's top side (its underside has a twin, which sees the sky below the room).
+      if (p.y > 1e-3f || a.mesh.normals[v].y < 0.5f || std::abs(p.x) > 0.5f || std::abs(p.z) > 0.5f) continue;
+      ASSERT_EQ(p, b.mesh.positions[v]);
+      through_open += a.vertex_direct[v].average();
+      through_glass += b.vertex_direct[v].average();
+    }
+    ASSERT_GT(through_open, 0.0);
+    const double ratio = through_glass / through_open;
+    EXPECT_GT(ratio, oblique) << "solver " << int(kind);
+    EXPECT_LT(ratio, steep) << "solver " << int(kind);
+  }
+}
