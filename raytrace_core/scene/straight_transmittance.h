@@ -17,10 +17,11 @@ namespace gilt::raytrace_core::scene {
 class Scene;
 
 /// Fraction of the light from the far end of `ray` (tmax, or infinity) that reaches its origin
-/// when every dielectric surface it meets, smooth or rough, is crossed in a straight line: the
-/// product of 1 − F at each crossing (Fresnel at the ray's angle to the surface, the same from
-/// either side of a pane) and of Beer–Lambert attenuation inside absorbing glass. Black when the
-/// ray meets anything else, or crosses more than 16 surfaces.
+/// when every smooth dielectric surface it meets is crossed in a straight line: the product of
+/// 1 − F at each crossing (Fresnel at the ray's angle to the surface, the same from either side
+/// of a pane) and of Beer–Lambert attenuation inside absorbing glass. Black when the ray meets
+/// anything else (frosted glass too, which spreads what it lets through into a lobe), or
+/// crosses more than 16 surfaces.
 Rgb straight_transmittance(const Scene& scene, Ray ray);
 
 }  // namespace gilt::raytrace_core::scene

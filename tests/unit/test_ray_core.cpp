@@ -268,7 +268,7 @@ rc::scene::TriangleMesh slab(float thickness, uint32_t material) {
 // A shadow ray through a pane of glass carries what both interfaces let through, in closed form:
 // (1 − F)² with F Fresnel's reflectance for η = 1.5 (0.04 head-on; at 60°, rs² = 0.176571 and
 // rp² = 0.001802 give F = 0.089187), times e^(−σ d / cos θ) where the glass absorbs; a diffuse
-// surface beyond blocks it unless the ray ends first.
+// surface beyond blocks it unless the ray ends first; frosted glass blocks it.
 TEST(RayCore, StraightTransmittanceThroughAPane) {
   rc::scene::Scene scene;
   scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
@@ -303,6 +303,10 @@ TEST(RayCore, StraightTransmittanceThroughAPane) {
   const rc::Rgb tint = through({10.1f, 0.2f, 1.0f}, {0, 0, -1}, 1.9f);
   EXPECT_NEAR(tint.r, head_on * std::exp(-0.5f * d), 1e-5f);
   EXPECT_NEAR(tint.b, head_on * std::exp(-2.0f * d), 1e-5f);
+  // Frosted glass spreads what it lets through into a lobe: not a straight line, so blocked.
+  scene.materials[1].roughness = 0.5f;
+  ASSERT_TRUE(scene.materials[1].is_rough_dielectric());
+  EXPECT_EQ(through({0.1f, 0.2f, 1.0f}, {0, 0, -1}), rc::Rgb(0.0f));
   // Going on to the plate (and beyond): blocked.
   EXPECT_EQ(through({10.1f, 0.2f, 1.0f}, {0, 0, -1}), rc::Rgb(0.0f));
   EXPECT_EQ(through({10.1f, 0.2f, 1.0f}, {0, 0, -1}, 2.1f), rc::Rgb(0.0f));
