@@ -746,10 +746,7 @@ TEST(ExportSnap, ExportedVerticesLieOnACurvedInput) {
   rc::scene::Scene scene;
   scene.materials.push_back(rc::scene::Material::make_diffuse("grey", rc::Rgb(0.5f)));
   scene.meshes.push_back(test::icosphere(3));
-  rc::scene::Light sky;
-  sky.kind = rc::scene::LightKind::environment;
-  sky.radiance = rc::Rgb(1.0f);
-  scene.punctual_lights.push_back(sky);
+  scene.punctual_lights.push_back(test::uniform_sky(1.0f));
   scene.commit();
   SolverSettings settings;
   settings.mesh.elements = 300;

@@ -10,6 +10,7 @@
 #include "raytrace_core/scene/bsdf.h"
 #include "raytrace_core/util/parallel.h"
 #include "raytrace_core/util/rng.h"
+#include "tests/support/test_scenes.h"
 
 namespace rc = gilt::raytrace_core;
 namespace rad = gilt::radiosity;
@@ -451,14 +452,12 @@ TEST(HierarchicalRadiosity, NoLightLeaksThroughAThickRoof) {
   box(walls, {-3, 0, -3}, {3, 3, 3}, true);
   box(walls, {-3.3f, -0.3f, -3.3f}, {3.3f, 3.3f, 3.3f}, false);
   scene.meshes.push_back(walls);
-  rc::scene::Light sun, sky;
+  rc::scene::Light sun;
   sun.kind = rc::scene::LightKind::directional;
   sun.direction = glm::normalize(rc::Vec3(0.35f, -1.0f, 0.45f));
   sun.irradiance = rc::Rgb(8.0f);
   scene.punctual_lights.push_back(sun);
-  sky.kind = rc::scene::LightKind::environment;
-  sky.radiance = rc::Rgb(1.0f);
-  scene.punctual_lights.push_back(sky);
+  scene.punctual_lights.push_back(gilt::test::uniform_sky(1.0f));
   scene.commit();
   constexpr double tolerance = 2e-3;
   rad::solver::SolverSettings s = settings(rad::solver::SolverKind::hierarchical, 8000, 0);
@@ -587,10 +586,7 @@ TEST(HierarchicalRadiosity, TheSkyLightsARoomThroughItsGlazedRoof) {
       box(pane, {-3, 3, -3}, {3, 3.04f, 3}, false);
       scene.meshes.push_back(pane);
     }
-    rc::scene::Light sky;
-    sky.kind = rc::scene::LightKind::environment;
-    sky.radiance = rc::Rgb(1.0f);
-    scene.punctual_lights.push_back(sky);
+    scene.punctual_lights.push_back(gilt::test::uniform_sky(1.0f));
     scene.commit();
     return scene;
   };
