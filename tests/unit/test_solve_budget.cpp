@@ -98,7 +98,17 @@ TEST(SolveBudget, AProgressiveSolveEndsItsKeptBackTimeBeforeItsLimit) {
   const rad::solver::Solution sol = rad::solver::solve(scene, s);
   EXPECT_DOUBLE_EQ(sol.seconds_kept_back, 4.0);
   EXPECT_GT(sol.residual, s.tolerance) << "stopped by the time, not converged";
-  EXPECT_LE(sol.seconds, s.time_limit - 0.5 * s.after_seconds);
+  // As for the hierarchical solve below: where meshing and the direct light alone take the time
+  // left to the solve, nothing after them is budgeted. Under the sanitizers they take about 2.8 s
+  // of the 2 s, and on a loaded machine the whole solve took 5.9 s there.
+  const double unbudgeted = sol.mesh_seconds + sol.direct_seconds;
+  if (unbudgeted > s.time_limit - s.after_seconds)
+    GTEST_SKIP() << "meshing and the direct light took " << unbudgeted << " s of the "
+                 << s.time_limit - s.after_seconds
+                 << " s left to the solve: a build this slow cannot show whether the kept-back time was kept";
+  EXPECT_LE(sol.seconds, s.time_limit - 0.5 * s.after_seconds)
+      << "meshing " << sol.mesh_seconds << " s, direct light " << sol.direct_seconds << " s, shooting "
+      << sol.shoot_seconds << " s";
 }
 
 // The same for the hierarchical solver, whose timed ladder foretells its first level. Untimed,
