@@ -4,10 +4,11 @@
 // A pane of glass (two parallel interfaces) shifts a ray sideways by a fraction of its thickness
 // and sends it on in its own direction, so a straight line through it is the path the light
 // takes, weighted by what each interface lets through (1 − F, Fresnel) and by what the glass
-// absorbs on the way. Radiosity uses this where light is not traced as paths: the sky and the
-// lamps seen through a window light the room behind it (a room whose glazing was opaque to its
-// solver read 0.76 of the path tracer's mean, 0.35 near its windows). For curved glass (a
-// bottle, a lens) the straight line keeps the light's total but not its caustic.
+// absorbs on the way. The radiosity solver uses this for its direct light from the sky, which is
+// not traced as paths: the sky seen through a window lights the room behind it (a room whose
+// glazing was opaque to its solver read 0.76 of the path tracer's mean, 0.35 near its windows).
+// For curved glass (a bottle, a lens) the straight line keeps the light's total but not its
+// caustic. Each call that meets something scans the scene's materials for glass once.
 
 #include "raytrace_core/scene/ray.h"
 #include "raytrace_core/util/rgb.h"
